@@ -1,0 +1,3 @@
+from fivdisc.cli import main
+
+main()

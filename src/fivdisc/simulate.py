@@ -1,0 +1,242 @@
+"""Driver of the non-smooth simulation: ``simulate(case) -> Result``."""
+
+from __future__ import annotations
+
+import time as _time
+from collections.abc import Callable, Mapping
+from importlib.metadata import version
+
+import numpy as np
+
+from fivdisc._kernels import integrate as kern
+from fivdisc._kernels.dynamics import SLIP
+from fivdisc.case import Case
+from fivdisc.errors import SimulationError
+from fivdisc.model import Model, build_model
+from fivdisc.result import EVENT_KINDS, PHASE_NAMES, Result, build_dataset
+from fivdisc.speed import SpeedProfile
+
+_STATUS = {
+    kern.ST_DONE: "success",
+    kern.ST_STOPPED: "stopped",
+    kern.ST_NONFINITE: "nonfinite",
+    kern.ST_UNDERFLOW: "step_size_underflow",
+    kern.ST_ZENO: "endless_switching",
+    kern.ST_MAX_SWITCHES: "max_switches",
+}
+_EVENT_BUFFER = 1 << 15
+_CHUNKS = 200
+# Switches closer than this, this many times in a row, are taken as Zeno/chattering.
+_ZENO_DT = 1e-10
+_ZENO_COUNT = 1000
+
+
+def initial_state(model: Model, initial=None) -> np.ndarray:
+    """Kernel state at t = 0.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    initial : None, "rest", "equilibrium", mapping or array
+        ``None`` takes the case's ``simulation.initial_state``. A mapping may give
+        ``q`` [m], ``q_dot`` [m/s], ``phi`` [rad], ``phi_dot`` [rad/s] (missing ones
+        are zero); an array is a full state of length ``2 n + 4``.
+    """
+    sim = model.case.simulation
+    if initial is None:
+        initial = sim.initial_state
+    y = np.zeros(model.state_size)
+    n = model.n
+    if isinstance(initial, str):
+        if initial == "rest":
+            return y
+        if initial == "equilibrium":
+            from fivdisc.analysis.equilibrium import sliding_equilibrium
+
+            y = sliding_equilibrium(model).state.copy()
+            y[n] += sim.perturbation.phi
+            y[2 * n + 2] += sim.perturbation.phi_dot
+            return y
+        raise SimulationError(
+            f"initial = {initial!r} is invalid: must be 'rest', 'equilibrium', a mapping "
+            "or a state array"
+        )
+    if isinstance(initial, Mapping):
+        allowed = {"q", "q_dot", "phi", "phi_dot"}
+        unknown = set(initial) - allowed
+        if unknown:
+            raise SimulationError(
+                f"initial has unknown keys {sorted(unknown)}: allowed are {sorted(allowed)}"
+            )
+        for key, sl in (("q", slice(0, n)), ("q_dot", slice(n + 2, 2 * n + 2))):
+            if key in initial:
+                val = np.asarray(initial[key], dtype=float)
+                if val.shape != (n,):
+                    raise SimulationError(
+                        f"initial[{key!r}] has shape {val.shape}: must be ({n},), one per "
+                        "modal coordinate"
+                    )
+                y[sl] = val
+        y[n] = float(initial.get("phi", 0.0))
+        y[2 * n + 2] = float(initial.get("phi_dot", 0.0))
+    else:
+        y = np.array(initial, dtype=float)
+        if y.shape != (model.state_size,):
+            raise SimulationError(
+                f"initial state has shape {y.shape}: must be ({model.state_size},) = 2 n + 4"
+            )
+    if not np.all(np.isfinite(y)):
+        raise SimulationError("initial state is invalid: all values must be finite")
+    return y
+
+
+def simulate(
+    case: Case,
+    *,
+    initial=None,
+    speed: SpeedProfile | tuple[Callable, Callable] | None = None,
+    stop_on: tuple[str, ...] = (),
+    progress: bool = False,
+) -> Result:
+    """Integrate the slider-on-disc system of ``case``.
+
+    Parameters
+    ----------
+    case : Case
+        The case (disc, slider, friction, speed, simulation settings).
+    initial : optional
+        Initial state; see :func:`initial_state`.
+    speed : SpeedProfile or (callable, callable), optional
+        Overrides the case's speed: a profile, or a pair ``Omega(t)`` [rad/s],
+        ``Omegadot(t)`` [rad/s^2] of Python callables (represented by a cubic
+        Hermite interpolant, see :meth:`SpeedProfile.from_callables`).
+    stop_on : tuple of str
+        Event kinds (``"separation"``, ``"stick"``, ...) that end the run early;
+        the status is then ``"stopped"``.
+    progress : bool
+        Show a progress bar in simulated time.
+
+    Returns
+    -------
+    Result
+        Its ``dataset`` holds the sampled histories and the event table; a failed
+        run keeps what was computed, with ``status`` and ``message`` saying why.
+    """
+    sim = case.simulation
+    if isinstance(speed, tuple):
+        speed = SpeedProfile.from_callables(*speed, t_end=sim.duration)
+    for kind in stop_on:
+        if kind not in EVENT_KINDS:
+            raise SimulationError(
+                f"stop_on = {kind!r} is invalid: must be one of {', '.join(EVENT_KINDS)}"
+            )
+    model = build_model(case, speed)
+    y = initial_state(model, initial)
+
+    n_out = int(np.floor(sim.duration * sim.output_rate + 1e-9)) + 1
+    ns = model.state_size
+    out_y = np.full((n_out, ns), np.nan)
+    out_aux = np.full((n_out, 4), np.nan)
+    ctl = np.zeros(kern.N_CONTROL)
+    ctl[kern.C_RTOL] = sim.rtol
+    ctl[kern.C_ATOL] = sim.atol
+    ctl[kern.C_MAX_STEP] = sim.max_step
+    ctl[kern.C_T_FINAL] = sim.duration
+    ctl[kern.C_OUT_DT] = 1.0 / sim.output_rate
+    ctl[kern.C_MAX_SWITCHES] = sim.max_switches
+    ctl[kern.C_ZENO_DT] = _ZENO_DT
+    ctl[kern.C_ZENO_COUNT] = _ZENO_COUNT
+    ctl[kern.C_STOP_MASK] = sum(1 << EVENT_KINDS.index(k) for k in set(stop_on))
+    fst = np.zeros(kern.N_FSTATE)
+    fst[kern.F_LAST_SWITCH] = -np.inf
+    ist = np.zeros(kern.N_ISTATE, dtype=np.int64)
+    ist[kern.I_PHASE] = SLIP
+    ist[kern.I_SIGN] = 1
+    k = np.zeros((7, ns))
+    ev_prev = np.zeros(3)
+    ev_t = np.empty(_EVENT_BUFFER)
+    ev_i = np.empty((_EVENT_BUFFER, 3), dtype=np.int64)
+    breaks = np.unique(model.speed.breakpoints[model.speed.breakpoints < sim.duration])
+    mdl = model.kernel_args
+    ev_times: list[np.ndarray] = []
+    ev_rows: list[np.ndarray] = []
+
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=sim.duration, unit="s", unit_scale=False, desc="simulating",
+                   bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s [{elapsed}<{remaining}]")
+    start = _time.perf_counter()
+    status = kern.ST_RUNNING
+    interrupted = False
+    try:
+        for chunk in range(1, _CHUNKS + 1):
+            target = sim.duration * chunk / _CHUNKS
+            while True:
+                status = kern.run(target, mdl, ctl, fst, ist, y, k, ev_prev, breaks,
+                                  out_y, out_aux, ev_t, ev_i)
+                n_ev = ist[kern.I_EVENTS]
+                if n_ev:
+                    ev_times.append(ev_t[:n_ev].copy())
+                    ev_rows.append(ev_i[:n_ev].copy())
+                    ist[kern.I_EVENTS] = 0
+                if status != kern.ST_RUNNING or fst[kern.F_T] >= target:
+                    break
+            if bar is not None:
+                bar.update(fst[kern.F_T] - bar.n)
+            if status != kern.ST_RUNNING:
+                break
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        if bar is not None:
+            bar.close()
+    wall = _time.perf_counter() - start
+
+    t_end = fst[kern.F_T]
+    phase_name = PHASE_NAMES[ist[kern.I_PHASE]]
+    if interrupted:
+        name, message = "interrupted", f"interrupted at t = {t_end:.9g} s in {phase_name}"
+    else:
+        name = _STATUS.get(status, "unknown")
+        message = _message(name, t_end, PHASE_NAMES[ist[kern.I_FAIL_PHASE]], sim)
+    n_done = int(ist[kern.I_OUT_NEXT])
+    times = np.minimum(np.arange(n_done) / sim.output_rate, sim.duration)
+    events = (
+        np.concatenate(ev_times) if ev_times else np.empty(0),
+        np.concatenate(ev_rows) if ev_rows else np.empty((0, 3), dtype=np.int64),
+    )
+    attrs = {
+        "status": name,
+        "message": message,
+        "end_time": float(t_end),
+        "impact": int(sim.impact),
+        "case": case.to_toml(),
+        "fivdisc_version": version("fivdisc"),
+        "wall_time": wall,
+        "n_steps": int(ist[kern.I_STEPS]),
+        "n_rejected": int(ist[kern.I_REJECTED]),
+        "n_rhs": int(ist[kern.I_RHS]),
+        "n_switches": int(ist[kern.I_SWITCHES]),
+        "final_phase": int(ist[kern.I_PHASE]),
+        "final_state": y.copy(),
+    }
+    ds = build_dataset(model, out_y[:n_done], out_aux[:n_done], times, events, attrs)
+    return Result(ds)
+
+
+def _message(name: str, t: float, phase: str, sim) -> str:
+    where = f"at t = {t:.9g} s in {phase}"
+    return {
+        "success": f"reached t = {sim.duration} s",
+        "stopped": f"stopped early on request at t = {t:.9g} s",
+        "nonfinite": f"state became non-finite {where}; try smaller simulation.rtol/atol "
+        "or check the parameters",
+        "step_size_underflow": f"step size underflow {where}; try looser simulation.rtol/atol",
+        "endless_switching": f"endless switching (Zeno/chattering) {where}: "
+        f"{_ZENO_COUNT} switches less than {_ZENO_DT} s apart",
+        "max_switches": f"simulation.max_switches = {sim.max_switches} reached {where}",
+    }.get(name, f"ended {where}")
+
