@@ -187,7 +187,8 @@ class Disc(_Table):
         nu, in (-1, 0.5).
     modes
         (k, l) = (nodal circles, nodal diameters) of the modes kept; each l >= 1
-        stands for a doublet (cos and sin). Distinct, at least one.
+        stands for a doublet (cos and sin). Distinct; empty means a rigid disc
+        (N = N0), the classic 1-DOF oscillator on a moving belt.
     """
 
     _key: ClassVar[tuple[str, ...]] = ("disc",)
@@ -199,7 +200,7 @@ class Disc(_Table):
     youngs_modulus: Real = _field(150e9, "Pa", gt=0)
     poisson_ratio: Real = _field(0.211, gt=-1, lt=0.5)
     modes: Annotated[tuple[Mode, ...], AfterValidator(_distinct_modes)] = _field(
-        ((0, 0), (0, 1), (0, 2), (0, 3)), min_length=1
+        ((0, 0), (0, 1), (0, 2), (0, 3))
     )
 
     @model_validator(mode="after")
@@ -439,6 +440,10 @@ class Simulation(_Table):
         each r within [a, b].
     omega_dot_terms
         Keep the disc's dOmega/dt terms (the paper's printed equations omit them).
+    printed_gyroscopic_sign
+        Use the printed paper's sign of the gyroscopic term of the D equations
+        (+2 l M Omega dC/dt instead of -). That form is not skew: it acts as a
+        speed-proportional negative damping. For comparison with the paper only.
     rtol
         Relative tolerance of the integrator, in (0, 0.1].
     atol
@@ -459,6 +464,7 @@ class Simulation(_Table):
     initial_state: Literal["rest", "equilibrium"] = "rest"
     probes: tuple[Probe, ...] = _field(((0.1, 0.0), (0.1, 1.0)))
     omega_dot_terms: Flag = True
+    printed_gyroscopic_sign: Flag = False
     rtol: Real = _field(1e-8, gt=0, le=0.1)
     atol: Real = _field(1e-11, gt=0)
     max_step: Real = _field(0.0, "s", ge=0)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -71,15 +72,21 @@ class Model:
         """Length of the kernel's state vector, ``2 n + 4``."""
         return 2 * self.n + 4
 
-    @property
+    @cached_property
     def kernel_args(self) -> tuple:
         """The model tuple the numba kernels take."""
+        mass = self.modal_mass
+        gyro_sign = (
+            np.ones_like(self.sgn) if self.case.simulation.printed_gyroscopic_sign else self.sgn
+        )
         return (
             self.par,
             self.l,
             self.R0,
-            self.modal_mass,
-            self.omega**2,
+            1.0 / mass,
+            mass * self.omega**2,
+            mass * self.l**2,
+            gyro_sign * self.l * mass,
             self.sgn,
             self.partner,
             self.speed.knots,

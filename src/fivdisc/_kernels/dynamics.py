@@ -9,12 +9,14 @@ integrated only in separation (in contact the slider follows the disc and they a
 held constant). Every function here is written without comparisons on the state so
 that it also compiles for complex arrays (complex-step Jacobians).
 
-The model tuple ``mdl`` is ``(par, li, R0, Mm, w2, sgn, partner, knots, coef)``:
-``par`` scalar parameters indexed by the ``P_*`` constants; per modal coordinate the
-nodal-diameter count ``li``, the mode shape at the track ``R0``, the modal mass
-``Mm``, the squared natural frequency ``w2``, ``sgn`` = +1 for a cosine (C) and -1
-for a sine (D) coordinate, and ``partner`` = index of the other member of a doublet
-(-1 for l = 0); ``knots``/``coef`` are the piecewise-cubic speed profile.
+The model tuple ``mdl`` is ``(par, li, R0, minv, kd, ml2, gyr, sgn, partner, knots,
+coef)``: ``par`` scalar parameters indexed by the ``P_*`` constants; per modal
+coordinate the nodal-diameter count ``li``, the mode shape at the track ``R0``, the
+inverse modal mass ``minv = 1/M``, the modal stiffness ``kd = M omega^2``,
+``ml2 = M l^2``, the gyroscopic factor ``gyr = sgn l M``, ``sgn`` = +1 for a cosine (C)
+and -1 for a sine (D) coordinate, and ``partner`` = index of the other member of a
+doublet (-1 for l = 0); ``knots``/``coef`` are the piecewise-cubic speed profile
+(positions ``M_*`` below).
 """
 
 from __future__ import annotations
@@ -43,6 +45,11 @@ P_OMDOT = 13
 P_IMPACT = 14
 P_LMAX = 15
 N_PAR = 16
+
+M_PAR = 0
+M_MINV = 3
+M_KNOTS = 9
+M_COEF = 10
 
 
 @njit(cache=True)
@@ -78,7 +85,7 @@ def evaluate(t, y, phase, s, right, mdl, work, dy):
     velocity [m/s] under the slider, and the relative speed ``Omega - phidot``
     [rad/s]. ``work`` is a ``(5, m)`` scratch array of the state's dtype.
     """
-    par, li, R0, Mm, w2, sgn, partner, knots, coef = mdl
+    par, li, R0, minv, kd, ml2, gyr, sgn, partner, knots, coef = mdl
     n = li.shape[0]
     m = par[P_MASS]
     inertia = par[P_INERTIA]
@@ -109,11 +116,15 @@ def evaluate(t, y, phase, s, right, mdl, work, dy):
         cl[k + 1] = 2.0 * c1 * cl[k] - cl[k - 1]
         sl[k + 1] = 2.0 * c1 * sl[k] - sl[k - 1]
 
+    om2 = om * om
     wc = zero
     wcd = zero
     gpq = zero
     gpqd = zero
     l2gq = zero
+    s_gf = zero
+    s_gg = zero
+    s_ggp = zero
     for j in range(n):
         lj = li[j]
         if sgn[j] > 0.0:
@@ -132,10 +143,13 @@ def evaluate(t, y, phase, s, right, mdl, work, dy):
         gpqd += gpj * qdj
         l2gq += lj * lj * gj * qj
         p = partner[j]
-        gyro = zero
+        fj = -(kd[j] - ml2[j] * om2) * qj
         if p >= 0:
-            gyro = sgn[j] * lj * Mm[j] * (2.0 * om * y[n + 2 + p] + eps * omd * y[p])
-        fq[j] = -Mm[j] * (w2[j] - lj * lj * om * om) * qj - gyro
+            fj -= gyr[j] * (2.0 * om * y[n + 2 + p] + eps * omd * y[p])
+        fq[j] = fj
+        s_gf += gj * fj * minv[j]
+        s_gg += gj * gj * minv[j]
+        s_ggp += gj * gpj * minv[j]
         dy[j] = qdj
     wcd += phid * gpq
     v = om - phid
@@ -143,7 +157,7 @@ def evaluate(t, y, phase, s, right, mdl, work, dy):
     dy[n] = phid
     if phase == SEPARATION:
         for j in range(n):
-            dy[n + 2 + j] = fq[j] / Mm[j]
+            dy[n + 2 + j] = fq[j] * minv[j]
         dy[2 * n + 2] = (-par[P_CPHI] * phid - par[P_KPHI] * phi) / inertia
         dy[n + 1] = y[2 * n + 3]
         dy[2 * n + 3] = (-par[P_N0] - par[P_CZ] * y[2 * n + 3] - par[P_KZ] * y[n + 1]) / m
@@ -164,32 +178,22 @@ def evaluate(t, y, phase, s, right, mdl, work, dy):
         mu = par[P_MU1] + (par[P_MU0] - par[P_MU1]) * np.exp(-par[P_ALPHA] * r0 * s * v)
         smu = s * mu
         fphi = -par[P_CPHI] * phid - par[P_KPHI] * phi
-        a1 = zero
-        a2 = zero
-        for j in range(n):
-            a1 += g[j] * fq[j] / Mm[j]
-            a2 += g[j] * (g[j] - hh * smu * gp[j]) / Mm[j]
         # Rank-one elimination of N from [M q'' + N e = Fq; I phi'' = Fphi + r0 s mu N;
-        # N = n_known + m (g.q'' + g'.q phi'')]: O(n) instead of a dense solve.
-        nf = (n_known + m * a1 + m * gpq * fphi / inertia) / (
-            1.0 + m * a2 - m * gpq * r0 * smu / inertia
+        # N = n_known + m (g.q'' + g'.q phi'')] with e = g - hh s mu g': O(n), no solve.
+        nf = (n_known + m * s_gf + m * gpq * fphi / inertia) / (
+            1.0 + m * (s_gg - hh * smu * s_ggp) - m * gpq * r0 * smu / inertia
         )
         f = smu * nf
         for j in range(n):
-            dy[n + 2 + j] = (fq[j] - nf * (g[j] - hh * smu * gp[j])) / Mm[j]
+            dy[n + 2 + j] = (fq[j] - nf * (g[j] - hh * smu * gp[j])) * minv[j]
         dy[2 * n + 2] = (fphi + r0 * f) / inertia
         return nf, f, wc, wcd, v
 
     # Stick: phi'' = Omegadot, friction is the reaction of the in-plane oscillator.
     f = (inertia * omd + par[P_CPHI] * om + par[P_KPHI] * phi) / r0
-    a1 = zero
-    a2 = zero
+    nf = (n_known + m * (s_gf + hh * f * s_ggp) + m * gpq * omd) / (1.0 + m * s_gg)
     for j in range(n):
-        a1 += g[j] * (fq[j] + hh * f * gp[j]) / Mm[j]
-        a2 += g[j] * g[j] / Mm[j]
-    nf = (n_known + m * a1 + m * gpq * omd) / (1.0 + m * a2)
-    for j in range(n):
-        dy[n + 2 + j] = (fq[j] + hh * f * gp[j] - nf * g[j]) / Mm[j]
+        dy[n + 2 + j] = (fq[j] + hh * f * gp[j] - nf * g[j]) * minv[j]
     dy[2 * n + 2] = omd + zero
     return nf, f, wc, wcd, v
 
@@ -217,8 +221,9 @@ def event_values(phase, s, nf, f, wc, v, y, par, out):
 def plastic_impact(y, mdl, work):
     """Perfectly plastic re-contact (paper Eqs. 47-56): positions kept, slider and disc
     leave with one normal velocity. ``work[0]``/``work[1]`` must hold g, g' at ``y``."""
-    par, li, R0, Mm, w2, sgn, partner, knots, coef = mdl
-    n = li.shape[0]
+    par = mdl[M_PAR]
+    minv = mdl[M_MINV]
+    n = minv.shape[0]
     m = par[P_MASS]
     g = work[0]
     gp = work[1]
@@ -226,11 +231,11 @@ def plastic_impact(y, mdl, work):
     ratio = 0.0
     disc = 0.0
     for j in range(n):
-        ratio += m * g[j] * g[j] / Mm[j]
+        ratio += m * g[j] * g[j] * minv[j]
         disc += g[j] * y[n + 2 + j] + y[2 * n + 2] * gp[j] * y[j]
     zd_plus = (disc + ratio * zd_minus) / (1.0 + ratio)
     for j in range(n):
-        y[n + 2 + j] -= m * g[j] / Mm[j] * (zd_plus - zd_minus)
+        y[n + 2 + j] -= m * g[j] * minv[j] * (zd_plus - zd_minus)
     y[2 * n + 3] = zd_plus
 
 

@@ -18,6 +18,9 @@ from numba import njit
 
 from fivdisc._kernels.dopri5 import A, C, E, dense_coefficients, dense_eval
 from fivdisc._kernels.dynamics import (
+    M_COEF,
+    M_KNOTS,
+    P_LMAX,
     P_IMPACT,
     P_MUS,
     SEPARATION,
@@ -91,8 +94,8 @@ def choose_contact_phase(t, y, s_hint, mdl, work, dy):
     """Phase of a slider in contact at state ``y``: stick, slip (with its sign) or,
     where contact would need a pulling normal force, separation."""
     par = mdl[0]
-    knots = mdl[7]
-    coef = mdl[8]
+    knots = mdl[M_KNOTS]
+    coef = mdl[M_COEF]
     n = (y.shape[0] - 4) // 2
     om, _ = speed_at(t, knots, coef, True)
     v = om - y[2 * n + 2]
@@ -148,8 +151,8 @@ def _record_change(t, old_phase, old_s, new_phase, new_s, ev_t, ev_i, ist):
 def apply_switch(which, t, y, phase, s, mdl, work, dy, ev_t, ev_i, ist):
     """Carry the state across the switch triggered by event ``which`` of ``phase``."""
     par = mdl[0]
-    knots = mdl[7]
-    coef = mdl[8]
+    knots = mdl[M_KNOTS]
+    coef = mdl[M_COEF]
     n = (y.shape[0] - 4) // 2
     if phase == SEPARATION:
         # Re-contact: fill g, g' for the impact map, then pick the contact phase.
@@ -260,7 +263,7 @@ def _write_sample(i, ti, ys, phase, s, mdl, work, dy, out_y, out_aux):
     n = (ys.shape[0] - 4) // 2
     nf, f, wc, wcd, v = evaluate(ti, ys, phase, s, False, mdl, work, dy)
     if phase == STICK:
-        om, _ = speed_at(ti, mdl[7], mdl[8], False)
+        om, _ = speed_at(ti, mdl[M_KNOTS], mdl[M_COEF], False)
         ys[2 * n + 2] = om
     if phase != SEPARATION:
         ys[n + 1] = wc
@@ -316,7 +319,7 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
     """Advance the integration until ``t >= t_target``, the end, a failure, or a nearly
     full event buffer. All arrays are updated in place; returns the status."""
     ns = y.shape[0]
-    width = max(ns, int(mdl[0][15]) + 2)
+    width = max(ns, int(mdl[0][P_LMAX]) + 2)
     work = np.zeros((5, width))
     ynew = np.empty(ns)
     ytmp = np.empty(ns)
@@ -486,7 +489,7 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
                 old_phase = phase
                 old_s = s
                 if phase == STICK:
-                    om, _ = speed_at(t, mdl[7], mdl[8], True)
+                    om, _ = speed_at(t, mdl[M_KNOTS], mdl[M_COEF], True)
                     y[ns - 2] = om
                 phase, s = choose_contact_phase(t, y, s, mdl, work, dy)
                 _record_change(t, old_phase, old_s, phase, s, ev_t, ev_i, ist)

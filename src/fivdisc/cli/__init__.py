@@ -33,9 +33,10 @@ def cli() -> None:
 
 
 def _register() -> None:
-    from fivdisc.cli import modes
+    from fivdisc.cli import modes, simulate
 
     cli.add_command(modes.modes)
+    cli.add_command(simulate.simulate)
 
 
 _register()
