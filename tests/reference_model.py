@@ -59,6 +59,22 @@ Phase choice and event re-arming
 Within each integration window the speed is exactly linear in t (all the
 profiles are piecewise linear), so ``Omega(t) = Omega_a + Omegadot (t - t_a)``
 with a constant ``Omegadot``.
+
+Case options honoured: ``simulation.impact``, ``omega_dot_terms``,
+``printed_gyroscopic_sign``, ``initial_state`` ("rest" or "equilibrium" plus
+``perturbation``), ``max_step``, ``max_switches``.
+
+Two properties of the stated model (not of this code) that checks must respect
+------------------------------------------------------------------------------
+* The slider's phi equation has no component of the normal force along the
+  disc's slope, so without friction and damping the Jacobi integral changes at
+  the rate ``N phidot (g'.q)``; it is a first integral only while that is zero
+  (e.g. phi = phidot = 0 and f = 0).
+* For the same reason the plastic impact map changes
+  ``T2 = 1/2 sum M qdot^2 + 1/2 m zdot^2`` by exactly ``-u (u/2 + b) / K`` with
+  ``u`` the approach velocity (< 0), ``b = phidot (g'.q)`` and
+  ``K = 1/m + sum g^2/M``: T2 cannot increase when ``b = 0`` but can if
+  ``b > |u|/2`` (a grazing re-contact of a fast-moving slider on a sloped disc).
 """
 
 from __future__ import annotations
@@ -233,8 +249,12 @@ class _Model:
         self.omega_dot_terms = bool(getattr(sim, "omega_dot_terms", True))
         self.impact = bool(getattr(sim, "impact", True))
         self.partner = md.partner
-        # sign of the gyroscopic coupling on the right-hand side: -1 for C, +1 for D
-        self.gsign = np.where(md.is_sine, 1.0, -1.0)
+        # sign of the coupling terms on the right-hand side: -1 for C, +1 for D ...
+        self.dsign = np.where(md.is_sine, 1.0, -1.0)
+        # ... except the D equations' gyroscopic term with the printed paper's sign
+        # (+2 l M Omega Cdot on the left: not skew), an option for comparison only
+        printed = bool(getattr(sim, "printed_gyroscopic_sign", False))
+        self.gsign = np.where(md.is_sine, -1.0 if printed else 1.0, -1.0)
         self.lf = md.l.astype(float)
 
     # ---- kinematics
@@ -259,7 +279,7 @@ class _Model:
         md, p = self.md, self.partner
         eps = 1.0 if self.omega_dot_terms else 0.0
         lM = self.lf * md.M
-        b = self.gsign * (2.0 * lM * Om * qd[p] + eps * lM * Omd * q[p])
+        b = self.gsign * 2.0 * lM * Om * qd[p] + self.dsign * eps * lM * Omd * q[p]
         b -= md.M * (md.omega**2 - self.lf**2 * Om**2) * q
         return b
 
@@ -522,7 +542,9 @@ class ReferenceResult:
 
     def evaluate(self, times) -> dict:
         """Dense output at ``times``: phi, phi_dot, q, q_dot, z, z_dot, normal_force,
-        friction_force, phase, Omega, t."""
+        friction_force, phase, slip_sign (s in slip, else 0), Omega, t.
+
+        At a switch time the later segment is used (the state just after the switch)."""
         model = self._model
         n = model.n
         times = np.atleast_1d(np.asarray(times, float))
@@ -537,6 +559,7 @@ class ReferenceResult:
             "normal_force": np.empty(times.size),
             "friction_force": np.empty(times.size),
             "phase": np.empty(times.size, dtype=int),
+            "slip_sign": np.empty(times.size, dtype=int),
             "Omega": np.empty(times.size),
         }
         for i, (t, k) in enumerate(zip(times, self._segment_index(times), strict=True)):
@@ -554,6 +577,7 @@ class ReferenceResult:
             out["normal_force"][i] = r["N"]
             out["friction_force"][i] = r["f"]
             out["phase"][i] = seg.phase
+            out["slip_sign"][i] = seg.sign
             out["Omega"][i] = seg.piece.omega(t)
         return out
 
@@ -714,7 +738,8 @@ def reference_simulate(
     y0=None,
     phase0: int | None = None,
     mode_data: ModeData | None = None,
-    max_switches: int = 200_000,
+    max_step: float | None = None,
+    max_switches: int | None = None,
 ) -> ReferenceResult:
     """Integrate the phase machine of equations.md from t = 0 to ``t_end``.
 
@@ -729,13 +754,24 @@ def reference_simulate(
     phase0 : optional initial phase (0 slip, 1 stick, 2 separation: needs z, zdot);
         default: chosen from the state (contact).
     mode_data : optional :class:`ModeData` instead of computing it from ``case.disc``.
-    max_switches : raise RuntimeError after that many phase switches.
+    max_step : largest solve_ivp step [s]; default ``case.simulation.max_step`` (0 = none).
+    max_switches : raise RuntimeError after that many phase switches; default
+        ``case.simulation.max_switches`` (else 200000).
+
+    The case options ``simulation.impact``, ``omega_dot_terms`` and
+    ``printed_gyroscopic_sign`` are honoured.
     """
     md = mode_data if mode_data is not None else mode_data_from_case(case)
     model = _Model(case, md)
     n = md.n
     if t_end is None:
         t_end = float(case.simulation.duration)
+    if max_step is None:
+        max_step = float(getattr(case.simulation, "max_step", 0.0))
+    if not max_step or max_step <= 0.0:
+        max_step = math.inf
+    if max_switches is None:
+        max_switches = int(getattr(case.simulation, "max_switches", 200_000))
     pieces = _speed_pieces(case.speed, t_end)
     y, phase = _initial_state(case, md, y0, phase0)
     t = 0.0
@@ -791,6 +827,7 @@ def reference_simulate(
             atol=atol,
             dense_output=True,
             events=evs,
+            max_step=max_step,
         )
         if ivp.status < 0:
             raise RuntimeError(

@@ -36,8 +36,9 @@ is a convention only: the dynamics depend on ``R(r)^2 / M``, which does not chan
 
 References
 ----------
-.. [1] A. W. Leissa, *Vibration of Plates*, NASA SP-160, 1969, section 2.3 (annular plates).
-.. [2] The paper of this project, ``slider-on-spinning-disc.md``, Table 1 and Eqs. (20)-(24).
+.. [1] A. W. Leissa, *Vibration of Plates*, NASA SP-160, 1969, ch. 2 (annular plates).
+.. [2] The paper the project reproduces (``slider-on-spinning-disc.md``): Eq. (24), Table 1 and
+   the natural frequencies quoted after it; the project's ``equations.md``, "Disc modes".
 """
 
 from __future__ import annotations
@@ -64,6 +65,10 @@ MAX_DERIVATIVE = 3
 _POINTS_PER_SPACING = 32
 # Grid points evaluated per vectorised call while scanning for sign changes.
 _SCAN_CHUNK = 64
+# The determinant of a matrix with unit columns is at most 1 in size (Hadamard) and is
+# computed to an absolute error of order 1e-15; below this its sign means nothing. That happens
+# as beta -> 0, where J_l and I_l (and Y_l and K_l) become parallel, and where Y_l overflows.
+_DETERMINANT_NOISE = 1e-12
 # Slack on the radial range accepted by PlateMode.shape, to let r = a or b computed with
 # round-off through.
 _RADIUS_SLACK = 1e-12
@@ -161,10 +166,12 @@ def _determinant(order: int, nu: float, a: float, b: float, beta: np.ndarray) ->
 
     For large l, Y_l and K_l are huge at r = a while J_l and I_l are small there; unit columns
     keep every entry O(1). Dividing by positive column norms moves neither the zeros nor the
-    sign changes.
+    sign changes. Where Y_l(beta a) overflows (beta a << l, far below the first root of a
+    harmonic l) the value is NaN, which brackets no root.
     """
-    matrix = _boundary_matrix(order, nu, a, b, beta)
-    return np.linalg.det(matrix / np.linalg.norm(matrix, axis=-2, keepdims=True))
+    with np.errstate(over="ignore", invalid="ignore"):
+        matrix = _boundary_matrix(order, nu, a, b, beta)
+        return np.linalg.det(matrix / np.linalg.norm(matrix, axis=-2, keepdims=True))
 
 
 def _count_bucket(count: int) -> int:
@@ -189,6 +196,9 @@ def _roots(a: float, b: float, nu: float, order: int, count: int) -> tuple[float
         return float(_determinant(order, nu, a, b, np.array([beta]))[0])
 
     roots: list[float] = []
+    # Last grid point whose determinant has a trustworthy sign; a bracket runs from it to the
+    # next such point, so cells with an untrustworthy sign are merged into their neighbours'.
+    last_beta, last_value = math.nan, math.nan
     start = 0.5 * step
     while len(roots) < count:
         if start > beta_cap:
@@ -196,15 +206,15 @@ def _roots(a: float, b: float, nu: float, order: int, count: int) -> tuple[float
                 f"found only {len(roots)} of {count} frequency parameters for l = {order} below "
                 f"beta = {beta_cap:.4g} 1/m; the plate geometry may be degenerate"
             )
-        # One grid point overlaps the next chunk so no bracket is lost at the seam.
-        grid = start + step * np.arange(_SCAN_CHUNK + 1)
+        grid = start + step * np.arange(_SCAN_CHUNK)
         values = _determinant(order, nu, a, b, grid)
-        for i in range(_SCAN_CHUNK):
-            if values[i] == 0.0:
-                roots.append(float(grid[i]))
-            elif values[i] * values[i + 1] < 0.0:
-                roots.append(optimize.brentq(det, grid[i], grid[i + 1], xtol=1e-14, rtol=1e-15))
-        start = float(grid[-1])
+        for beta, value in zip(grid.tolist(), values.tolist(), strict=True):
+            if not abs(value) > _DETERMINANT_NOISE:  # also skips NaN
+                continue
+            if value * last_value < 0.0:
+                roots.append(optimize.brentq(det, last_beta, beta, xtol=1e-14, rtol=1e-15))
+            last_beta, last_value = beta, value
+        start = float(grid[-1]) + step
     return tuple(roots[:count])
 
 
@@ -536,7 +546,7 @@ class PlateMode:
         slack = _RADIUS_SLACK * b
         if radii.size and not (np.all(radii >= a - slack) and np.all(radii <= b + slack)):
             bad = radii[(radii < a - slack) | (radii > b + slack) | np.isnan(radii)].flat[0]
-            raise ModeError(f"r = {bad!r} is out of range; allowed: {a} <= r <= {b} [m]")
+            raise ModeError(f"r = {float(bad)!r} is out of range; allowed: {a} <= r <= {b} [m]")
         values = _radial_values(
             self.l, self.beta, a, b, np.asarray(self.coefficients), radii, int(derivative)
         )

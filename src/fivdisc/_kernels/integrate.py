@@ -41,6 +41,9 @@ ST_ZENO = 4
 ST_MAX_SWITCHES = 5
 ST_STOPPED = 6
 
+# Interior points (+1) at which a near-zero event function is probed within a step.
+_PROBES = 8
+
 # Event kinds.
 EV_STICK = 0
 EV_SLIP = 1
@@ -193,15 +196,13 @@ def _event_at(theta, i, t, h, rc, phase, s, mdl, work, dy, ytmp, evt):
 
 
 @njit(cache=True)
-def locate(i, g_lo, g_hi, t, h, rc, phase, s, mdl, work, dy, ytmp, evt):
+def locate(i, lo, hi, g_lo, g_hi, t, h, rc, phase, s, mdl, work, dy, ytmp, evt):
     """Fraction of the step at which event ``i`` crosses zero, taken on the far side.
 
     Illinois false position on the bracket [lo, hi] with g(lo) > 0 >= g(hi), with a
     bisection whenever the bracket fails to halve; stops when the bracket is below
     1e-13 s (far below the 1e-9 s the switches must be located to).
     """
-    lo = 0.0
-    hi = 1.0
     tol = max(1e-13 / h, 1e-15)
     side = 0
     for _ in range(200):
@@ -414,7 +415,27 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
                 if not have_rc:
                     dense_coefficients(y, ynew, k, hs, rc)
                     have_rc = True
-                th = locate(i, ev_prev[i], evn[i], t, hs, rc, phase, s, mdl, work, dy, ytmp, evt)
+                th = locate(i, 0.0, 1.0, ev_prev[i], evn[i], t, hs, rc, phase, s, mdl, work,
+                            dy, ytmp, evt)
+            elif ev_prev[i] > 0.0 and min(ev_prev[i], evn[i]) < 2.0 * abs(evn[i] - ev_prev[i]):
+                # Both ends positive but close to zero for the change over the step: the
+                # function may dip below zero and back inside it (a brief separation or
+                # stick), so probe the dense output at interior points.
+                if not have_rc:
+                    dense_coefficients(y, ynew, k, hs, rc)
+                    have_rc = True
+                th = 2.0
+                g_lo = ev_prev[i]
+                for p in range(1, _PROBES):
+                    tp = p / _PROBES
+                    gp = _event_at(tp, i, t, hs, rc, phase, s, mdl, work, dy, ytmp, evt)
+                    if gp <= 0.0:
+                        th = locate(i, (p - 1) / _PROBES, tp, g_lo, gp, t, hs, rc, phase, s,
+                                    mdl, work, dy, ytmp, evt)
+                        break
+                    g_lo = gp
+                if th > 1.0:
+                    continue
             elif ev_prev[i] <= 0.0 and evn[i] < min(ev_prev[i], 0.0):
                 # A phase entered exactly on its boundary is already leaving it.
                 th = 1.0

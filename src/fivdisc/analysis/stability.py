@@ -1,0 +1,290 @@
+"""Linear stability of the sliding equilibrium, the paper's perturbation test, and maps."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+from fivdisc._kernels import dynamics as dyn
+from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium
+from fivdisc.case import Case
+from fivdisc.errors import CaseError
+from fivdisc.model import Model, build_model
+
+
+@dataclass(frozen=True)
+class LinearStability:
+    """Eigen-analysis of the slip equations linearised about the sliding equilibrium.
+
+    Attributes
+    ----------
+    equilibrium : Equilibrium
+        The sliding equilibrium.
+    jacobian : ndarray
+        ``(2 n + 2, 2 n + 2)`` Jacobian in the variables ``(q, phi, qdot, phidot)``.
+    eigenvalues : ndarray
+        Complex eigenvalues [1/s], sorted by decreasing real part.
+    eigenvectors : ndarray
+        Right eigenvectors (columns), in the order of ``eigenvalues``.
+    dominant : tuple of str
+        Per eigenvalue, the coordinate (``"C01"``, ..., ``"phi"``) with the largest share
+        of the eigenvector's kinetic energy.
+    """
+
+    equilibrium: Equilibrium
+    jacobian: np.ndarray
+    eigenvalues: np.ndarray
+    eigenvectors: np.ndarray
+    dominant: tuple[str, ...]
+
+    @property
+    def max_growth_rate(self) -> float:
+        """Largest real part of the eigenvalues [1/s]; > 0 means unstable."""
+        return float(self.eigenvalues.real[0])
+
+    @property
+    def stable(self) -> bool:
+        """Whether every eigenvalue has a negative real part (asymptotic stability)."""
+        return self.max_growth_rate < 0.0
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """Damped natural frequencies ``|Im(lambda)| / 2 pi`` [Hz]."""
+        return np.abs(self.eigenvalues.imag) / (2.0 * np.pi)
+
+    def table(self) -> list[dict]:
+        """One row per eigenvalue with a non-negative imaginary part: growth rate [1/s],
+        frequency [Hz] and dominant coordinate."""
+        return [
+            {
+                "growth_rate": float(lam.real),
+                "frequency_hz": float(abs(lam.imag) / (2.0 * np.pi)),
+                "coordinate": name,
+            }
+            for lam, name in zip(self.eigenvalues, self.dominant, strict=True)
+            if lam.imag >= 0.0
+        ]
+
+
+def _reduced_indices(n: int) -> np.ndarray:
+    # Drop the slider's own z, zdot: in contact they are slaved to the disc.
+    return np.r_[0 : n + 1, n + 2 : 2 * n + 3]
+
+
+def slip_jacobian(model: Model, state: np.ndarray) -> np.ndarray:
+    """Exact (complex-step) Jacobian of the slip equations (s = +1) at ``state``, in the
+    variables ``(q, phi, qdot, phidot)``."""
+    jac = dyn.complex_step_jacobian(0.0, state, dyn.SLIP, 1, model.kernel_args)
+    idx = _reduced_indices(model.n)
+    return jac[np.ix_(idx, idx)]
+
+
+def linear_stability(case: Case | Model) -> LinearStability:
+    """Eigenvalues of the slip equations linearised about the sliding equilibrium.
+
+    Parameters
+    ----------
+    case : Case or Model
+        A case at constant disc speed.
+
+    Returns
+    -------
+    LinearStability
+    """
+    model = case if isinstance(case, Model) else build_model(case)
+    eq = sliding_equilibrium(model)
+    jac = slip_jacobian(model, eq.state)
+    lam, vec = np.linalg.eig(jac)
+    order = np.lexsort((-lam.imag, -lam.real))
+    lam = lam[order]
+    vec = vec[:, order]
+    n = model.n
+    inertia = np.append(model.modal_mass, model.par[dyn.P_INERTIA])
+    # Velocity part of an eigenvector is lambda times its displacement part.
+    energy = inertia[:, None] * np.abs(vec[n + 1 :, :]) ** 2
+    names = (*model.labels, "phi")
+    dominant = tuple(names[i] for i in np.argmax(energy, axis=0))
+    return LinearStability(eq, jac, lam, vec, dominant)
+
+
+@dataclass(frozen=True)
+class PerturbationTest:
+    """The paper's stability test: perturb the equilibrium, simulate, compare amplitudes.
+
+    Attributes
+    ----------
+    initial_amplitude, final_amplitude : float
+        Largest ``|phi - phi_eq|`` [rad] over the first period of the slider's in-plane
+        oscillation and over the last tenth of the run.
+    growth_rate : float
+        ``log(final / initial) / elapsed`` [1/s], a rough estimate of the envelope's rate.
+    decays : bool
+        Whether the perturbation shrank.
+    """
+
+    initial_amplitude: float
+    final_amplitude: float
+    growth_rate: float
+    decays: bool
+
+
+def perturbation_test(case: Case, duration: float | None = None) -> PerturbationTest:
+    """Simulate from the perturbed sliding equilibrium and see whether it decays (paper 3.1).
+
+    Parameters
+    ----------
+    case : Case
+        Constant-speed case; ``simulation.perturbation`` sets the offsets.
+    duration : float, optional
+        Simulated time [s]; defaults to the case's ``simulation.duration``.
+    """
+    from fivdisc.simulate import simulate
+
+    updates: dict = {"simulation.initial_state": "equilibrium"}
+    if duration is not None:
+        updates["simulation.duration"] = duration
+    run = case.replace(updates)
+    eq = sliding_equilibrium(run)
+    ds = simulate(run).dataset
+    dev = np.abs(ds["phi"].values - eq.phi)
+    t = ds["time"].values
+    slider = run.slider
+    period = 2.0 * np.pi * np.sqrt(slider.mass * slider.track_radius**2
+                                   / slider.rotational_stiffness)
+    head = max(2, int(np.searchsorted(t, t[0] + period)))
+    span = max(1, t.size // 10)
+    first = float(np.max(dev[:head]))
+    last = float(np.max(dev[-span:]))
+    elapsed = t[-span] - t[0] if t.size > span else float("nan")
+    rate = float(np.log(max(last, 1e-300) / first) / elapsed) if first > 0 else float("nan")
+    return PerturbationTest(first, last, rate, last < first)
+
+
+def _axis(spec, name: str) -> tuple[str, np.ndarray]:
+    key, values = spec
+    values = np.asarray(values, dtype=float)
+    if values.ndim != 1 or values.size < 2:
+        raise CaseError(f"{name} = {key}: needs at least 2 values, got {values.size}")
+    return key, values
+
+
+def _equilibrium_key(model: Model) -> tuple:
+    # Damping does not enter the equilibrium: maps over c_z, c_phi reuse one solve.
+    par = model.par.copy()
+    par[[dyn.P_CZ, dyn.P_CPHI]] = 0.0
+    return (tuple(par), tuple(model.speed.coefficients.ravel()), model.labels,
+            tuple(model.R0), tuple(model.omega))
+
+
+def stability_map(
+    case: Case,
+    x: tuple[str, Sequence[float]],
+    y: tuple[str, Sequence[float]],
+    curves: tuple[str, Sequence[float]] | None = None,
+    progress: bool = False,
+) -> xr.Dataset:
+    """Largest growth rate of the linearised slip equations over a parameter grid.
+
+    Parameters
+    ----------
+    case : Case
+        Base case at constant speed.
+    x, y : (str, sequence of float)
+        Dotted case key and values of the horizontal and vertical axes, for example
+        ``("slider.normal_damping", np.linspace(0, 12, 200))``.
+    curves : (str, sequence of float), optional
+        A third key whose values give one map (and one boundary curve) each, e.g.
+        ``("friction.decay", [0, 1, 10])``.
+    progress : bool
+        Show a progress bar.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``max_growth_rate`` [1/s] and ``stable`` on (curve, y, x), and ``boundary``
+        (curve, x): the smallest y above which every grid value is stable at that x
+        (NaN if the column is never stable or always stable).
+    """
+    xkey, xs = _axis(x, "x")
+    ykey, ys = _axis(y, "y")
+    ckey, cs = (curves[0], np.asarray(curves[1], dtype=float)) if curves else (None, [None])
+    growth = np.full((len(cs), ys.size, xs.size), np.nan)
+    cache: dict[tuple, Equilibrium] = {}
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=growth.size, desc="stability map", unit="pt")
+    for ic, cval in enumerate(cs):
+        base = case if ckey is None else case.replace({ckey: float(cval)})
+        for iy, yval in enumerate(ys):
+            row = base.replace({ykey: float(yval)})
+            jacs = []
+            for xval in xs:
+                model = build_model(row.replace({xkey: float(xval)}))
+                key = _equilibrium_key(model)
+                if key not in cache:
+                    cache[key] = sliding_equilibrium(model)
+                jacs.append(slip_jacobian(model, cache[key].state))
+            growth[ic, iy] = np.max(np.linalg.eigvals(np.stack(jacs)).real, axis=1)
+            if bar is not None:
+                bar.update(xs.size)
+    if bar is not None:
+        bar.close()
+    stable = growth < 0.0
+    boundary = np.full((len(cs), xs.size), np.nan)
+    for ic in range(len(cs)):
+        for ix in range(xs.size):
+            col = stable[ic, :, ix]
+            if col.all() or not col[-1]:
+                continue
+            last_unstable = np.nonzero(~col)[0][-1]
+            g0, g1 = growth[ic, last_unstable, ix], growth[ic, last_unstable + 1, ix]
+            y0, y1 = ys[last_unstable], ys[last_unstable + 1]
+            boundary[ic, ix] = y0 + (y1 - y0) * g0 / (g0 - g1)
+    coords = {
+        "x": ("x", xs, {"long_name": xkey}),
+        "y": ("y", ys, {"long_name": ykey}),
+        "curve": ("curve", np.asarray(cs if ckey else [np.nan], dtype=float),
+                  {"long_name": ckey or "none"}),
+    }
+    return xr.Dataset(
+        {
+            "max_growth_rate": (("curve", "y", "x"), growth,
+                                {"units": "1/s", "long_name": "largest real part of eigenvalues"}),
+            "stable": (("curve", "y", "x"), stable.astype(np.int8),
+                       {"units": "1", "long_name": "sliding equilibrium asymptotically stable"}),
+            "boundary": (("curve", "x"), boundary,
+                         {"units": "", "long_name": f"stability boundary in {ykey}"}),
+        },
+        coords=coords,
+        attrs={"x_key": xkey, "y_key": ykey, "curve_key": ckey or "", "case": case.to_toml()},
+    )
+
+
+def parse_range(text: str, option: str) -> tuple[str, np.ndarray]:
+    """Parse ``KEY=START:STOP:N`` (inclusive linspace) or ``KEY=v1,v2,...``."""
+    if "=" not in text:
+        raise CaseError(f"{option} = {text!r} is invalid: write KEY=START:STOP:N or KEY=v1,v2,..")
+    key, spec = text.split("=", 1)
+    try:
+        if ":" in spec:
+            start, stop, num = spec.split(":")
+            values = np.linspace(float(start), float(stop), int(num))
+        else:
+            values = np.array([float(v) for v in spec.split(",")])
+    except ValueError:
+        raise CaseError(
+            f"{option} = {text!r} is invalid: write KEY=START:STOP:N or KEY=v1,v2,.."
+        ) from None
+    if key.strip() not in Case.valid_keys():
+        import difflib
+
+        near = difflib.get_close_matches(key.strip(), Case.valid_keys(), n=1)
+        hint = f"; did you mean '{near[0]}'?" if near else ""
+        raise CaseError(f"{option}: unknown case key '{key.strip()}'{hint}")
+    return key.strip(), values
+

@@ -1,0 +1,336 @@
+"""Per-run reductions: the numbers a sweep keeps from each simulation.
+
+Built-in reductions are named (see :data:`BUILTIN`); user reductions are named by
+import path, ``"package.module:function"``, and are called with the run's
+:class:`~fivdisc.result.Result`, returning a real number (stored as float64).
+
+A reduction that is final once some event has happened (``separated`` after the
+first separation) lets the run stop there; see :func:`stop_events`.
+"""
+
+from __future__ import annotations
+
+import difflib
+import importlib
+import math
+import numbers
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from functools import cache
+from typing import Any
+
+from fivdisc.case import Case
+from fivdisc.errors import FivdiscError
+from fivdisc.result import Result
+
+__all__ = [
+    "BUILTIN",
+    "Reduction",
+    "RunFailed",
+    "SweepError",
+    "evaluate",
+    "fill_values",
+    "resolve",
+    "stop_events",
+]
+
+
+class SweepError(FivdiscError, ValueError):
+    """A sweep file or sweep value is invalid; the message names the key, value and allowed."""
+
+
+class RunFailed(FivdiscError):
+    """A simulation of a sweep point did not end as requested."""
+
+
+@dataclass(frozen=True)
+class Reduction:
+    """One stored quantity.
+
+    Attributes
+    ----------
+    spec
+        As written in ``reduce.keep``.
+    name
+        Variable name in the store (the function's name for a user reduction).
+    dtype
+        ``"bool"`` or ``"float64"``.
+    units
+        Units of the value.
+    long_name
+        Description, stored as the variable's ``long_name``.
+    decided_by
+        Event kinds after which the value is final, so the run may stop at the
+        first of them; None if the value needs the whole run.
+    needs_run
+        Whether the value comes from a simulation (False: from the case alone).
+    func
+        ``func(result, case) -> value``; `result` is None when `needs_run` is False.
+    """
+
+    spec: str
+    name: str
+    dtype: str
+    units: str
+    long_name: str
+    decided_by: tuple[str, ...] | None
+    needs_run: bool
+    func: Callable[[Result | None, Case], Any]
+
+    def __call__(self, result: Result | None, case: Case) -> bool | float:
+        """The value for one run, checked and converted to the stored type."""
+        value = self.func(result, case)
+        if self.dtype == "bool":
+            return bool(value)
+        if not isinstance(value, numbers.Real):
+            raise RunFailed(
+                f"reduction '{self.spec}' returned {value!r} ({type(value).__name__}): "
+                "must be a real number"
+            )
+        return float(value)
+
+    @property
+    def fill(self) -> bool | float:
+        """Value stored before the point is computed and when it fails."""
+        return False if self.dtype == "bool" else math.nan
+
+
+def _first_separation(result: Result | None, case: Case) -> float:
+    times = result.events("separation")
+    return float(times[0]) if times.size else math.nan
+
+
+def _phase_fraction(phase: str) -> Callable[[Result | None, Case], float]:
+    def fraction(result: Result | None, case: Case) -> float:
+        spent = result.summary()["time_in_phase"]
+        total = sum(spent.values())
+        return spent[phase] / total if total > 0 else math.nan
+
+    return fraction
+
+
+def _dominant_frequency(result: Result | None, case: Case) -> float:
+    from fivdisc.analysis.spectra import dominant_frequency
+
+    return dominant_frequency(result.dataset, var="phi")
+
+
+def _max_growth_rate(result: Result | None, case: Case) -> float:
+    from fivdisc.analysis.stability import linear_stability
+
+    return linear_stability(case).max_growth_rate
+
+
+def _builtin(
+    name: str,
+    func: Callable[[Result | None, Case], Any],
+    units: str,
+    long_name: str,
+    dtype: str = "float64",
+    decided_by: tuple[str, ...] | None = None,
+    needs_run: bool = True,
+) -> Reduction:
+    return Reduction(name, name, dtype, units, long_name, decided_by, needs_run, func)
+
+
+BUILTIN: dict[str, Reduction] = {
+    r.name: r
+    for r in (
+        _builtin(
+            "separated",
+            lambda result, case: result.events("separation").size > 0,
+            "1",
+            "the slider separated from the disc at least once",
+            dtype="bool",
+            decided_by=("separation",),
+        ),
+        _builtin(
+            "first_separation_time",
+            _first_separation,
+            "s",
+            "time of the first separation (nan if none)",
+            decided_by=("separation",),
+        ),
+        _builtin(
+            "stick_fraction",
+            _phase_fraction("stick"),
+            "1",
+            "fraction of the output samples' time spent in stick",
+        ),
+        _builtin(
+            "separation_fraction",
+            _phase_fraction("separation"),
+            "1",
+            "fraction of the output samples' time spent in separation",
+        ),
+        _builtin(
+            "max_abs_w",
+            lambda result, case: result.summary()["max_abs_w"],
+            "m",
+            "largest |w| at the probes",
+        ),
+        _builtin(
+            "max_normal_force",
+            lambda result, case: result.summary()["peak_normal_force"],
+            "N",
+            "largest normal contact force",
+        ),
+        _builtin(
+            "dominant_frequency",
+            _dominant_frequency,
+            "Hz",
+            "dominant frequency of the slider angle phi",
+        ),
+        _builtin(
+            "max_growth_rate",
+            _max_growth_rate,
+            "1/s",
+            "largest real part of the linearised system's eigenvalues (constant speed)",
+            needs_run=False,
+        ),
+    )
+}
+
+# Modules the built-ins import when they run: checked up front so that a missing one
+# stops the sweep before it starts rather than failing every point.
+_NEEDS_MODULE = {
+    "dominant_frequency": "fivdisc.analysis.spectra",
+    "max_growth_rate": "fivdisc.analysis.stability",
+}
+
+
+def _user(spec: str) -> Reduction:
+    """A user reduction from ``"package.module:function"``."""
+    where = f"reduce.keep: '{spec}'"
+    module_name, _, attr = spec.partition(":")
+    if not module_name or not attr.isidentifier():
+        raise SweepError(
+            f"{where} is invalid: must be a built-in reduction"
+            f"{_near(spec, BUILTIN)} ({', '.join(BUILTIN)}) or 'package.module:function'"
+        )
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as exc:
+        raise SweepError(f"{where} is invalid: cannot import '{module_name}' ({exc})") from None
+    func = getattr(module, attr, None)
+    if not callable(func):
+        names = [n for n in vars(module) if callable(getattr(module, n)) and not n.startswith("_")]
+        raise SweepError(
+            f"{where} is invalid: '{module_name}' has no function '{attr}'{_near(attr, names)}"
+        )
+    doc = (func.__doc__ or "").strip().splitlines()
+    return Reduction(
+        spec=spec,
+        name=attr,
+        dtype="float64",
+        units="",
+        long_name=doc[0] if doc else spec,
+        decided_by=None,
+        needs_run=True,
+        func=lambda result, case: func(result),
+    )
+
+
+def _near(name: str, names: Sequence[str]) -> str:
+    matches = difflib.get_close_matches(name, list(names), n=1)
+    return f"; did you mean '{matches[0]}'?" if matches else ""
+
+
+@cache
+def _resolve(keep: tuple[str, ...]) -> tuple[Reduction, ...]:
+    reductions = []
+    for spec in keep:
+        if not isinstance(spec, str):
+            raise SweepError(f"reduce.keep entry {spec!r} is invalid: must be a string")
+        if ":" in spec:
+            reductions.append(_user(spec))
+            continue
+        if spec not in BUILTIN:
+            raise SweepError(
+                f"reduce.keep: unknown reduction '{spec}'{_near(spec, BUILTIN)}; built-in are "
+                f"{', '.join(BUILTIN)}, or give a user one as 'package.module:function'"
+            )
+        if spec in _NEEDS_MODULE:
+            try:
+                importlib.import_module(_NEEDS_MODULE[spec])
+            except ImportError as exc:
+                raise SweepError(
+                    f"reduce.keep: reduction '{spec}' needs {_NEEDS_MODULE[spec]}, which cannot "
+                    f"be imported ({exc})"
+                ) from None
+        reductions.append(BUILTIN[spec])
+    seen: dict[str, str] = {}
+    for r in reductions:
+        if r.name in seen or r.name in ("error", "done"):
+            other = seen.get(r.name, "the sweep's own variable")
+            raise SweepError(
+                f"reduce.keep: '{r.spec}' and '{other}' would both be stored as '{r.name}'"
+            )
+        seen[r.name] = r.spec
+    return tuple(reductions)
+
+
+def resolve(keep: Sequence[str]) -> tuple[Reduction, ...]:
+    """The reductions named in `keep`, checked (user functions are imported).
+
+    Raises
+    ------
+    SweepError
+        An unknown built-in (with the nearest name), an import path that does not
+        resolve to a function, or two reductions with the same stored name.
+    """
+    return _resolve(tuple(keep))
+
+
+def stop_events(reductions: Sequence[Reduction]) -> tuple[str, ...]:
+    """Event kinds at which a run may stop: those that decide every kept value.
+
+    Reductions computed from the case alone do not constrain the run; any
+    reduction that needs the whole run means no early stop (an empty tuple).
+    """
+    kinds: set[str] = set()
+    for r in reductions:
+        if not r.needs_run:
+            continue
+        if r.decided_by is None:
+            return ()
+        kinds.update(r.decided_by)
+    return tuple(sorted(kinds))
+
+
+def evaluate(case: Case, keep: Sequence[str]) -> dict[str, bool | float]:
+    """Simulate one case (if any kept reduction needs it) and reduce the run.
+
+    Parameters
+    ----------
+    case
+        The point's case.
+    keep
+        Reduction names, as in ``reduce.keep``.
+
+    Returns
+    -------
+    dict
+        Stored name -> value.
+
+    Raises
+    ------
+    RunFailed
+        The run did not end as requested (its status and message are given), or a
+        user reduction returned something other than a real number.
+    """
+    # Imported here: the simulator loads numba, which validating a sweep does not need.
+    from fivdisc.simulate import simulate
+
+    reductions = resolve(keep)
+    result = None
+    if any(r.needs_run for r in reductions):
+        result = simulate(case, stop_on=stop_events(reductions))
+        if not result.ok:
+            raise RunFailed(f"simulation {result.status}: {result.message}")
+    return {r.name: r(result, case) for r in reductions}
+
+
+def fill_values(reductions: Sequence[Reduction]) -> dict[str, bool | float]:
+    """Stored name -> value kept for a point that failed."""
+    return {r.name: r.fill for r in reductions}

@@ -1,0 +1,361 @@
+"""Sweep definitions: a base case, axes over case keys, and the reductions to keep.
+
+A sweep file is TOML::
+
+    base = "fig27_base.toml"             # a case file (relative to this file), or a [base] table
+    mode = "grid"                        # or "zip": all axes the same length, walked together
+    [axes]
+    "speed.initial" = "2.0:20.0:40"      # start:stop:n (inclusive linspace), or a list of values
+    "speed.duration" = [5.0, 10.0, 35.0]
+    [link]                               # optional: keys that copy another key at every point
+    "simulation.duration" = "speed.duration"
+    [reduce]
+    keep = ["separated", "first_separation_time"]
+
+Points are numbered in C order (the first axis varies slowest). Building a
+:class:`Sweep` validates everything, including the case of every point, so a sweep
+that starts cannot fail on its input halfway through.
+"""
+
+from __future__ import annotations
+
+import difflib
+import hashlib
+import json
+import math
+import re
+import tomllib
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from os import PathLike
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+
+from fivdisc.case import Case, load_case
+from fivdisc.errors import CaseError
+from fivdisc.sweep.reductions import Reduction, SweepError, resolve, stop_events
+
+__all__ = ["Sweep", "SweepError", "load_sweep", "parse_range"]
+
+FORMAT = "fivdisc-sweep/1"
+MODES = ("grid", "zip")
+_FILE_KEYS = ("base", "mode", "axes", "link", "reduce")
+_REDUCE_KEYS = ("keep",)
+_RANGE = re.compile(r"^\s*([^:]+):([^:]+):([^:]+)\s*$")
+_INTEGER = re.compile(r"^\s*[+-]?\d+\s*$")
+
+
+def _nearest(name: str, names: Sequence[str]) -> str:
+    """"; did you mean 'x'?" for the closest of `names`, or "" if none is close."""
+    matches = difflib.get_close_matches(name, list(names), n=1)
+    return f"; did you mean '{matches[0]}'?" if matches else ""
+
+
+def parse_range(text: str, where: str = "range") -> list[float] | list[int]:
+    """Values of a ``"start:stop:n"`` range: n evenly spaced values, both ends included.
+
+    Parameters
+    ----------
+    text
+        ``"start:stop:n"``; integers for start and stop give integer values when
+        the spacing is a whole number.
+    where
+        Name of the setting, for error messages.
+
+    Raises
+    ------
+    SweepError
+        Not of that form, a non-finite end, n < 1, or n = 1 with start != stop.
+    """
+    match = _RANGE.match(text)
+    rule = 'must be "start:stop:n" (n evenly spaced values, ends included) or a list of values'
+    if match is None:
+        raise SweepError(f"{where} = {text!r} is invalid: {rule}")
+    start_text, stop_text, n_text = match.groups()
+    try:
+        start, stop, n = float(start_text), float(stop_text), int(n_text)
+    except ValueError:
+        raise SweepError(f"{where} = {text!r} is invalid: {rule}") from None
+    if not (math.isfinite(start) and math.isfinite(stop)):
+        raise SweepError(f"{where} = {text!r} is invalid: start and stop must be finite")
+    if n < 1:
+        raise SweepError(f"{where} = {text!r} is invalid: n must be >= 1")
+    if n == 1 and start != stop:
+        raise SweepError(f"{where} = {text!r} is invalid: n = 1 needs start == stop")
+    values = np.linspace(start, stop, n)
+    if (
+        _INTEGER.match(start_text)
+        and _INTEGER.match(stop_text)
+        and (n == 1 or (int(stop) - int(start)) % (n - 1) == 0)
+    ):
+        return [int(v) for v in np.rint(values)]
+    return values.tolist()
+
+
+def _axis_values(key: str, raw: Any) -> tuple[Any, ...]:
+    """An axis's values from a range string or a list."""
+    where = f"axes.'{key}'"
+    if isinstance(raw, str):
+        return tuple(parse_range(raw, where))
+    if isinstance(raw, np.ndarray):
+        raw = raw.tolist()
+    if not isinstance(raw, list | tuple) or not raw:
+        raise SweepError(
+            f"{where} = {raw!r} is invalid: must be a non-empty list of values or "
+            '"start:stop:n"'
+        )
+    return tuple(v.item() if isinstance(v, np.generic) else v for v in raw)
+
+
+def _canonical(value: Any) -> Any:
+    """A value as plain JSON data (tuples become lists)."""
+    return json.loads(json.dumps(value))
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """A validated sweep: base case, axes, linked keys and kept reductions.
+
+    Parameters
+    ----------
+    base
+        The case every point starts from.
+    axes
+        Dotted case key -> values, in order (a list, or ``"start:stop:n"``).
+    mode
+        ``"grid"``: every combination, first axis slowest; ``"zip"``: the axes,
+        all of the same length, walked together.
+    keep
+        Reductions stored per point: built-in names (see
+        :data:`fivdisc.sweep.reductions.BUILTIN`) or ``"package.module:function"``.
+    link
+        Dotted key -> dotted key whose value it copies at every point, after the
+        axes are applied (e.g. ``{"simulation.duration": "speed.duration"}``).
+    source
+        File the sweep was read from, prefixed to error messages; None otherwise.
+
+    Raises
+    ------
+    SweepError
+        Invalid axes, mode, link or reductions.
+    CaseError
+        The case of some point is invalid (the message names the point).
+    """
+
+    base: Case
+    axes: Mapping[str, Any]
+    mode: Literal["grid", "zip"] = "grid"
+    keep: Sequence[str] = ("separated",)
+    link: Mapping[str, str] = field(default_factory=dict)
+    source: str | None = None
+    reductions: tuple[Reduction, ...] = field(init=False, repr=False, compare=False)
+    cases: tuple[Case, ...] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        prefix = f"{self.source}: " if self.source else ""
+        try:
+            self._validate()
+        except (SweepError, CaseError) as exc:
+            raise type(exc)(f"{prefix}{exc}") from None
+
+    def _validate(self) -> None:
+        set_ = object.__setattr__  # frozen dataclass: normalised fields are set once, here
+        if not isinstance(self.base, Case):
+            raise SweepError(f"base = {self.base!r} is invalid: must be a fivdisc Case")
+        if self.mode not in MODES:
+            raise SweepError(
+                f"mode = {self.mode!r} is invalid: must be one of {', '.join(map(repr, MODES))}"
+            )
+        valid = Case.valid_keys()
+        if not self.axes:
+            raise SweepError("axes is empty: name at least one case key to vary")
+        axes: dict[str, tuple[Any, ...]] = {}
+        for key, raw in self.axes.items():
+            if key not in valid:
+                raise SweepError(f"axes: unknown case key '{key}'{_nearest(key, valid)}")
+            axes[key] = _axis_values(key, raw)
+            if self.mode == "grid":
+                text = [json.dumps(v, sort_keys=True) for v in axes[key]]
+                repeated = next((v for v in text if text.count(v) > 1), None)
+                if repeated is not None:
+                    raise SweepError(
+                        f"axes.'{key}' repeats the value {repeated}: grid axes must have "
+                        "distinct values"
+                    )
+        if self.mode == "zip" and len({len(v) for v in axes.values()}) > 1:
+            lengths = ", ".join(f"'{k}' has {len(v)}" for k, v in axes.items())
+            raise SweepError(f"mode = 'zip' needs axes of equal length: {lengths}")
+        set_(self, "axes", axes)
+
+        link = dict(self.link)
+        for target, origin in link.items():
+            if target not in valid:
+                raise SweepError(f"link: unknown case key '{target}'{_nearest(target, valid)}")
+            if target in axes:
+                raise SweepError(f"link: '{target}' is an axis; it cannot also copy '{origin}'")
+            if not isinstance(origin, str) or origin not in valid:
+                raise SweepError(
+                    f"link.'{target}' = {origin!r} is invalid: must be a case key"
+                    f"{_nearest(str(origin), valid)}"
+                )
+        set_(self, "link", link)
+
+        if isinstance(self.keep, str) or not self.keep:
+            raise SweepError(
+                f"reduce.keep = {self.keep!r} is invalid: must be a non-empty list of reductions"
+            )
+        set_(self, "keep", tuple(self.keep))
+        set_(self, "reductions", resolve(self.keep))
+        set_(self, "cases", tuple(self._point_case(i) for i in range(self.n_points)))
+
+        if any(r.name == "max_growth_rate" for r in self.reductions):
+            for i, case in enumerate(self.cases):
+                if case.speed.profile != "constant":
+                    raise SweepError(
+                        f"reduce.keep: 'max_growth_rate' needs a constant disc speed, but point "
+                        f"{i} ({self._describe(i)}) has speed.profile = '{case.speed.profile}'"
+                    )
+
+    # --- points --------------------------------------------------------------------------
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """Points along each axis (grid), or ``(n_points,)`` (zip)."""
+        lengths = tuple(len(v) for v in self.axes.values())
+        return lengths if self.mode == "grid" else lengths[:1]
+
+    @property
+    def n_points(self) -> int:
+        """Number of points."""
+        return math.prod(self.shape)
+
+    def updates(self, index: int) -> dict[str, Any]:
+        """Axis key -> value at point `index`."""
+        if self.mode == "zip":
+            return {key: values[index] for key, values in self.axes.items()}
+        position = np.unravel_index(index, self.shape)
+        return {
+            key: values[int(i)]
+            for (key, values), i in zip(self.axes.items(), position, strict=True)
+        }
+
+    def _describe(self, index: int) -> str:
+        return ", ".join(f"{k} = {json.dumps(v)}" for k, v in self.updates(index).items())
+
+    def _point_case(self, index: int) -> Case:
+        try:
+            case = self.base.replace(self.updates(index))
+            if self.link:
+                case = case.replace({t: case.get(o) for t, o in self.link.items()})
+        except CaseError as exc:
+            raise CaseError(f"point {index} ({self._describe(index)}): {exc}") from None
+        return case
+
+    def __iter__(self) -> Iterator[Case]:
+        return iter(self.cases)
+
+    # --- identity ------------------------------------------------------------------------
+
+    @property
+    def stop_on(self) -> tuple[str, ...]:
+        """Event kinds that end a run early because every kept value is then decided."""
+        return stop_events(self.reductions)
+
+    @property
+    def definition(self) -> str:
+        """Canonical JSON text of the sweep: equal sweeps give equal text."""
+        data = {
+            "format": FORMAT,
+            "base": self.base.model_dump(mode="json"),
+            "mode": self.mode,
+            "axes": [[key, _canonical(values)] for key, values in self.axes.items()],
+            "link": [[t, o] for t, o in self.link.items()],
+            "keep": list(self.keep),
+        }
+        return json.dumps(data, sort_keys=True, separators=(",", ":"), allow_nan=False)
+
+    @property
+    def digest(self) -> str:
+        """SHA-256 (hex) of :attr:`definition`."""
+        return hashlib.sha256(self.definition.encode()).hexdigest()
+
+    # --- reading -------------------------------------------------------------------------
+
+    @classmethod
+    def from_toml(
+        cls, text: str, root: str | PathLike[str] | None = None, source: str | None = None
+    ) -> Sweep:
+        """Parse and validate a sweep from TOML text.
+
+        Parameters
+        ----------
+        text
+            The sweep file's content.
+        root
+            Directory a ``base`` file name is relative to (default: the working directory).
+        source
+            Name of the file, prefixed to error messages.
+        """
+        prefix = f"{source}: " if source else ""
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise SweepError(f"{prefix}invalid TOML: {exc}") from None
+        try:
+            kwargs = _file_fields(data, Path(root) if root is not None else Path.cwd())
+        except (SweepError, CaseError) as exc:
+            raise type(exc)(f"{prefix}{exc}") from None
+        return cls(**kwargs, source=source)
+
+
+def _file_fields(data: dict[str, Any], root: Path) -> dict[str, Any]:
+    """Keyword arguments of :class:`Sweep` from a parsed sweep file."""
+    for key in data:
+        if key not in _FILE_KEYS:
+            raise SweepError(f"unknown key '{key}'{_nearest(key, _FILE_KEYS)}")
+    raw_base = data.get("base", {})
+    if isinstance(raw_base, str):
+        path = root / raw_base
+        try:
+            base = load_case(path)
+        except FileNotFoundError:
+            raise SweepError(f"base = {raw_base!r} is invalid: no file {path}") from None
+    elif isinstance(raw_base, dict):
+        try:
+            base = Case(**raw_base)
+        except CaseError as exc:
+            raise CaseError(f"base: {exc}") from None
+    else:
+        raise SweepError(f"base = {raw_base!r} is invalid: must be a case file name or a table")
+    for table in ("axes", "link", "reduce"):
+        if not isinstance(data.get(table, {}), dict):
+            raise SweepError(f"{table} = {data[table]!r} is invalid: must be a table")
+    reduce = data.get("reduce", {})
+    for key in reduce:
+        if key not in _REDUCE_KEYS:
+            raise SweepError(f"unknown key 'reduce.{key}'{_nearest(key, _REDUCE_KEYS)}")
+    if "keep" not in reduce:
+        raise SweepError("reduce.keep is missing: list the reductions to store")
+    return {
+        "base": base,
+        "mode": data.get("mode", "grid"),
+        "axes": data.get("axes", {}),
+        "link": data.get("link", {}),
+        "keep": reduce["keep"],
+    }
+
+
+def load_sweep(path: str | PathLike[str]) -> Sweep:
+    """Read and validate a sweep file; a ``base`` file name is relative to it.
+
+    Raises
+    ------
+    SweepError, CaseError
+        Invalid sweep or case; the message starts with the file's path.
+    FileNotFoundError
+        The sweep file does not exist.
+    """
+    path = Path(path)
+    return Sweep.from_toml(path.read_text(encoding="utf-8"), root=path.parent, source=str(path))
