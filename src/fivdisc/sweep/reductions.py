@@ -240,8 +240,6 @@ def _near(name: str, names: Sequence[str]) -> str:
 def _resolve(keep: tuple[str, ...]) -> tuple[Reduction, ...]:
     reductions = []
     for spec in keep:
-        if not isinstance(spec, str):
-            raise SweepError(f"reduce.keep entry {spec!r} is invalid: must be a string")
         if ":" in spec:
             reductions.append(_user(spec))
             continue
@@ -279,6 +277,9 @@ def resolve(keep: Sequence[str]) -> tuple[Reduction, ...]:
         An unknown built-in (with the nearest name), an import path that does not
         resolve to a function, or two reductions with the same stored name.
     """
+    for spec in keep:
+        if not isinstance(spec, str):
+            raise SweepError(f"reduce.keep entry {spec!r} is invalid: must be a string")
     return _resolve(tuple(keep))
 
 
