@@ -114,8 +114,9 @@ def plot_timeseries(data: xr.Dataset | object, var: str, probe: int | None = Non
     fig, ax = _axes(ax)
     if "flag_values" in da.attrs:
         ax.step(da["time"].values, da.values, where="post")
-        ax.set_yticks(np.asarray(da.attrs["flag_values"]).tolist(),
-                      str(da.attrs.get("flag_meanings", "")).split() or None)
+        values = np.atleast_1d(da.attrs["flag_values"]).tolist()
+        meanings = str(da.attrs.get("flag_meanings", "")).split()
+        ax.set_yticks(values, meanings if len(meanings) == len(values) else None)
     else:
         ax.plot(da["time"].values, da.values, lw=0.8)
     ax.set_xlabel(_label(da["time"], "time"))

@@ -127,12 +127,11 @@ def evaluate(t, y, phase, s, right, mdl, work, dy):
     s_ggp = zero
     for j in range(n):
         lj = li[j]
-        if sgn[j] > 0.0:
-            gj = R0[j] * cl[lj]
-            gpj = -lj * R0[j] * sl[lj]
-        else:
-            gj = R0[j] * sl[lj]
-            gpj = lj * R0[j] * cl[lj]
+        # Branch-free g = R cos(l phi) (C, sgn = 1) or R sin(l phi) (D, sgn = -1).
+        cs = 0.5 + 0.5 * sgn[j]
+        sn = 0.5 - 0.5 * sgn[j]
+        gj = R0[j] * (cs * cl[lj] + sn * sl[lj])
+        gpj = lj * R0[j] * (sn * cl[lj] - cs * sl[lj])
         g[j] = gj
         gp[j] = gpj
         qj = y[j]

@@ -41,8 +41,12 @@ ST_ZENO = 4
 ST_MAX_SWITCHES = 5
 ST_STOPPED = 6
 
+# Step-size control exponents: 1/5 - 0.75 beta and beta.
+_BETA = 0.04
+_EXPO1 = 0.2 - 0.75 * _BETA
+
 # Interior points (+1) at which a near-zero event function is probed within a step.
-_PROBES = 8
+_PROBES = 4
 
 # Event kinds.
 EV_STICK = 0
@@ -64,7 +68,8 @@ I_SWITCHES = 8
 I_ZENO = 9
 I_STARTED = 10
 I_FAIL_PHASE = 11
-N_ISTATE = 12
+I_EVAL_EVENTS = 12
+N_ISTATE = 13
 
 # Float state slots.
 F_T = 0
@@ -188,7 +193,8 @@ def apply_switch(which, t, y, phase, s, mdl, work, dy, ev_t, ev_i, ist):
 
 
 @njit(cache=True)
-def _event_at(theta, i, t, h, rc, phase, s, mdl, work, dy, ytmp, evt):
+def _event_at(theta, i, t, h, rc, phase, s, mdl, work, dy, ytmp, evt, ist):
+    ist[I_EVAL_EVENTS] += 1
     dense_eval(rc, theta, ytmp)
     nf, f, wc, wcd, v = evaluate(t + theta * h, ytmp, phase, s, False, mdl, work, dy)
     event_values(phase, s, nf, f, wc, v, ytmp, mdl[0], evt)
@@ -196,26 +202,33 @@ def _event_at(theta, i, t, h, rc, phase, s, mdl, work, dy, ytmp, evt):
 
 
 @njit(cache=True)
-def locate(i, lo, hi, g_lo, g_hi, t, h, rc, phase, s, mdl, work, dy, ytmp, evt):
+def locate(i, lo, hi, g_lo, g_hi, t, h, rc, phase, s, mdl, work, dy, ytmp, evt, ist):
     """Fraction of the step at which event ``i`` crosses zero, taken on the far side.
 
-    Illinois false position on the bracket [lo, hi] with g(lo) > 0 >= g(hi), with a
-    bisection whenever the bracket fails to halve; stops when the bracket is below
-    1e-13 s (far below the 1e-9 s the switches must be located to).
+    Illinois false position on the bracket [lo, hi] with g(lo) > 0 >= g(hi): the kept
+    end's value is halved when the same end survives twice, which closes the bracket
+    superlinearly; a bisection steps in if the bracket fails to shrink fourfold in
+    four iterations. Stops when the bracket is below 1e-12 s (the switches must be
+    located to 1e-9 s).
     """
-    tol = max(1e-13 / h, 1e-15)
+    tol = max(1e-12 / h, 1e-15)
     side = 0
-    for _ in range(200):
+    width_ref = hi - lo
+    for it in range(200):
         width = hi - lo
         if width <= tol:
             break
-        if g_lo - g_hi != 0.0:
-            mid = lo + width * g_lo / (g_lo - g_hi)
+        if it % 4 == 3:
+            if width > 0.25 * width_ref:
+                mid = 0.5 * (lo + hi)
+            else:
+                mid = lo + width * g_lo / (g_lo - g_hi)
+            width_ref = width
         else:
-            mid = 0.5 * (lo + hi)
-        if not (lo < mid < hi):
-            mid = 0.5 * (lo + hi)
-        gm = _event_at(mid, i, t, h, rc, phase, s, mdl, work, dy, ytmp, evt)
+            mid = lo + width * g_lo / (g_lo - g_hi)
+        # Keep the trial point strictly inside so that the bracket always shrinks.
+        mid = min(max(mid, lo + 0.5 * tol), hi - 0.5 * tol)
+        gm = _event_at(mid, i, t, h, rc, phase, s, mdl, work, dy, ytmp, evt, ist)
         if gm > 0.0:
             lo = mid
             g_lo = gm
@@ -228,17 +241,6 @@ def locate(i, lo, hi, g_lo, g_hi, t, h, rc, phase, s, mdl, work, dy, ytmp, evt):
             if side == -1:
                 g_lo *= 0.5
             side = -1
-        if hi - lo > 0.5 * width:
-            # False position stalled on one side: bisect once.
-            mid = 0.5 * (lo + hi)
-            gm = _event_at(mid, i, t, h, rc, phase, s, mdl, work, dy, ytmp, evt)
-            if gm > 0.0:
-                lo = mid
-                g_lo = gm
-            else:
-                hi = mid
-                g_hi = gm
-            side = 0
     return hi
 
 
@@ -355,6 +357,7 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
 
     status = ST_RUNNING
     after_reject = False
+    err_old = 1e-4
     while True:
         if t >= t_final:
             status = ST_DONE
@@ -373,24 +376,26 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
             land = True
 
         for st in range(1, 7):
-            for i in range(ns):
-                acc = 0.0
-                for j in range(st):
-                    acc += A[st, j] * k[j, i]
-                ytmp[i] = y[i] + hs * acc
+            ytmp[:] = y
+            for j in range(st):
+                a = hs * A[st, j]
+                if a != 0.0:
+                    for i in range(ns):
+                        ytmp[i] += a * k[j, i]
             nf, f, wc, wcd, v = evaluate(t + C[st] * hs, ytmp, phase, s, False, mdl, work, k[st])
         ynew[:] = ytmp
         ist[I_RHS] += 6
-        for i in range(ns):
-            acc = 0.0
-            for st in range(7):
-                acc += E[st] * k[st, i]
-            err_vec[i] = hs * acc
+        err_vec[:] = 0.0
+        for st in range(7):
+            a = hs * E[st]
+            if a != 0.0:
+                for i in range(ns):
+                    err_vec[i] += a * k[st, i]
         err = _rms_scaled(err_vec, y, ynew, atol, rtol)
 
         if not np.isfinite(err) or err > 1.0:
             if np.isfinite(err):
-                h = hs * max(0.2, 0.9 * err ** -0.2)
+                h = hs / min(5.0, err**_EXPO1 / 0.9)
             else:
                 h = 0.25 * hs
             ist[I_REJECTED] += 1
@@ -416,7 +421,7 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
                     dense_coefficients(y, ynew, k, hs, rc)
                     have_rc = True
                 th = locate(i, 0.0, 1.0, ev_prev[i], evn[i], t, hs, rc, phase, s, mdl, work,
-                            dy, ytmp, evt)
+                            dy, ytmp, evt, ist)
             elif ev_prev[i] > 0.0 and min(ev_prev[i], evn[i]) < 2.0 * abs(evn[i] - ev_prev[i]):
                 # Both ends positive but close to zero for the change over the step: the
                 # function may dip below zero and back inside it (a brief separation or
@@ -428,10 +433,10 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
                 g_lo = ev_prev[i]
                 for p in range(1, _PROBES):
                     tp = p / _PROBES
-                    gp = _event_at(tp, i, t, hs, rc, phase, s, mdl, work, dy, ytmp, evt)
+                    gp = _event_at(tp, i, t, hs, rc, phase, s, mdl, work, dy, ytmp, evt, ist)
                     if gp <= 0.0:
                         th = locate(i, (p - 1) / _PROBES, tp, g_lo, gp, t, hs, rc, phase, s,
-                                    mdl, work, dy, ytmp, evt)
+                                    mdl, work, dy, ytmp, evt, ist)
                         break
                     g_lo = gp
                 if th > 1.0:
@@ -445,10 +450,11 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
                 theta = th
                 which = i
 
-        if err == 0.0:
-            fac = 5.0
-        else:
-            fac = min(5.0, max(0.2, 0.9 * err ** -0.2))
+        # PI control (Gustafsson; Hairer, Norsett & Wanner II.4): damps the step-size
+        # oscillation that plain error-per-step control shows, and so rejections.
+        pi = err**_EXPO1 / err_old**_BETA if err > 0.0 else 0.0
+        fac = min(5.0, max(0.1, 0.9 / pi)) if pi > 0.0 else 5.0
+        err_old = max(err, 1e-4)
         if after_reject:
             fac = min(fac, 1.0)
         after_reject = False

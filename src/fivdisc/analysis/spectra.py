@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 import scipy.fft
@@ -155,6 +155,9 @@ def series(data: xr.Dataset | object, var: str, probe: int | None = None,
             raise AnalysisError(f"probe = {probe!r} is invalid for var = {var!r}: must be an "
                                 f"integer index along {dim!r} in [0, {size - 1}]")
         da = da.isel({dim: int(index)})
+        if dim not in da.coords:
+            # Keep the index as a scalar coordinate so labels can say which series this is.
+            da = da.assign_coords({dim: int(index)})
     return time_window(da.to_dataset(name=var), t0, t1)[var]
 
 
@@ -256,9 +259,9 @@ class Periodicity:
     def summary(self) -> str:
         """One line: the kind, the generators and how many peaks they explain."""
         if self.kind == "none":
-            return "none: no spectral peaks (static response)"
+            return "none: no spectral peaks (e.g. a static response)"
         n = len(self.peaks)
-        fit = f"{n} peaks within {self.tol:.2g} Hz"
+        fit = f"{n} peak{'s' if n != 1 else ''} within {self.tol:.2g} Hz"
         if self.kind == "periodic":
             return f"periodic: f0 = {self.fundamental:.4g} Hz ({fit} of its multiples)"
         gens = ", ".join(f"f{i + 1} = {f:.4g} Hz" for i, f in enumerate(self.frequencies))
@@ -270,9 +273,9 @@ class Periodicity:
         return self.summary
 
 
-def _finite(name: str, value: object) -> float:
+def _finite(name: str, value: Any) -> float:
     try:
-        number = float(value)  # type: ignore[arg-type]
+        number = float(value)
     except (TypeError, ValueError):
         number = np.nan
     if not np.isfinite(number):
@@ -340,9 +343,11 @@ def stft(data: xr.Dataset | object, var: str = "phi", probe: int | None = None,
     t0, t1 : float, optional
         Time window [s]; default the whole record.
     detrend : bool
-        Remove a straight line from each segment first, so that a drifting mean
-        (e.g. the slider angle under a decelerating disc) does not leak into the
-        low frequencies.
+        Remove the least-squares straight line of the selected record first, so that
+        the offset and drift of the mean (the slider angle's equilibrium) do not swamp
+        the lowest bins. The line is fitted to the whole record, not to each segment:
+        a per-segment fit would absorb part of each segment's oscillation and leak it
+        into the low frequencies (about A / (pi cycles) per segment).
 
     Returns
     -------
@@ -380,9 +385,8 @@ def stft(data: xr.Dataset | object, var: str = "phi", probe: int | None = None,
             f"{span:g} s: shorten the segment or widen t0, t1"
         )
     if detrend:
-        transform = sft.stft_detrend(values, "linear", p0, p1)
-    else:
-        transform = sft.stft(values, p0, p1)
+        values = scipy.signal.detrend(values, type="linear")
+    transform = sft.stft(values, p0, p1)
     times = float(da["time"].values[0]) + sft.t(values.size, p0, p1)
     attrs = da.attrs
     # Scalar coordinates (the probe's index and position) say where the series was taken.
@@ -526,8 +530,8 @@ def find_peaks(spectrum: Spectrum, n: int = 10, min_rel_height: float = 0.05,
     tiny = np.finfo(float).tiny
     left, mid, right = (np.log(np.maximum(amp[index + k], tiny)) for k in (-1, 0, 1))
     curvature = left - 2.0 * mid + right
-    shift = np.where(curvature < 0.0, 0.5 * (left - right) / np.where(curvature < 0.0,
-                                                                       curvature, -1.0), 0.0)
+    # A flat top (zero curvature) stays where it is: dividing by -inf gives no shift.
+    shift = 0.5 * (left - right) / np.where(curvature < 0.0, curvature, -np.inf)
     step = freq[1] - freq[0]
     frequencies = freq[index] + shift * step
     amplitudes = np.exp(mid - 0.25 * (left - right) * shift)
@@ -560,7 +564,10 @@ def classify(peaks: Peaks, tol: float | None = None, max_order: int = 4,
 
     The response is periodic if, for a fundamental f0 = (lowest peak) / m with
     m <= ``max_order``, every peak lies within ``tol`` of a multiple of f0 (f0 is
-    then refitted by least squares; the largest such f0 is taken). Otherwise the peaks
+    then refitted by least squares; the largest such f0 is taken). Fundamentals below
+    20 ``tol`` are not tried: any line lies within ``tol`` of a multiple of f0 with
+    chance 2 ``tol`` / f0, so so low a fundamental would fit nearly any set of lines.
+    Otherwise the peaks
     are visited strongest first and each one that is no integer combination
     ``sum(m_k f_k)``, ``|m_k| <= max_order``, of the generators so far becomes a new
     generator; the generators are finally refitted by least squares to all the peaks
@@ -597,6 +604,8 @@ def classify(peaks: Peaks, tol: float | None = None, max_order: int = 4,
 
     for m in range(1, max_order + 1):
         f0 = freq.min() / m
+        if f0 < 20.0 * tolerance:
+            break
         harmonic = np.rint(freq / f0)
         f0 = float(harmonic @ freq / (harmonic @ harmonic))
         harmonic = np.rint(freq / f0)
@@ -606,8 +615,8 @@ def classify(peaks: Peaks, tol: float | None = None, max_order: int = 4,
 
     generators: list[float] = []
     for f in freq:
-        combos = _combinations(len(generators), max_order) if generators else None
-        if combos is not None and _explain(f, generators, tolerance, combos) is not None:
+        if generators and _explain(f, generators, tolerance,
+                                   _combinations(len(generators), max_order)) is not None:
             continue
         generators.append(float(f))
         if len(generators) > max_generators:

@@ -33,10 +33,11 @@ def cli() -> None:
 
 
 def _register() -> None:
-    from fivdisc.cli import modes, simulate
+    from fivdisc.cli import modes, plot, simulate
 
     cli.add_command(modes.modes)
     cli.add_command(simulate.simulate)
+    cli.add_command(plot.plot)
 
 
 _register()

@@ -89,12 +89,14 @@ def _check(ds, kind: str, var: str | None, probe: int | None) -> str | None:
               help="Time window in s; either side may be empty [default: all].")
 @click.option("--fmax", type=float, default=None,
               help="Highest frequency shown by spectrogram and spectrum [Hz].")
+@click.option("--segment", type=float, default=None,
+              help="STFT segment length of spectrogram [s] [default: 0.05].")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               help="Figure file; the format follows the extension [default: RESULT-KIND.png].")
 @click.option("--dpi", type=click.IntRange(min=10), default=150, show_default=True,
               help="Resolution of raster formats.")
 def plot(result: Path, kind: str, var: str | None, probe: int | None, window_text: str | None,
-         fmax: float | None, output: Path | None, dpi: int) -> None:
+         fmax: float | None, segment: float | None, output: Path | None, dpi: int) -> None:
     """Plot a simulation RESULT (netCDF written by ``fivdisc simulate``) to a file."""
     import xarray as xr
 
@@ -115,13 +117,16 @@ def plot(result: Path, kind: str, var: str | None, probe: int | None, window_tex
                            "spectrum")
     if fmax is not None and not fmax > 0:
         raise FivdiscError(f"--fmax {fmax:g} is invalid: must be > 0 [Hz]")
+    if segment is not None and kind != "spectrogram":
+        raise FivdiscError(f"--segment is not used by --kind {kind}: only by spectrogram")
     name = _check(ds, kind, var, probe)
     window = parse_window(window_text, ds["time"].values)
 
     if kind == "timeseries":
         fig = plots.plot_timeseries(ds, name, probe, window)
     elif kind == "spectrogram":
-        fig = plots.plot_spectrogram(ds, name, probe, window, fmax=fmax)
+        fig = plots.plot_spectrogram(ds, name, probe, window, fmax=fmax,
+                                     segment=0.05 if segment is None else segment)
     elif kind == "spectrum":
         fig = plots.plot_spectrum(ds, name, probe, window, fmax=fmax)
     elif kind == "phase":

@@ -14,7 +14,7 @@ import difflib
 import importlib
 import math
 import numbers
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from functools import cache
 from typing import Any
@@ -206,7 +206,7 @@ def _user(spec: str) -> Reduction:
     if not module_name or not attr.isidentifier():
         raise SweepError(
             f"{where} is invalid: must be a built-in reduction"
-            f"{_near(spec, BUILTIN)} ({', '.join(BUILTIN)}) or 'package.module:function'"
+            f"{nearest(spec, BUILTIN)} ({', '.join(BUILTIN)}) or 'package.module:function'"
         )
     try:
         module = importlib.import_module(module_name)
@@ -216,7 +216,7 @@ def _user(spec: str) -> Reduction:
     if not callable(func):
         names = [n for n in vars(module) if callable(getattr(module, n)) and not n.startswith("_")]
         raise SweepError(
-            f"{where} is invalid: '{module_name}' has no function '{attr}'{_near(attr, names)}"
+            f"{where} is invalid: '{module_name}' has no function '{attr}'{nearest(attr, names)}"
         )
     doc = (func.__doc__ or "").strip().splitlines()
     return Reduction(
@@ -231,7 +231,8 @@ def _user(spec: str) -> Reduction:
     )
 
 
-def _near(name: str, names: Sequence[str]) -> str:
+def nearest(name: str, names: Iterable[str]) -> str:
+    """Hint naming the closest of `names` ("; did you mean 'x'?"), or "" if none is close."""
     matches = difflib.get_close_matches(name, list(names), n=1)
     return f"; did you mean '{matches[0]}'?" if matches else ""
 
@@ -245,7 +246,7 @@ def _resolve(keep: tuple[str, ...]) -> tuple[Reduction, ...]:
             continue
         if spec not in BUILTIN:
             raise SweepError(
-                f"reduce.keep: unknown reduction '{spec}'{_near(spec, BUILTIN)}; built-in are "
+                f"reduce.keep: unknown reduction '{spec}'{nearest(spec, BUILTIN)}; built-in are "
                 f"{', '.join(BUILTIN)}, or give a user one as 'package.module:function'"
             )
         if spec in _NEEDS_MODULE:

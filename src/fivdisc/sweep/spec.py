@@ -19,7 +19,6 @@ that starts cannot fail on its input halfway through.
 
 from __future__ import annotations
 
-import difflib
 import hashlib
 import json
 import math
@@ -35,7 +34,7 @@ import numpy as np
 
 from fivdisc.case import Case, load_case
 from fivdisc.errors import CaseError
-from fivdisc.sweep.reductions import Reduction, SweepError, resolve, stop_events
+from fivdisc.sweep.reductions import Reduction, SweepError, nearest, resolve, stop_events
 
 __all__ = ["Sweep", "SweepError", "load_sweep", "parse_range"]
 
@@ -45,12 +44,6 @@ _FILE_KEYS = ("base", "mode", "axes", "link", "reduce")
 _REDUCE_KEYS = ("keep",)
 _RANGE = re.compile(r"^\s*([^:]+):([^:]+):([^:]+)\s*$")
 _INTEGER = re.compile(r"^\s*[+-]?\d+\s*$")
-
-
-def _nearest(name: str, names: Sequence[str]) -> str:
-    """"; did you mean 'x'?" for the closest of `names`, or "" if none is close."""
-    matches = difflib.get_close_matches(name, list(names), n=1)
-    return f"; did you mean '{matches[0]}'?" if matches else ""
 
 
 def parse_range(text: str, where: str = "range") -> list[float] | list[int]:
@@ -103,8 +96,7 @@ def _axis_values(key: str, raw: Any) -> tuple[Any, ...]:
         raw = raw.tolist()
     if not isinstance(raw, list | tuple) or not raw:
         raise SweepError(
-            f"{where} = {raw!r} is invalid: must be a non-empty list of values or "
-            '"start:stop:n"'
+            f'{where} = {raw!r} is invalid: must be a non-empty list of values or "start:stop:n"'
         )
     return tuple(v.item() if isinstance(v, np.generic) else v for v in raw)
 
@@ -174,7 +166,7 @@ class Sweep:
         axes: dict[str, tuple[Any, ...]] = {}
         for key, raw in self.axes.items():
             if key not in valid:
-                raise SweepError(f"axes: unknown case key '{key}'{_nearest(key, valid)}")
+                raise SweepError(f"axes: unknown case key '{key}'{nearest(key, valid)}")
             axes[key] = _axis_values(key, raw)
             if self.mode == "grid":
                 text = [json.dumps(v, sort_keys=True) for v in axes[key]]
@@ -192,13 +184,13 @@ class Sweep:
         link = dict(self.link)
         for target, origin in link.items():
             if target not in valid:
-                raise SweepError(f"link: unknown case key '{target}'{_nearest(target, valid)}")
+                raise SweepError(f"link: unknown case key '{target}'{nearest(target, valid)}")
             if target in axes:
                 raise SweepError(f"link: '{target}' is an axis; it cannot also copy '{origin}'")
             if not isinstance(origin, str) or origin not in valid:
                 raise SweepError(
                     f"link.'{target}' = {origin!r} is invalid: must be a case key"
-                    f"{_nearest(str(origin), valid)}"
+                    f"{nearest(str(origin), valid)}"
                 )
         set_(self, "link", link)
 
@@ -314,7 +306,7 @@ def _file_fields(data: dict[str, Any], root: Path) -> dict[str, Any]:
     """Keyword arguments of :class:`Sweep` from a parsed sweep file."""
     for key in data:
         if key not in _FILE_KEYS:
-            raise SweepError(f"unknown key '{key}'{_nearest(key, _FILE_KEYS)}")
+            raise SweepError(f"unknown key '{key}'{nearest(key, _FILE_KEYS)}")
     raw_base = data.get("base", {})
     if isinstance(raw_base, str):
         path = root / raw_base
@@ -335,7 +327,7 @@ def _file_fields(data: dict[str, Any], root: Path) -> dict[str, Any]:
     reduce = data.get("reduce", {})
     for key in reduce:
         if key not in _REDUCE_KEYS:
-            raise SweepError(f"unknown key 'reduce.{key}'{_nearest(key, _REDUCE_KEYS)}")
+            raise SweepError(f"unknown key 'reduce.{key}'{nearest(key, _REDUCE_KEYS)}")
     if "keep" not in reduce:
         raise SweepError("reduce.keep is missing: list the reductions to store")
     return {

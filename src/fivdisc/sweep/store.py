@@ -282,8 +282,9 @@ class SweepStore:
 def _create(path: Path, sweep: Sweep) -> None:
     """Write the empty store under a temporary name and rename it into place."""
     tmp = path.with_name(f"{path.name}.tmp-{os.getpid()}")
-    encoding = {name: {"chunks": (1,)} for name in (*(r.name for r in sweep.reductions),
-                                                    "error", "done")}
+    encoding = {
+        name: {"chunks": (1,)} for name in (*(r.name for r in sweep.reductions), "error", "done")
+    }
     try:
         _template(sweep).to_zarr(
             tmp, mode="w-", compute=False, consolidated=False, zarr_format=3, encoding=encoding
@@ -334,8 +335,7 @@ def as_grid(data: xr.Dataset) -> xr.Dataset:
     """
     if data.attrs.get("sweep_mode") != "grid":
         raise SweepError(
-            f"sweep_mode = {data.attrs.get('sweep_mode')!r} is invalid for as_grid: "
-            "must be 'grid'"
+            f"sweep_mode = {data.attrs.get('sweep_mode')!r} is invalid for as_grid: must be 'grid'"
         )
     keys = json.loads(data.attrs["sweep_axes"])
     shape = tuple(json.loads(data.attrs["sweep_shape"]))

@@ -1,0 +1,35 @@
+"""Parameter sweeps: many simulations, reduced to a few numbers each, stored resumably.
+
+>>> from fivdisc.sweep import load_sweep, run_sweep, open_sweep
+>>> report = run_sweep(load_sweep("examples/sweep_fig27.toml"), "fig27.zarr")  # doctest: +SKIP
+>>> open_sweep("fig27.zarr")["separated"]  # doctest: +SKIP
+
+See :mod:`fivdisc.sweep.spec` for the sweep file format, :mod:`fivdisc.sweep.store`
+for the store layout and :mod:`fivdisc.sweep.separation` for the paper's separation
+maps (Fig. 27).
+"""
+
+from fivdisc.sweep.reductions import BUILTIN, Reduction, RunFailed, SweepError
+from fivdisc.sweep.run import SweepReport, run_sweep, warm_kernel
+from fivdisc.sweep.separation import plot_separation_map, separation_sweep
+from fivdisc.sweep.spec import Sweep, load_sweep, parse_range
+from fivdisc.sweep.store import SweepStore, as_grid, open_sweep, read_mask
+
+__all__ = [
+    "BUILTIN",
+    "Reduction",
+    "RunFailed",
+    "Sweep",
+    "SweepError",
+    "SweepReport",
+    "SweepStore",
+    "as_grid",
+    "load_sweep",
+    "open_sweep",
+    "parse_range",
+    "plot_separation_map",
+    "read_mask",
+    "run_sweep",
+    "separation_sweep",
+    "warm_kernel",
+]

@@ -1,0 +1,305 @@
+"""Running a sweep: a local process pool or a Dask cluster, results stored as they finish.
+
+Workers only compute; the coordinating process (the one calling :func:`run_sweep`)
+writes every result to the store, so the store has a single writer. Points already
+complete in the store are skipped, which makes an interrupted sweep resumable by
+running it again.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+import time
+from collections import deque
+from collections.abc import Iterable
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor
+from concurrent.futures import wait as wait_local
+from dataclasses import dataclass
+from multiprocessing import get_context
+from os import PathLike
+from pathlib import Path
+from typing import Any
+
+from fivdisc.case import Case
+from fivdisc.errors import FivdiscError
+from fivdisc.sweep.reductions import SweepError, evaluate, fill_values, resolve
+from fivdisc.sweep.spec import Sweep
+from fivdisc.sweep.store import PointOutcome, SweepStore
+
+__all__ = ["SweepReport", "run_sweep", "warm_kernel"]
+
+# Points submitted ahead per worker: enough to keep workers busy while the
+# coordinator writes, few enough that an interruption discards little work.
+_AHEAD_PER_WORKER = 2
+_PARENT_POLL = 1.0  # [s]
+
+
+@dataclass(frozen=True)
+class SweepReport:
+    """How a call of :func:`run_sweep` went.
+
+    Attributes
+    ----------
+    store
+        The Zarr store.
+    n_points
+        Points in the sweep.
+    already_done
+        Points found complete in the store when the call started.
+    computed
+        Points computed by this call.
+    failed
+        Failed points in the store (this and earlier calls), index -> message.
+    wall_time
+        Duration of the call [s].
+    """
+
+    store: Path
+    n_points: int
+    already_done: int
+    computed: int
+    failed: dict[int, str]
+    wall_time: float
+
+
+def warm_kernel() -> None:
+    """Compile or load the simulator's numba code with a tiny run (about 1 ms simulated)."""
+    from fivdisc.simulate import simulate
+
+    simulate(Case(simulation={"duration": 1e-3, "output_rate": 1000.0}))
+
+
+def run_point(index: int, case: Case, keep: tuple[str, ...]) -> PointOutcome:
+    """Compute one point; a failure is returned as the outcome's error, not raised."""
+    reductions = resolve(keep)
+    try:
+        return PointOutcome(index, evaluate(case, keep))
+    except FivdiscError as exc:
+        return PointOutcome(index, fill_values(reductions), str(exc))
+    except Exception as exc:  # a user reduction or the solver may raise anything
+        return PointOutcome(index, fill_values(reductions), f"{type(exc).__name__}: {exc}")
+
+
+# --- executors -------------------------------------------------------------------------------
+
+
+def _exit_with_parent(parent: int) -> None:
+    # A coordinator killed by SIGKILL cannot stop its workers; they stop themselves.
+    while os.getppid() == parent:
+        time.sleep(_PARENT_POLL)
+    os._exit(1)
+
+
+def _init_local_worker(parent: int) -> None:
+    # Ctrl-C reaches the whole process group; only the coordinator should act on it.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_exit_with_parent, args=(parent,), daemon=True).start()
+    warm_kernel()
+
+
+class _LocalPool:
+    """A ProcessPoolExecutor whose workers are warmed and die with the coordinator."""
+
+    def __init__(self, workers: int) -> None:
+        self.workers = workers
+        # spawn, not fork: the coordinator runs threads (tqdm, zarr's I/O loop) that a
+        # forked child would inherit in an arbitrary state.
+        self._pool = ProcessPoolExecutor(
+            max_workers=workers,
+            mp_context=get_context("spawn"),
+            initializer=_init_local_worker,
+            initargs=(os.getpid(),),
+        )
+
+    def submit(self, index: int, case: Case, keep: tuple[str, ...]) -> Any:
+        return self._pool.submit(run_point, index, case, keep)
+
+    def wait(self, futures: Iterable[Any]) -> set[Any]:
+        return wait_local(futures, return_when=FIRST_COMPLETED).done
+
+    def outcome(self, future: Any, index: int, keep: tuple[str, ...]) -> PointOutcome:
+        exc = future.exception()
+        if exc is None:
+            return future.result()
+        # A worker process died (BrokenProcessPool): the pool is unusable.
+        raise FivdiscError(
+            f"a worker process died while computing point {index} ({exc}); "
+            "rerun the same command to resume"
+        )
+
+    def close(self) -> None:
+        self._pool.shutdown(wait=True)
+
+    def abort(self) -> None:
+        # ProcessPoolExecutor has no public way (before Python 3.14) to stop tasks that
+        # are running; terminate its processes so an interrupted sweep exits at once.
+        processes = list(getattr(self._pool, "_processes", {}).values())
+        self._pool.shutdown(wait=False, cancel_futures=True)
+        for process in processes:
+            process.terminate()
+
+
+def _warm_plugin() -> Any:
+    from distributed.diagnostics.plugin import WorkerPlugin
+
+    class WarmKernel(WorkerPlugin):
+        """Loads the simulator's compiled code once on every worker, present and future."""
+
+        name = "fivdisc-warm-kernel"
+
+        def setup(self, worker: Any) -> None:
+            warm_kernel()
+
+    return WarmKernel()
+
+
+class _DaskPool:
+    """The workers of an existing Dask distributed cluster."""
+
+    def __init__(self, address: str) -> None:
+        try:
+            from distributed import Client
+        except ImportError as exc:
+            raise SweepError(
+                f"--scheduler needs dask.distributed ({exc}); install it with "
+                "`pip install fivdisc[distributed]`"
+            ) from None
+        try:
+            self._client = Client(address, timeout="10s")
+        except OSError as exc:
+            raise SweepError(f"scheduler = {address!r}: cannot connect ({exc})") from None
+        self._client.register_plugin(_warm_plugin())
+        self.workers = max(1, sum(self._client.nthreads().values()))
+
+    def submit(self, index: int, case: Case, keep: tuple[str, ...]) -> Any:
+        return self._client.submit(run_point, index, case, keep, pure=False)
+
+    def wait(self, futures: Iterable[Any]) -> set[Any]:
+        from distributed import wait
+
+        return set(wait(list(futures), return_when="FIRST_COMPLETED").done)
+
+    def outcome(self, future: Any, index: int, keep: tuple[str, ...]) -> PointOutcome:
+        if future.status == "finished":
+            return future.result()
+        # The task itself never raises (run_point catches), so this is the cluster's
+        # failure, e.g. a worker killed repeatedly while running it: record the point.
+        exc = future.exception()
+        return PointOutcome(index, fill_values(resolve(keep)), f"{type(exc).__name__}: {exc}")
+
+    def close(self) -> None:
+        self._client.close()
+
+    def abort(self) -> None:
+        self._client.close()
+
+
+# --- the loop --------------------------------------------------------------------------------
+
+
+def run_sweep(
+    sweep: Sweep,
+    store: str | PathLike[str],
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: bool = True,
+) -> SweepReport:
+    """Compute the points of `sweep` that `store` does not hold yet, storing each as it ends.
+
+    Parameters
+    ----------
+    sweep
+        The sweep.
+    store
+        Zarr store directory; created if missing. An existing store must hold the
+        same sweep (same definition hash), whose complete points are skipped.
+    scheduler
+        Address of a Dask distributed scheduler (e.g. ``"tcp://127.0.0.1:8786"``) to
+        run on; None runs on a local process pool.
+    workers
+        Size of the local process pool (default: the number of CPUs); local pool only.
+    progress
+        Show a progress bar (points, failures, time left) on stderr.
+
+    Returns
+    -------
+    SweepReport
+        Counts, failures and timing.
+
+    Raises
+    ------
+    SweepError
+        Bad `workers`, a store holding another sweep, or no connection to `scheduler`.
+    KeyboardInterrupt
+        On Ctrl-C, after the workers are stopped; complete points stay stored.
+    """
+    start = time.perf_counter()
+    if workers is not None and (
+        isinstance(workers, bool) or not isinstance(workers, int) or workers < 1
+    ):
+        raise SweepError(f"workers = {workers!r} is invalid: must be an integer >= 1")
+    if workers is not None and scheduler is not None:
+        raise SweepError(
+            f"workers = {workers} is invalid with a scheduler: the cluster's size is set "
+            "where the cluster is started"
+        )
+    target = SweepStore.open(store, sweep)
+    done = target.completed()
+    todo = deque(int(i) for i in range(sweep.n_points) if not done[i])
+    already = sweep.n_points - len(todo)
+    failed = target.errors(done)
+
+    if todo:
+        pool = _DaskPool(scheduler) if scheduler else _LocalPool(workers or os.cpu_count() or 1)
+        try:
+            _drive(pool, sweep, target, todo, already, failed, progress)
+        except BaseException:
+            pool.abort()
+            raise
+        pool.close()
+    return SweepReport(
+        store=target.path,
+        n_points=sweep.n_points,
+        already_done=already,
+        computed=sweep.n_points - already,
+        failed=failed,
+        wall_time=time.perf_counter() - start,
+    )
+
+
+def _drive(
+    pool: _LocalPool | _DaskPool,
+    sweep: Sweep,
+    target: SweepStore,
+    todo: deque[int],
+    already: int,
+    failed: dict[int, str],
+    progress: bool,
+) -> None:
+    """Keep the pool fed, and store results as they come back."""
+    from tqdm import tqdm
+
+    keep = tuple(sweep.keep)
+    ahead = _AHEAD_PER_WORKER * pool.workers
+    running: dict[Any, int] = {}
+    with tqdm(
+        total=sweep.n_points,
+        initial=already,
+        unit="point",
+        desc="sweep",
+        disable=not progress,
+        dynamic_ncols=True,
+    ) as bar:
+        bar.set_postfix(failed=len(failed))
+        while todo or running:
+            while todo and len(running) < ahead:
+                index = todo.popleft()
+                running[pool.submit(index, sweep.cases[index], keep)] = index
+            finished = pool.wait(running)
+            outcomes = [pool.outcome(f, running.pop(f), keep) for f in finished]
+            target.write(outcomes)
+            failed.update((o.index, o.error) for o in outcomes if o.error)
+            bar.set_postfix(failed=len(failed), refresh=False)
+            bar.update(len(outcomes))
