@@ -117,7 +117,7 @@ class ModeData:
     R0: np.ndarray
     M: np.ndarray
     omega: np.ndarray
-    l: np.ndarray  # noqa: E741 (the paper's symbol)
+    l: np.ndarray
     is_sine: np.ndarray
 
     @property
@@ -135,7 +135,7 @@ class ModeData:
         return part
 
     @classmethod
-    def from_lists(cls, R0, M, omega, l, is_sine) -> ModeData:  # noqa: E741
+    def from_lists(cls, R0, M, omega, l, is_sine) -> ModeData:
         return cls(
             np.asarray(R0, float),
             np.asarray(M, float),
@@ -154,7 +154,7 @@ def mode_data_from_case(case: Any) -> ModeData:
 
         plate = AnnularPlate.from_disc(case.disc)
         r0 = float(case.slider.track_radius)
-        for k, l in modes:  # noqa: E741
+        for k, l in modes:
             mode = plate.mode(int(k), int(l))
             r = float(np.asarray(mode.shape(r0)))
             for is_sine in (False, True) if l >= 1 else (False,):

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from reference_model import jacobi_integral, mode_data_from_case
 
 from fivdisc._kernels import dynamics as dyn
 from fivdisc.analysis.equilibrium import sliding_equilibrium
@@ -13,6 +12,7 @@ from fivdisc.errors import SimulationError
 from fivdisc.model import build_model
 from fivdisc.simulate import simulate
 from fivdisc.speed import SpeedProfile
+from reference_model import jacobi_integral, mode_data_from_case
 
 
 def _belt_period(case: Case, omega: float) -> float:

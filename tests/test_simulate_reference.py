@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from reference_model import reference_simulate
 
 from fivdisc.case import Case
 from fivdisc.simulate import simulate
+from reference_model import reference_simulate
 
 SPAN = 0.1
 TIGHT = {"rtol": 1e-10, "atol": 1e-13, "duration": SPAN, "output_rate": 20000.0}

@@ -52,7 +52,7 @@ class Model:
     modes: tuple[PlateMode, ...]
     labels: tuple[str, ...]
     k: np.ndarray
-    l: np.ndarray  # noqa: E741  (the paper's symbol)
+    l: np.ndarray
     sgn: np.ndarray
     partner: np.ndarray
     R0: np.ndarray

@@ -394,7 +394,7 @@ class AnnularPlate:
         """Flexural rigidity ``D = E h^3 / (12 (1 - nu^2))`` [N m]."""
         return self.youngs_modulus * self.thickness**3 / (12.0 * (1.0 - self.poisson_ratio**2))
 
-    def frequency_parameters(self, l: int, count: int) -> np.ndarray:  # noqa: E741 (paper's l)
+    def frequency_parameters(self, l: int, count: int) -> np.ndarray:
         """The first ``count`` frequency parameters of harmonic ``l``.
 
         Parameters
@@ -419,7 +419,7 @@ class AnnularPlate:
         )
         return np.array(roots[:count])
 
-    def mode(self, k: int, l: int) -> PlateMode:  # noqa: E741 (paper's l)
+    def mode(self, k: int, l: int) -> PlateMode:
         """Mode with ``k`` nodal circles and ``l`` nodal diameters.
 
         Parameters
@@ -505,7 +505,7 @@ class PlateMode:
     """
 
     k: int
-    l: int  # noqa: E741 (the paper's symbol for nodal diameters)
+    l: int
     beta: float
     omega: float
     modal_mass: float

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from itertools import pairwise
 
 import numpy as np
 
@@ -125,7 +126,7 @@ class SpeedProfile:
         knots: list[float] = []
         coefs: list[np.ndarray] = []
         scale = 1.0 + max(abs(sample(e, False)[0]) for e in edges)
-        for a, b in zip(edges[:-1], edges[1:], strict=True):
+        for a, b in pairwise(edges):
             stack = [(a, b)]
             pieces: list[tuple[float, np.ndarray]] = []
             while stack:
@@ -169,7 +170,8 @@ class SpeedProfile:
 
     def is_constant(self) -> bool:
         """Whether Omega never changes."""
-        return bool(np.all(self.coefficients[:, 1:] == 0.0)) and np.ptp(self.coefficients[:, 0]) == 0
+        coef = self.coefficients
+        return bool(np.all(coef[:, 1:] == 0.0) and np.ptp(coef[:, 0]) == 0.0)
 
 
 def _hermite(t0: float, t1: float, p0: tuple[float, float], p1: tuple[float, float]) -> np.ndarray:

@@ -20,8 +20,8 @@ from fivdisc._kernels.dopri5 import A, C, E, dense_coefficients, dense_eval
 from fivdisc._kernels.dynamics import (
     M_COEF,
     M_KNOTS,
-    P_LMAX,
     P_IMPACT,
+    P_LMAX,
     P_MUS,
     SEPARATION,
     SLIP,
@@ -196,7 +196,7 @@ def apply_switch(which, t, y, phase, s, mdl, work, dy, ev_t, ev_i, ist):
 def _event_at(theta, i, t, h, rc, phase, s, mdl, work, dy, ytmp, evt, ist):
     ist[I_EVAL_EVENTS] += 1
     dense_eval(rc, theta, ytmp)
-    nf, f, wc, wcd, v = evaluate(t + theta * h, ytmp, phase, s, False, mdl, work, dy)
+    nf, f, wc, _, v = evaluate(t + theta * h, ytmp, phase, s, False, mdl, work, dy)
     event_values(phase, s, nf, f, wc, v, ytmp, mdl[0], evt)
     return evt[i]
 
@@ -264,7 +264,7 @@ def _write_outputs(t0, t1, h, rc, phase, s, mdl, work, dy, ytmp, ctl, out_y, out
 @njit(cache=True)
 def _write_sample(i, ti, ys, phase, s, mdl, work, dy, out_y, out_aux):
     n = (ys.shape[0] - 4) // 2
-    nf, f, wc, wcd, v = evaluate(ti, ys, phase, s, False, mdl, work, dy)
+    nf, f, wc, wcd, _ = evaluate(ti, ys, phase, s, False, mdl, work, dy)
     if phase == STICK:
         om, _ = speed_at(ti, mdl[M_KNOTS], mdl[M_COEF], False)
         ys[2 * n + 2] = om
@@ -313,7 +313,7 @@ def _initial_step(t, y, f0, phase, s, mdl, work, ctl, ytmp, dy):
 
 @njit(cache=True)
 def _restart(t, y, phase, s, mdl, work, k, ev_prev):
-    nf, f, wc, wcd, v = evaluate(t, y, phase, s, True, mdl, work, k[0])
+    nf, f, wc, _, v = evaluate(t, y, phase, s, True, mdl, work, k[0])
     event_values(phase, s, nf, f, wc, v, y, mdl[0], ev_prev)
 
 
@@ -382,7 +382,7 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
                 if a != 0.0:
                     for i in range(ns):
                         ytmp[i] += a * k[j, i]
-            nf, f, wc, wcd, v = evaluate(t + C[st] * hs, ytmp, phase, s, False, mdl, work, k[st])
+            nf, f, wc, _, v = evaluate(t + C[st] * hs, ytmp, phase, s, False, mdl, work, k[st])
         ynew[:] = ytmp
         ist[I_RHS] += 6
         err_vec[:] = 0.0
@@ -499,10 +499,12 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
         if status != ST_RUNNING:
             ist[I_FAIL_PHASE] = phase
             break
-        if ist[I_OUT_NEXT] < out_y.shape[0] and min(ist[I_OUT_NEXT] * ctl[C_OUT_DT], t_final) <= t_new:
+        next_out = min(ist[I_OUT_NEXT] * ctl[C_OUT_DT], t_final)
+        if ist[I_OUT_NEXT] < out_y.shape[0] and next_out <= t_new:
             if not have_rc:
                 dense_coefficients(y, ynew, k, hs, rc)
-            _write_outputs(t, t_new, hs, rc, phase, s, mdl, work, dy, yout, ctl, out_y, out_aux, ist)
+            _write_outputs(t, t_new, hs, rc, phase, s, mdl, work, dy, yout, ctl, out_y, out_aux,
+                           ist)
         y[:] = ynew
         for i in range(ns):
             k[0, i] = k[6, i]
