@@ -5,7 +5,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import root
 
 from fivdisc._kernels import dynamics as dyn
 from fivdisc.case import Case
@@ -69,6 +68,8 @@ def sliding_equilibrium(case: Case | Model, xtol: float = 1e-13) -> Equilibrium:
     SimulationError
         If the speed is not constant or no equilibrium is found.
     """
+    from scipy.optimize import root
+
     model = case if isinstance(case, Model) else build_model(case)
     if not model.speed.is_constant():
         raise SimulationError(

@@ -19,7 +19,6 @@ from typing import Any, Literal
 
 import numpy as np
 import scipy.fft
-import scipy.signal
 import xarray as xr
 
 from fivdisc.errors import FivdiscError
@@ -302,6 +301,8 @@ def _samples(da: xr.DataArray) -> tuple[np.ndarray, float]:
 
 
 def _taper(window: WindowSpec, n: int) -> np.ndarray:
+    import scipy.signal
+
     try:
         # The periodic (DFT-even) form is the one meant for spectral analysis.
         return scipy.signal.get_window(window, n, fftbins=True)
@@ -361,6 +362,9 @@ def stft(data: xr.Dataset | object, var: str = "phi", probe: int | None = None,
         On an unknown variable, a bad probe, window, segment or overlap, or a time
         window shorter than one segment.
     """
+    import scipy.signal
+
+
     da = series(data, var, probe, t0, t1)
     values, fs = _samples(da)
     seg = _finite("segment", segment)
@@ -440,6 +444,8 @@ def spectrum(data: xr.Dataset | object, var: str, probe: int | None = None,
     AnalysisError
         On an unknown variable, a bad probe, window, time window or oversample.
     """
+    import scipy.signal
+
     if isinstance(oversample, bool) or not isinstance(oversample, int | np.integer) or (
         oversample < 1
     ):
@@ -522,6 +528,8 @@ def find_peaks(spectrum: Spectrum, n: int = 10, min_rel_height: float = 0.05,
     height = max(rel * float(amp[band].max()), spectrum.floor)
     if height <= 0.0:
         return empty
+    import scipy.signal
+
     index, _ = scipy.signal.find_peaks(amp, height=height)
     index = index[band[index]]
     if index.size == 0:
