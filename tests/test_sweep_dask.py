@@ -68,7 +68,8 @@ def test_workers_option_is_for_the_local_pool(cluster, tmp_path) -> None:
         )
 
 
-def test_unreachable_scheduler(tmp_path) -> None:
+def test_unreachable_scheduler(tmp_path, monkeypatch) -> None:
+    monkeypatch.setattr("fivdisc.sweep.run._CONNECT_TIMEOUT", 1.0)
     path = tmp_path / "sweep.toml"
     path.write_text(SWEEP, encoding="utf-8")
     with pytest.raises(SweepError, match=r"scheduler = 'tcp://127\.0\.0\.1:9': cannot connect"):

@@ -301,11 +301,11 @@ def _samples(da: xr.DataArray) -> tuple[np.ndarray, float]:
 
 
 def _taper(window: WindowSpec, n: int) -> np.ndarray:
-    import scipy.signal
+    from scipy import signal
 
     try:
         # The periodic (DFT-even) form is the one meant for spectral analysis.
-        return scipy.signal.get_window(window, n, fftbins=True)
+        return signal.get_window(window, n, fftbins=True)
     except (TypeError, ValueError) as exc:
         raise AnalysisError(
             f"window = {window!r} is not a scipy.signal window ({exc}): use a name such as "
@@ -362,7 +362,7 @@ def stft(data: xr.Dataset | object, var: str = "phi", probe: int | None = None,
         On an unknown variable, a bad probe, window, segment or overlap, or a time
         window shorter than one segment.
     """
-    import scipy.signal
+    from scipy import signal
 
 
     da = series(data, var, probe, t0, t1)
@@ -379,7 +379,7 @@ def stft(data: xr.Dataset | object, var: str = "phi", probe: int | None = None,
     if not 0.0 <= ovl < 1.0:
         raise AnalysisError(f"overlap = {overlap!r} is invalid: must be in [0, 1)")
     hop = max(1, nperseg - round(ovl * nperseg))
-    sft = scipy.signal.ShortTimeFFT(_taper(window, nperseg), hop, fs,
+    sft = signal.ShortTimeFFT(_taper(window, nperseg), hop, fs,
                                     fft_mode="onesided2X", scale_to="magnitude")
     p0 = sft.lower_border_end[1]
     p1 = sft.upper_border_begin(values.size)[1]
@@ -389,7 +389,7 @@ def stft(data: xr.Dataset | object, var: str = "phi", probe: int | None = None,
             f"{span:g} s: shorten the segment or widen t0, t1"
         )
     if detrend:
-        values = scipy.signal.detrend(values, type="linear")
+        values = signal.detrend(values, type="linear")
     transform = sft.stft(values, p0, p1)
     times = float(da["time"].values[0]) + sft.t(values.size, p0, p1)
     attrs = da.attrs
@@ -444,7 +444,7 @@ def spectrum(data: xr.Dataset | object, var: str, probe: int | None = None,
     AnalysisError
         On an unknown variable, a bad probe, window, time window or oversample.
     """
-    import scipy.signal
+    from scipy import signal
 
     if isinstance(oversample, bool) or not isinstance(oversample, int | np.integer) or (
         oversample < 1
@@ -457,7 +457,7 @@ def spectrum(data: xr.Dataset | object, var: str, probe: int | None = None,
                             "needs at least 8")
     floor = _NOISE_FLOOR * float(np.max(np.abs(values)))
     if detrend:
-        values = scipy.signal.detrend(values, type="linear")
+        values = signal.detrend(values, type="linear")
     taper = _taper(window, values.size)
     nfft = scipy.fft.next_fast_len(int(oversample) * values.size, real=True)
     amplitude = np.abs(scipy.fft.rfft(values * taper, nfft)) * (2.0 / taper.sum())
@@ -528,9 +528,9 @@ def find_peaks(spectrum: Spectrum, n: int = 10, min_rel_height: float = 0.05,
     height = max(rel * float(amp[band].max()), spectrum.floor)
     if height <= 0.0:
         return empty
-    import scipy.signal
+    from scipy import signal
 
-    index, _ = scipy.signal.find_peaks(amp, height=height)
+    index, _ = signal.find_peaks(amp, height=height)
     index = index[band[index]]
     if index.size == 0:
         return empty

@@ -34,6 +34,7 @@ __all__ = ["SweepReport", "run_sweep", "warm_kernel"]
 # coordinator writes, few enough that an interruption discards little work.
 _AHEAD_PER_WORKER = 2
 _PARENT_POLL = 1.0  # [s]
+_CONNECT_TIMEOUT = 10.0  # [s], to reach a Dask scheduler
 
 
 @dataclass(frozen=True)
@@ -167,7 +168,7 @@ class _DaskPool:
                 "`pip install fivdisc[distributed]`"
             ) from None
         try:
-            self._client = Client(address, timeout="10s")
+            self._client = Client(address, timeout=_CONNECT_TIMEOUT)
         except OSError as exc:
             raise SweepError(f"scheduler = {address!r}: cannot connect ({exc})") from None
         self._client.register_plugin(_warm_plugin())
