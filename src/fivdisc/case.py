@@ -56,6 +56,7 @@ __all__ = [
     "Speed",
     "TableSpeed",
     "load_case",
+    "unit_of",
 ]
 
 _TWO_PI = 2.0 * math.pi
@@ -892,3 +893,22 @@ def _describe(exc: ValidationError, root: type[_Table]) -> str:
     if len(errors) > _MAX_REPORTED_ERRORS:
         messages.append(f"and {len(errors) - _MAX_REPORTED_ERRORS} more errors")
     return "; ".join(messages)
+
+
+def unit_of(key: str) -> str:
+    """Unit of a dotted case key (``"slider.normal_damping"`` -> ``"N s/m"``), "" if none."""
+    table, _, name = key.rpartition(".")
+    models = {
+        "disc": (Disc,),
+        "slider": (Slider,),
+        "friction": (Friction,),
+        "speed": (ConstantSpeed, DeceleratingSpeed, AcceleratingSpeed, TableSpeed),
+        "simulation": (Simulation,),
+        "simulation.perturbation": (Perturbation,),
+    }.get(table, ())
+    for model in models:
+        field = model.model_fields.get(name)
+        if field is not None:
+            return str((field.json_schema_extra or {}).get("unit", ""))
+    return ""
+

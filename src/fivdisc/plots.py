@@ -293,3 +293,37 @@ def plot_normal_force(data: xr.Dataset | object, window: Window = None,
     ax.set_xlabel(_label(ds["time"], "time"))
     ax.set_ylabel(_label(force, "normal_force"))
     return fig
+
+
+def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None) -> Figure:
+    """Stability map of :func:`fivdisc.analysis.stability.stability_map` (paper Fig. 3).
+
+    With one curve the map is shaded by the sign of the largest growth rate; with several,
+    only their boundary curves are drawn ('stable' lies above each curve).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The map's dataset.
+    ax : matplotlib Axes, optional
+        Where to draw.
+    """
+    fig, ax = _axes(ax)
+    x, y = ds["x"].values, ds["y"].values
+    if ds.sizes["curve"] == 1:
+        ax.contourf(x, y, ds["stable"].values[0], levels=[-0.5, 0.5, 1.5],
+                    colors=["#f4c7c3", "#c6e5c3"])
+        ax.plot([], [], color="#c6e5c3", lw=8, label="stable")
+        ax.plot([], [], color="#f4c7c3", lw=8, label="unstable")
+    for i, value in enumerate(ds["curve"].values):
+        label = f"{ds.attrs['curve_key']} = {value:g}" if ds.attrs["curve_key"] else "boundary"
+        ax.plot(x, ds["boundary"].values[i], lw=1.5, label=label)
+    from fivdisc.case import unit_of
+
+    for key, set_label in ((ds.attrs["x_key"], ax.set_xlabel), (ds.attrs["y_key"], ax.set_ylabel)):
+        unit = unit_of(key)
+        set_label(f"{key} [{unit}]" if unit else key)
+    ax.set_xlim(x[0], x[-1])
+    ax.set_ylim(y[0], y[-1])
+    ax.legend(loc="best", fontsize="small")
+    return fig

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import xarray as xr
@@ -11,8 +11,23 @@ import xarray as xr
 from fivdisc._kernels import dynamics as dyn
 from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium
 from fivdisc.case import Case
-from fivdisc.errors import CaseError
+from fivdisc.errors import CaseError, SimulationError
 from fivdisc.model import Model, build_model
+from fivdisc.speed import SpeedProfile
+
+# Case keys that enter the model only through its parameter vector: a map over them
+# patches that vector instead of rebuilding the model (and the plate modes) per point.
+_PAR_KEYS = {
+    "slider.normal_damping": dyn.P_CZ,
+    "slider.rotational_damping": dyn.P_CPHI,
+    "slider.normal_stiffness": dyn.P_KZ,
+    "slider.rotational_stiffness": dyn.P_KPHI,
+    "slider.preload": dyn.P_N0,
+    "friction.static": dyn.P_MUS,
+    "friction.kinetic_max": dyn.P_MU0,
+    "friction.kinetic_min": dyn.P_MU1,
+    "friction.decay": dyn.P_ALPHA,
+}
 
 
 @dataclass(frozen=True)
@@ -179,6 +194,30 @@ def _equilibrium_key(model: Model) -> tuple:
             tuple(model.R0), tuple(model.omega))
 
 
+def _point_model(base: Model, case: Case, updates: dict[str, float]) -> Model:
+    """Model of ``case`` with ``updates``, by patching ``base`` where that is exact."""
+    if not all(k in _PAR_KEYS or k == "speed.value" for k in updates):
+        return build_model(case.replace(updates))
+    par = base.par.copy()
+    speed = base.speed
+    for key, value in updates.items():
+        if key == "speed.value":
+            speed = SpeedProfile.constant(value)
+        else:
+            par[_PAR_KEYS[key]] = value
+    return replace(base, par=par, speed=speed)
+
+
+def _validate_grid(case: Case, axes: list[tuple[str, np.ndarray]]) -> None:
+    """Every axis value, alone and at the grid's corners, must give a valid case."""
+    for key, values in axes:
+        for v in values:
+            case.replace({key: float(v)})
+    corners = np.array(np.meshgrid(*[[v[0], v[-1]] for _, v in axes])).reshape(len(axes), -1)
+    for combo in corners.T:
+        case.replace({key: float(v) for (key, _), v in zip(axes, combo, strict=True)})
+
+
 def stability_map(
     case: Case,
     x: tuple[str, Sequence[float]],
@@ -204,13 +243,20 @@ def stability_map(
     Returns
     -------
     xarray.Dataset
-        ``max_growth_rate`` [1/s] and ``stable`` on (curve, y, x), and ``boundary``
-        (curve, x): the smallest y above which every grid value is stable at that x
-        (NaN if the column is never stable or always stable).
+        ``max_growth_rate`` [1/s] (NaN where no sliding equilibrium exists) and
+        ``stable`` on (curve, y, x), and ``boundary``
+        (curve, x): the value of y above which the equilibrium is stable at that x,
+        interpolated where the growth rate changes sign for the last time (NaN if the
+        column is never stable at the top or stable throughout).
     """
     xkey, xs = _axis(x, "x")
     ykey, ys = _axis(y, "y")
-    ckey, cs = (curves[0], np.asarray(curves[1], dtype=float)) if curves else (None, [None])
+    axes = [(xkey, xs), (ykey, ys)]
+    if curves:
+        axes.append((curves[0], np.asarray(curves[1], dtype=float)))
+    _validate_grid(case, axes)
+    cs = axes[2][1] if curves else [None]
+    base = build_model(case)
     growth = np.full((len(cs), ys.size, xs.size), np.nan)
     cache: dict[tuple, Equilibrium] = {}
     bar = None
@@ -219,17 +265,26 @@ def stability_map(
 
         bar = tqdm(total=growth.size, desc="stability map", unit="pt")
     for ic, cval in enumerate(cs):
-        base = case if ckey is None else case.replace({ckey: float(cval)})
+        fixed = {} if cval is None else {curves[0]: float(cval)}
         for iy, yval in enumerate(ys):
-            row = base.replace({ykey: float(yval)})
             jacs = []
+            guess = None
             for xval in xs:
-                model = build_model(row.replace({xkey: float(xval)}))
+                model = _point_model(base, case, {**fixed, ykey: float(yval), xkey: float(xval)})
                 key = _equilibrium_key(model)
                 if key not in cache:
-                    cache[key] = sliding_equilibrium(model)
-                jacs.append(slip_jacobian(model, cache[key].state))
-            growth[ic, iy] = np.max(np.linalg.eigvals(np.stack(jacs)).real, axis=1)
+                    try:
+                        cache[key] = sliding_equilibrium(model, guess=guess)
+                    except SimulationError:
+                        cache[key] = None
+                if cache[key] is None:
+                    jacs.append(np.full((2 * base.n + 2,) * 2, np.nan))
+                    continue
+                guess = cache[key]
+                jacs.append(slip_jacobian(model, guess.state))
+            stack = np.stack(jacs)
+            ok = np.isfinite(stack).all(axis=(1, 2))
+            growth[ic, iy, ok] = np.max(np.linalg.eigvals(stack[ok]).real, axis=1)
             if bar is not None:
                 bar.update(xs.size)
     if bar is not None:
@@ -245,10 +300,11 @@ def stability_map(
             g0, g1 = growth[ic, last_unstable, ix], growth[ic, last_unstable + 1, ix]
             y0, y1 = ys[last_unstable], ys[last_unstable + 1]
             boundary[ic, ix] = y0 + (y1 - y0) * g0 / (g0 - g1)
+    ckey = curves[0] if curves else ""
     coords = {
         "x": ("x", xs, {"long_name": xkey}),
         "y": ("y", ys, {"long_name": ykey}),
-        "curve": ("curve", np.asarray(cs if ckey else [np.nan], dtype=float),
+        "curve": ("curve", np.asarray(cs if curves else [np.nan], dtype=float),
                   {"long_name": ckey or "none"}),
     }
     return xr.Dataset(
@@ -261,14 +317,32 @@ def stability_map(
                          {"units": "", "long_name": f"stability boundary in {ykey}"}),
         },
         coords=coords,
-        attrs={"x_key": xkey, "y_key": ykey, "curve_key": ckey or "", "case": case.to_toml()},
+        attrs={"x_key": xkey, "y_key": ykey, "curve_key": ckey, "case": case.to_toml()},
     )
+
+
+def resolve_key(key: str, option: str) -> str:
+    """Full dotted case key from a dotted key or an unambiguous last part (``decay``)."""
+    import difflib
+
+    keys = Case.valid_keys()
+    if key in keys:
+        return key
+    matches = [k for k in keys if k.rsplit(".", 1)[-1] == key]
+    if len(matches) == 1:
+        return matches[0]
+    if len(matches) > 1:
+        raise CaseError(f"{option}: key '{key}' is ambiguous: write one of {', '.join(matches)}")
+    near = difflib.get_close_matches(key, keys, n=1)
+    hint = f"; did you mean '{near[0]}'?" if near else ""
+    raise CaseError(f"{option}: unknown case key '{key}'{hint}")
 
 
 def parse_range(text: str, option: str) -> tuple[str, np.ndarray]:
     """Parse ``KEY=START:STOP:N`` (inclusive linspace) or ``KEY=v1,v2,...``."""
+    usage = f"{option} = {text!r} is invalid: write KEY=START:STOP:N or KEY=v1,v2,..."
     if "=" not in text:
-        raise CaseError(f"{option} = {text!r} is invalid: write KEY=START:STOP:N or KEY=v1,v2,..")
+        raise CaseError(usage)
     key, spec = text.split("=", 1)
     try:
         if ":" in spec:
@@ -277,14 +351,7 @@ def parse_range(text: str, option: str) -> tuple[str, np.ndarray]:
         else:
             values = np.array([float(v) for v in spec.split(",")])
     except ValueError:
-        raise CaseError(
-            f"{option} = {text!r} is invalid: write KEY=START:STOP:N or KEY=v1,v2,.."
-        ) from None
-    if key.strip() not in Case.valid_keys():
-        import difflib
-
-        near = difflib.get_close_matches(key.strip(), Case.valid_keys(), n=1)
-        hint = f"; did you mean '{near[0]}'?" if near else ""
-        raise CaseError(f"{option}: unknown case key '{key.strip()}'{hint}")
-    return key.strip(), values
-
+        raise CaseError(usage) from None
+    if values.size < 1 or not np.all(np.isfinite(values)):
+        raise CaseError(usage)
+    return resolve_key(key.strip(), option), values

@@ -33,11 +33,12 @@ def cli() -> None:
 
 
 def _register() -> None:
-    from fivdisc.cli import modes, plot, simulate
+    from fivdisc.cli import modes, plot, simulate, stability
 
     cli.add_command(modes.modes)
     cli.add_command(simulate.simulate)
     cli.add_command(plot.plot)
+    cli.add_command(stability.stability)
 
 
 _register()
