@@ -72,7 +72,7 @@ def test_simulation_defaults() -> None:
     )
     assert sim.probes == ((0.1, 0.0), (0.1, 1.0))
     assert sim.omega_dot_terms is True
-    assert (sim.rtol, sim.atol, sim.max_step, sim.max_switches) == (1e-8, 1e-11, 0.0, 10_000_000)
+    assert (sim.rtol, sim.atol, sim.max_step, sim.max_switches) == (1e-6, 1e-9, 0.0, 10_000_000)
     assert sim.perturbation == Perturbation(phi=1e-3, phi_dot=0.0)
 
 

@@ -466,8 +466,8 @@ class Simulation(_Table):
     probes: tuple[Probe, ...] = _field(((0.1, 0.0), (0.1, 1.0)))
     omega_dot_terms: Flag = True
     printed_gyroscopic_sign: Flag = False
-    rtol: Real = _field(1e-8, gt=0, le=0.1)
-    atol: Real = _field(1e-11, gt=0)
+    rtol: Real = _field(1e-6, gt=0, le=0.1)
+    atol: Real = _field(1e-9, gt=0)
     max_step: Real = _field(0.0, "s", ge=0)
     max_switches: Count = _field(10_000_000, ge=1)
     perturbation: Perturbation = Perturbation()
