@@ -302,8 +302,14 @@ def test_definition_hash_follows_the_definition(tmp_path) -> None:
     assert a.definition == b.definition and len(a.digest) == 64
     assert Sweep.from_toml(text.replace("1.0:2.0:3", "1.0:2.0:4")).digest != a.digest
     assert Sweep.from_toml(text.replace("0.05", "0.06")).digest != a.digest
-    # the same points written as a list are the same sweep
+    # the same points written as a list, or with integers, are the same sweep
     assert Sweep.from_toml(text.replace('"1.0:2.0:3"', "[1.0, 1.5, 2.0]")).digest == a.digest
+    integers = _sweep_text('"speed.value" = "2:6:3"')
+    assert Sweep.from_toml(integers).axes == {"speed.value": (2.0, 4.0, 6.0)}
+    assert (
+        Sweep.from_toml(integers).digest
+        == Sweep.from_toml(integers.replace('"2:6:3"', "[2.0, 4.0, 6.0]")).digest
+    )
 
 
 # --- reductions ------------------------------------------------------------------------------

@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
+
+if TYPE_CHECKING:
+    from fivdisc.sweep import Sweep, SweepReport
 
 # Shell convention for a command ended by SIGINT (128 + 2).
 _EXIT_INTERRUPTED = 130
@@ -29,16 +33,18 @@ _progress_option = click.option(
 )
 
 
-def _run(sweep, output: Path, scheduler: str | None, workers: int | None, progress: bool):
+def _run(
+    spec: Sweep, output: Path, scheduler: str | None, workers: int | None, progress: bool
+) -> SweepReport:
     """Run a sweep into `output`, print what happened; exit 130 on Ctrl-C."""
     from fivdisc.sweep import read_mask, run_sweep
 
     try:
-        report = run_sweep(sweep, output, scheduler=scheduler, workers=workers, progress=progress)
+        report = run_sweep(spec, output, scheduler=scheduler, workers=workers, progress=progress)
     except KeyboardInterrupt:
         done = int(read_mask(output).sum()) if output.exists() else 0
         click.echo(
-            f"interrupted: {done} of {sweep.n_points} points are stored in {output}; "
+            f"interrupted: {done} of {spec.n_points} points are stored in {output}; "
             "rerun the same command to compute the rest",
             err=True,
         )

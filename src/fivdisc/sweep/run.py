@@ -201,17 +201,20 @@ class _DaskPool:
 
 
 def run_sweep(
-    sweep: Sweep,
+    spec: Sweep,
     store: str | PathLike[str],
     scheduler: str | None = None,
     workers: int | None = None,
     progress: bool = True,
 ) -> SweepReport:
-    """Compute the points of `sweep` that `store` does not hold yet, storing each as it ends.
+    """Compute the points of `spec` that `store` does not hold yet, storing each as it ends.
+
+    The local pool starts its workers with ``spawn``: a script calling this must
+    guard its entry point with ``if __name__ == "__main__":``.
 
     Parameters
     ----------
-    sweep
+    spec
         The sweep.
     store
         Zarr store directory; created if missing. An existing store must hold the
@@ -246,25 +249,25 @@ def run_sweep(
             f"workers = {workers} is invalid with a scheduler: the cluster's size is set "
             "where the cluster is started"
         )
-    target = SweepStore.open(store, sweep)
+    target = SweepStore.open(store, spec)
     done = target.completed()
-    todo = deque(int(i) for i in range(sweep.n_points) if not done[i])
-    already = sweep.n_points - len(todo)
+    todo = deque(int(i) for i in range(spec.n_points) if not done[i])
+    already = spec.n_points - len(todo)
     failed = target.errors(done)
 
     if todo:
         pool = _DaskPool(scheduler) if scheduler else _LocalPool(workers or os.cpu_count() or 1)
         try:
-            _drive(pool, sweep, target, todo, already, failed, progress)
+            _drive(pool, spec, target, todo, already, failed, progress)
         except BaseException:
             pool.abort()
             raise
         pool.close()
     return SweepReport(
         store=target.path,
-        n_points=sweep.n_points,
+        n_points=spec.n_points,
         already_done=already,
-        computed=sweep.n_points - already,
+        computed=spec.n_points - already,
         failed=failed,
         wall_time=time.perf_counter() - start,
     )

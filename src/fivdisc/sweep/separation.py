@@ -191,6 +191,10 @@ def plot_separation_map(
         )
     ax.set_xlabel(_LABELS.get((profile, x_key), f"{x_key} [{grid[x_key].attrs.get('units')}]"))
     ax.set_ylabel(_LABELS.get((profile, y_key), f"{y_key} [{grid[y_key].attrs.get('units')}]"))
+    # Half a grid step around the points, so that markers on the edges show whole.
+    for values, set_lim in ((xs, ax.set_xlim), (ys, ax.set_ylim)):
+        pad = 0.5 * (values.max() - values.min()) / max(len(values) - 1, 1) or 0.5
+        set_lim(values.min() - pad, values.max() + pad)
     ax.set_title(f"separation region (SR), {profile} disc", fontsize="medium")
     ax.legend(loc="upper left", fontsize="small", framealpha=0.9)
     if path is not None:

@@ -101,6 +101,16 @@ def _axis_values(key: str, raw: Any) -> tuple[Any, ...]:
     return tuple(v.item() if isinstance(v, np.generic) else v for v in raw)
 
 
+def strides_of(shape: Sequence[int]) -> tuple[int, ...]:
+    """Point-index step of each axis of a C-ordered grid of `shape`."""
+    return tuple(int(s) for s in np.cumprod((1, *shape[:0:-1]))[::-1])
+
+
+def _plain(value: Any) -> Any:
+    """A case value as plain data: tuples (arrays in a case) become lists."""
+    return _canonical(value) if isinstance(value, tuple) else value
+
+
 def _canonical(value: Any) -> Any:
     """A value as plain JSON data (tuples become lists)."""
     return json.loads(json.dumps(value))
@@ -161,6 +171,11 @@ class Sweep:
                 f"mode = {self.mode!r} is invalid: must be one of {', '.join(map(repr, MODES))}"
             )
         valid = Case.valid_keys()
+        for name in ("axes", "link"):
+            if not isinstance(getattr(self, name), Mapping):
+                raise SweepError(
+                    f"{name} = {getattr(self, name)!r} is invalid: must be a table (mapping)"
+                )
         if not self.axes:
             raise SweepError("axes is empty: name at least one case key to vary")
         axes: dict[str, tuple[Any, ...]] = {}
@@ -168,14 +183,6 @@ class Sweep:
             if key not in valid:
                 raise SweepError(f"axes: unknown case key '{key}'{nearest(key, valid)}")
             axes[key] = _axis_values(key, raw)
-            if self.mode == "grid":
-                text = [json.dumps(v, sort_keys=True) for v in axes[key]]
-                repeated = next((v for v in text if text.count(v) > 1), None)
-                if repeated is not None:
-                    raise SweepError(
-                        f"axes.'{key}' repeats the value {repeated}: grid axes must have "
-                        "distinct values"
-                    )
         if self.mode == "zip" and len({len(v) for v in axes.values()}) > 1:
             lengths = ", ".join(f"'{k}' has {len(v)}" for k, v in axes.items())
             raise SweepError(f"mode = 'zip' needs axes of equal length: {lengths}")
@@ -201,6 +208,23 @@ class Sweep:
         set_(self, "keep", tuple(self.keep))
         set_(self, "reductions", resolve(self.keep))
         set_(self, "cases", tuple(self._point_case(i) for i in range(self.n_points)))
+        # Keep the values as validated (e.g. 6 -> 6.0) so that equal sweeps have equal
+        # definitions however their values were spelt.
+        strides = strides_of(self.shape) if self.mode == "grid" else (1,) * len(axes)
+        validated = {
+            key: tuple(_plain(self.cases[j * stride].get(key)) for j in range(len(values)))
+            for (key, values), stride in zip(axes.items(), strides, strict=True)
+        }
+        set_(self, "axes", validated)
+        if self.mode == "grid":
+            for key, values in validated.items():
+                text = [json.dumps(v, sort_keys=True) for v in values]
+                repeated = next((v for v in text if text.count(v) > 1), None)
+                if repeated is not None:
+                    raise SweepError(
+                        f"axes.'{key}' repeats the value {repeated}: grid axes must have "
+                        "distinct values"
+                    )
 
         if any(r.name == "max_growth_rate" for r in self.reductions):
             for i, case in enumerate(self.cases):

@@ -35,7 +35,7 @@ import numpy as np
 import xarray as xr
 
 from fivdisc.sweep.reductions import SweepError
-from fivdisc.sweep.spec import Sweep
+from fivdisc.sweep.spec import Sweep, strides_of
 
 __all__ = ["PointOutcome", "SweepStore", "as_grid", "open_sweep", "read_mask"]
 
@@ -341,7 +341,7 @@ def as_grid(data: xr.Dataset) -> xr.Dataset:
     shape = tuple(json.loads(data.attrs["sweep_shape"]))
     # The axis values along each dimension are those of the points where the other
     # axes are at their first value, i.e. strides through the C-ordered points.
-    strides = np.cumprod((1, *shape[:0:-1]))[::-1]
+    strides = strides_of(shape)
     coords = {
         key: (key, data[key].values[: stride * length : stride], data[key].attrs)
         for key, length, stride in zip(keys, shape, strides, strict=True)
