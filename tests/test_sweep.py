@@ -105,7 +105,7 @@ def helper_dir(tmp_path_factory) -> Path:
 def _helper_on_path(helper_dir, monkeypatch) -> None:
     # spawned workers inherit sys.path; subprocesses get PYTHONPATH
     monkeypatch.syspath_prepend(str(helper_dir))
-    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(helper_dir), *sys.path]))
+    monkeypatch.setenv("PYTHONPATH", str(helper_dir))
 
 
 @pytest.fixture(scope="module")
@@ -362,13 +362,14 @@ def test_max_growth_rate_needs_constant_speed() -> None:
 
 
 def test_a_failing_point_is_returned_with_its_message() -> None:
-    keep = ("separated", "max_normal_force")
-    outcome = run_point(3, _short(**{"simulation.max_switches": 1}), keep)
-    assert outcome.index == 3
+    outcome = run_point(3, _short(**{"simulation.max_switches": 1}), ("separated",))
+    assert (outcome.index, outcome.values) == (3, None)
     assert outcome.error.startswith("simulation max_switches: simulation.max_switches = 1")
-    assert outcome.values["separated"] is False and math.isnan(outcome.values["max_normal_force"])
     outcome = run_point(0, _short(**{"speed.initial": 20.0}), ("sweep_helper:fragile",))
     assert outcome.error == "ValueError: too fast for this test"
+    # a worker that cannot import a user reduction records that too
+    outcome = run_point(0, _short(), ("sweep_helper_gone:f",))
+    assert "cannot import 'sweep_helper_gone'" in outcome.error
 
 
 # --- running and storing ---------------------------------------------------------------------
@@ -530,37 +531,37 @@ def test_interrupted_and_killed_sweeps_resume(reference, sweep_file, tmp_path) -
 
 
 def test_separation_is_likelier_at_high_speed_and_long_deceleration(tmp_path) -> None:
-    """Paper section 3.3 / Fig. 27, measured on a coarse 3 x 3 grid (runs <= 10 s).
+    """Paper section 3.3 / Fig. 27 on a coarse 3 x 3 grid (runs <= 16 s simulated).
 
-    fivdisc (corrected equations) separates only at high Omega_0 and long t_max,
-    e.g. Omega_0 = 20 rad/s separates for t_max >= 5 s; 6 rad/s does not within 10 s.
+    Measured with fivdisc's (corrected) equations: no point separates at Omega_0 =
+    12 rad/s or at t_max = 4 s; at Omega_0 = 16 and 20 rad/s separation starts for
+    t_max = 10 and 16 s, at t = 5.50 s and 3.59 s (16 rad/s) and 2.57 s and 2.64 s
+    (20 rad/s).
     """
     store, figure = tmp_path / "map.zarr", tmp_path / "map.png"
     result = CliRunner().invoke(
         separation_map,
         [
-            "--x",
-            "6:20:3",
-            "--y",
-            "2:10:3",
-            "-o",
-            str(store),
-            "--figure",
-            str(figure),
+            *("--x", "12:20:3", "--y", "4:16:3", "-o", str(store), "--figure", str(figure)),
             "--no-progress",
         ],
     )
     assert result.exit_code == 0, result.output
-    grid = as_grid(open_sweep(store))
+    grid = as_grid(open_sweep(store)).transpose("speed.initial", "speed.duration")
     assert grid["done"].all() and (grid["error"] == "").all()
-    separated = grid["separated"].transpose("speed.initial", "speed.duration").values
-    # monotone: never lost when Omega_0 or t_max grows
+    separated = grid["separated"].values
+    # the fraction of separated points grows with Omega_0 and with t_max ...
+    by_speed, by_duration = separated.mean(axis=1), separated.mean(axis=0)
+    assert (np.diff(by_speed) >= 0).all() and by_speed[-1] > by_speed[0], separated
+    assert (np.diff(by_duration) >= 0).all() and by_duration[-1] > by_duration[0], separated
+    # ... and no point loses separation when either grows
     assert (np.diff(separated.astype(int), axis=0) >= 0).all(), separated
     assert (np.diff(separated.astype(int), axis=1) >= 0).all(), separated
-    assert separated[-1, -1] and not separated[0, 0], separated
-    assert 0 < separated.mean() < 1
+    # where both separate, the faster disc separates sooner
     first = grid["first_separation_time"].values
-    assert np.isnan(first[~separated]).all() and (first[separated] > 0).all()
+    assert np.isnan(first[~separated]).all()
+    both = separated[1] & separated[2]
+    assert both.any() and (first[2][both] < first[1][both]).all(), first
     assert figure.stat().st_size > 10_000
     assert f"wrote {figure}" in result.output
 

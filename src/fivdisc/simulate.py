@@ -138,7 +138,7 @@ def simulate(
     ns = model.state_size
     # Rows past the last written sample are cut off, so they need no fill.
     out_y = np.empty((n_out, ns))
-    out_aux = np.empty((n_out, 4))
+    out_aux = np.empty((n_out, 5))
     ctl = np.zeros(kern.N_CONTROL)
     ctl[kern.C_RTOL] = sim.rtol
     ctl[kern.C_ATOL] = sim.atol

@@ -265,8 +265,8 @@ def _write_outputs(t0, t1, h, rc, phase, s, mdl, work, dy, ytmp, ctl, out_y, out
 def _write_sample(i, ti, ys, phase, s, mdl, work, dy, out_y, out_aux):
     n = (ys.shape[0] - 4) // 2
     nf, f, wc, wcd, _ = evaluate(ti, ys, phase, s, False, mdl, work, dy)
+    om, _ = speed_at(ti, mdl[M_KNOTS], mdl[M_COEF], False)
     if phase == STICK:
-        om, _ = speed_at(ti, mdl[M_KNOTS], mdl[M_COEF], False)
         ys[2 * n + 2] = om
     if phase != SEPARATION:
         ys[n + 1] = wc
@@ -276,6 +276,7 @@ def _write_sample(i, ti, ys, phase, s, mdl, work, dy, out_y, out_aux):
     out_aux[i, 1] = f
     out_aux[i, 2] = phase
     out_aux[i, 3] = wc
+    out_aux[i, 4] = om
 
 
 @njit(cache=True)

@@ -29,7 +29,6 @@ __all__ = [
     "RunFailed",
     "SweepError",
     "evaluate",
-    "fill_values",
     "resolve",
     "stop_events",
 ]
@@ -331,8 +330,3 @@ def evaluate(case: Case, keep: Sequence[str]) -> dict[str, bool | float]:
         if not result.ok:
             raise RunFailed(f"simulation {result.status}: {result.message}")
     return {r.name: r(result, case) for r in reductions}
-
-
-def fill_values(reductions: Sequence[Reduction]) -> dict[str, bool | float]:
-    """Stored name -> value kept for a point that failed."""
-    return {r.name: r.fill for r in reductions}

@@ -16,6 +16,7 @@ from collections import deque
 from collections.abc import Iterable
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor
 from concurrent.futures import wait as wait_local
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from multiprocessing import get_context
 from os import PathLike
@@ -24,7 +25,7 @@ from typing import Any
 
 from fivdisc.case import Case
 from fivdisc.errors import FivdiscError
-from fivdisc.sweep.reductions import SweepError, evaluate, fill_values, resolve
+from fivdisc.sweep.reductions import SweepError, evaluate
 from fivdisc.sweep.spec import Sweep
 from fivdisc.sweep.store import PointOutcome, SweepStore
 
@@ -74,13 +75,12 @@ def warm_kernel() -> None:
 
 def run_point(index: int, case: Case, keep: tuple[str, ...]) -> PointOutcome:
     """Compute one point; a failure is returned as the outcome's error, not raised."""
-    reductions = resolve(keep)
     try:
         return PointOutcome(index, evaluate(case, keep))
     except FivdiscError as exc:
-        return PointOutcome(index, fill_values(reductions), str(exc))
+        return PointOutcome(index, None, str(exc))
     except Exception as exc:  # a user reduction or the solver may raise anything
-        return PointOutcome(index, fill_values(reductions), f"{type(exc).__name__}: {exc}")
+        return PointOutcome(index, None, f"{type(exc).__name__}: {exc}")
 
 
 # --- executors -------------------------------------------------------------------------------
@@ -120,15 +120,17 @@ class _LocalPool:
     def wait(self, futures: Iterable[Any]) -> set[Any]:
         return wait_local(futures, return_when=FIRST_COMPLETED).done
 
-    def outcome(self, future: Any, index: int, keep: tuple[str, ...]) -> PointOutcome:
+    def outcome(self, future: Any, index: int) -> PointOutcome:
         exc = future.exception()
         if exc is None:
             return future.result()
-        # A worker process died (BrokenProcessPool): the pool is unusable.
-        raise FivdiscError(
-            f"a worker process died while computing point {index} ({exc}); "
-            "rerun the same command to resume"
-        )
+        if isinstance(exc, BrokenProcessPool):
+            raise FivdiscError(
+                f"a worker process died while computing point {index} ({exc}); "
+                "rerun the same command to resume"
+            )
+        # run_point catches everything, so this is e.g. a result that failed to pickle
+        return PointOutcome(index, None, f"{type(exc).__name__}: {exc}")
 
     def close(self) -> None:
         self._pool.shutdown(wait=True)
@@ -182,13 +184,13 @@ class _DaskPool:
 
         return set(wait(list(futures), return_when="FIRST_COMPLETED").done)
 
-    def outcome(self, future: Any, index: int, keep: tuple[str, ...]) -> PointOutcome:
+    def outcome(self, future: Any, index: int) -> PointOutcome:
         if future.status == "finished":
             return future.result()
-        # The task itself never raises (run_point catches), so this is the cluster's
-        # failure, e.g. a worker killed repeatedly while running it: record the point.
+        # run_point catches everything, so this is the cluster's failure, e.g. a worker
+        # killed repeatedly while running the point: record it as the point's error.
         exc = future.exception()
-        return PointOutcome(index, fill_values(resolve(keep)), f"{type(exc).__name__}: {exc}")
+        return PointOutcome(index, None, f"{type(exc).__name__}: {exc}")
 
     def close(self) -> None:
         self._client.close()
@@ -302,7 +304,7 @@ def _drive(
                 index = todo.popleft()
                 running[pool.submit(index, sweep.cases[index], keep)] = index
             finished = pool.wait(running)
-            outcomes = [pool.outcome(f, running.pop(f), keep) for f in finished]
+            outcomes = [pool.outcome(f, running.pop(f)) for f in finished]
             target.write(outcomes)
             failed.update((o.index, o.error) for o in outcomes if o.error)
             bar.set_postfix(failed=len(failed), refresh=False)

@@ -52,13 +52,13 @@ class PointOutcome:
     index
         The point's index.
     values
-        Stored name -> value of every kept reduction (fill values if it failed).
+        Stored name -> value of every kept reduction; None if the point failed.
     error
         "" for success, else why the point failed.
     """
 
     index: int
-    values: dict[str, bool | float]
+    values: dict[str, bool | float] | None
     error: str = ""
 
 
@@ -266,7 +266,13 @@ class SweepStore:
                 runs.append([outcome])
         for run in runs:
             data = {
-                r.name: (DIM, np.array([o.values[r.name] for o in run], dtype=r.dtype))
+                r.name: (
+                    DIM,
+                    np.array(
+                        [r.fill if o.values is None else o.values[r.name] for o in run],
+                        dtype=r.dtype,
+                    ),
+                )
                 for r in self.sweep.reductions
             }
             data["error"] = (DIM, np.array([o.error for o in run], dtype=_STRING))
