@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from fivdisc.case import unit_of
 from fivdisc.sweep.reductions import SweepError
 from fivdisc.sweep.spec import Sweep, strides_of
 
@@ -85,15 +86,6 @@ def _coordinate(values: Sequence[Any]) -> np.ndarray:
     return np.array([json.dumps(v) for v in values], dtype=_STRING)
 
 
-def _units(sweep: Sweep, key: str) -> str:
-    """Unit of a case key, from the case model's field (the first point's speed profile)."""
-    table, _, name = key.rpartition(".")
-    model = sweep.cases[0].get(table) if table else sweep.cases[0]
-    info = type(model).model_fields.get(name)
-    extra = info.json_schema_extra if info is not None else None
-    return str(extra.get("unit", "")) if isinstance(extra, dict) else ""
-
-
 def _template(sweep: Sweep) -> xr.Dataset:
     """The empty store: coordinates filled, data variables lazy (only metadata is written)."""
     import dask.array as da
@@ -121,7 +113,7 @@ def _template(sweep: Sweep) -> xr.Dataset:
     coords = {DIM: (DIM, np.arange(n), {"long_name": "sweep point (C order over the axes)"})}
     for key in sweep.axes:
         attrs = {"long_name": f"case key {key}"}
-        if unit := _units(sweep, key):
+        if unit := unit_of(key):
             attrs["units"] = unit
         coords[key] = (DIM, _coordinate([u[key] for u in updates]), attrs)
     attrs = {
