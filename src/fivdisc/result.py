@@ -83,10 +83,11 @@ def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarr
     }
     coords = {
         "time": _var("time", times, "s", "time"),
-        "coordinate": ("coordinate", list(model.labels), {"long_name": "modal coordinate"}),
+        "coordinate": ("coordinate", list(model.labels),
+                       {"units": "1", "long_name": "modal coordinate (C/D, k, l)"}),
         "k": _var("coordinate", model.k, "1", "nodal circles"),
         "l": _var("coordinate", model.l, "1", "nodal diameters"),
-        "probe": ("probe", np.arange(len(probes)), {"long_name": "probe index"}),
+        "probe": ("probe", np.arange(len(probes)), {"units": "1", "long_name": "probe index"}),
         "probe_r": _var("probe", probes[:, 0], "m", "probe radius"),
         "probe_theta": _var("probe", probes[:, 1], "rad", "probe angle (space-fixed)"),
     }
