@@ -239,12 +239,7 @@ def plot_phase_portrait(data: xr.Dataset | object, window: Window = None,
     ax : matplotlib Axes, optional
         Where to draw.
     """
-    ds = phase_portrait(data, *_bounds(window))
-    fig, ax = _axes(ax)
-    ax.plot(ds["phi"].values, ds["phi_dot"].values, lw=0.8)
-    ax.set_xlabel(_label(ds["phi"], "phi"))
-    ax.set_ylabel(_label(ds["phi_dot"], "phi_dot"))
-    return fig
+    return _trajectory(phase_portrait(data, *_bounds(window)), "phi", "phi_dot", ax)
 
 
 def plot_friction(data: xr.Dataset | object, window: Window = None,
@@ -261,10 +256,15 @@ def plot_friction(data: xr.Dataset | object, window: Window = None,
         Where to draw.
     """
     ds = friction_trajectory(data, *_bounds(window))
+    return _trajectory(ds, "relative_velocity", "friction_force", ax)
+
+
+def _trajectory(ds: xr.Dataset, x: str, y: str, ax: Axes | None) -> Figure:
+    """One variable of ``ds`` against another, labelled with names and units."""
     fig, ax = _axes(ax)
-    ax.plot(ds["relative_velocity"].values, ds["friction_force"].values, lw=0.8)
-    ax.set_xlabel(_label(ds["relative_velocity"], "relative_velocity"))
-    ax.set_ylabel(_label(ds["friction_force"], "friction_force"))
+    ax.plot(ds[x].values, ds[y].values, lw=0.8)
+    ax.set_xlabel(_label(ds[x], x))
+    ax.set_ylabel(_label(ds[y], y))
     return fig
 
 
