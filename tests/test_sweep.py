@@ -39,19 +39,21 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 # A user reduction, importable by the workers through PYTHONPATH / sys.path.
 HELPER = '''
+import time
 import tomllib
 
 
 def fragile(result):
     """Number of switches; fails on purpose for the fastest disc."""
+    time.sleep(0.3)  # slow enough to interrupt a sweep between points, however fast the solver
     case = tomllib.loads(result.dataset.attrs["case"])
     if case["speed"]["initial"] >= 20.0:
         raise ValueError("too fast for this test")
     return result.summary()["switches"]
 '''
 
-# 12 points of about 0.1-0.3 s each; the user reduction needs whole runs and fails
-# for the 3 points with initial = 20.
+# 12 points of about 0.4 s each; the user reduction needs whole runs and fails for
+# the 3 points with initial = 20.
 SWEEP = """
 mode = "grid"
 [base.speed]
@@ -499,7 +501,7 @@ def test_interrupted_and_killed_sweeps_resume(reference, sweep_file, tmp_path) -
     # SIGKILL to the coordinator only: its workers notice and exit by themselves
     process = _start(sweep_file, store)
     try:
-        _wait_for_points(process, store, interrupted + 2)
+        _wait_for_points(process, store, interrupted + 1)
         process.kill()
         process.communicate(timeout=60)
         deadline = time.monotonic() + 10.0
@@ -510,7 +512,7 @@ def test_interrupted_and_killed_sweeps_resume(reference, sweep_file, tmp_path) -
         with contextlib.suppress(ProcessLookupError):
             os.killpg(process.pid, signal.SIGKILL)
     killed = int(read_mask(store).sum())
-    assert interrupted + 2 <= killed < 12
+    assert interrupted < killed < 12
 
     command = [
         sys.executable,

@@ -33,12 +33,14 @@ def cli() -> None:
 
 
 def _register() -> None:
-    from fivdisc.cli import modes, plot, simulate, stability
+    from fivdisc.cli import modes, plot, simulate, stability, sweep
 
     cli.add_command(modes.modes)
     cli.add_command(simulate.simulate)
     cli.add_command(plot.plot)
     cli.add_command(stability.stability)
+    cli.add_command(sweep.sweep)
+    cli.add_command(sweep.separation_map)
 
 
 _register()

@@ -29,6 +29,7 @@ __all__ = [
     "RunFailed",
     "SweepError",
     "evaluate",
+    "nearest",
     "resolve",
     "stop_events",
 ]

@@ -173,12 +173,13 @@ def plot_separation_map(
     if separated.any() and len(xs) > 1 and len(ys) > 1:
         ax.contourf(X, Y, separated.astype(float), levels=[0.5, 1.5], colors=["0.85"])
         ax.contour(X, Y, separated.astype(float), levels=[0.5], colors=["0.3"], linewidths=1.0)
-    marker = max(2.0, 60.0 / max(len(xs), len(ys)))
+    marker = float(np.clip(60.0 / max(len(xs), len(ys)), 2.0, 7.0))
     ax.plot(X[separated], Y[separated], "o", color="k", ms=marker, label="separation")
     ax.plot(X[clear], Y[clear], "o", mfc="none", color="0.4", ms=marker, label="no separation")
     if failed.any():
         ax.plot(X[failed], Y[failed], "x", color="tab:red", ms=marker, label="run failed")
     if separated.any():
+        # under the markers, so that it hides none
         ax.text(
             X[separated].mean(),
             Y[separated].mean(),
@@ -187,7 +188,8 @@ def plot_separation_map(
             va="center",
             fontsize=14,
             fontweight="bold",
-            bbox={"fc": "white", "ec": "none", "alpha": 0.7},
+            color="0.45",
+            zorder=1,
         )
     ax.set_xlabel(_LABELS.get((profile, x_key), f"{x_key} [{grid[x_key].attrs.get('units')}]"))
     ax.set_ylabel(_LABELS.get((profile, y_key), f"{y_key} [{grid[y_key].attrs.get('units')}]"))
@@ -196,7 +198,8 @@ def plot_separation_map(
         pad = 0.5 * (values.max() - values.min()) / max(len(values) - 1, 1) or 0.5
         set_lim(values.min() - pad, values.max() + pad)
     ax.set_title(f"separation region (SR), {profile} disc", fontsize="medium")
-    ax.legend(loc="upper left", fontsize="small", framealpha=0.9)
+    # Outside the axes, so that it hides no point.
+    fig.legend(loc="outside upper center", ncol=3, fontsize="small", frameon=False)
     if path is not None:
         fig.savefig(Path(path), dpi=150)
     return fig
