@@ -163,6 +163,9 @@ def simulate(
     ev_times: list[np.ndarray] = []
     ev_rows: list[np.ndarray] = []
 
+    # A first call with target 0 only sets up the start: it compiles or loads the kernel
+    # before the progress bar starts, so the bar's rate and estimate are the integrator's.
+    kern.run(0.0, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_t, ev_i)
     bar = None
     if progress:
         from tqdm import tqdm
