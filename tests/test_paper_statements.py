@@ -1,7 +1,9 @@
 """The paper's statements about its figures (sections 3.1-3.2), checked on fivdisc.
 
 Each test names the figure and the paper's words; numbers are the paper's. Where
-fivdisc's picture differs in detail, the comment gives what fivdisc measures.
+fivdisc's picture differs in detail, the comment gives what fivdisc measures. The
+stability classes of Figs. 4, 6, 8 and 13 and the figure-by-figure comparisons of the
+reproduction are in test_paper.py.
 """
 
 from __future__ import annotations

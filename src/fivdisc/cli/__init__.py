@@ -33,7 +33,7 @@ def cli() -> None:
 
 
 def _register() -> None:
-    from fivdisc.cli import modes, plot, simulate, stability, sweep
+    from fivdisc.cli import modes, plot, reproduce, simulate, stability, sweep
 
     cli.add_command(modes.modes)
     cli.add_command(simulate.simulate)
@@ -41,6 +41,7 @@ def _register() -> None:
     cli.add_command(stability.stability)
     cli.add_command(sweep.sweep)
     cli.add_command(sweep.separation_map)
+    cli.add_command(reproduce.reproduce)
 
 
 _register()

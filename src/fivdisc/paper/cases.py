@@ -32,7 +32,10 @@ from __future__ import annotations
 
 import json
 import math
+import textwrap
 from dataclasses import dataclass
+from os import PathLike
+from pathlib import Path
 
 import numpy as np
 
@@ -43,6 +46,7 @@ __all__ = [
     "FIGURES",
     "PaperCase",
     "cases",
+    "write_examples",
 ]
 
 CITATION = (
@@ -144,17 +148,16 @@ class PaperCase:
         label
             "" for a one-case figure, "a" or "b" for a two-case one.
         """
-        head = [f"# Fig. {self.figure}{label} of the paper: {self.title}.",
-                f"# Caption: {self.caption}"]
+        text = [f"Fig. {self.figure}{label} of the paper: {self.title}.",
+                f"Caption: {self.caption}."]
         if self.start_from is not None:
-            head.append(
-                f"# Starts from the perturbed sliding equilibrium of Fig. {self.start_from} "
-                "(fivdisc.paper.reproduce passes it as the initial state); alone, this file "
-                "starts at rest."
-            )
-        head.append("# Written by fivdisc.paper.cases; the same case as "
-                    f"fivdisc.paper.cases.FIG{self.figure}.")
-        return "\n".join(head) + "\n\n" + self.runs[label].to_toml()
+            text.append(f"Starts from the perturbed sliding equilibrium of Fig. "
+                        f"{self.start_from}, which fivdisc.paper passes as the initial state; "
+                        "alone, this file starts at rest.")
+        text.append(f"Written by fivdisc.paper.cases.write_examples from FIG{self.figure}; "
+                    "edit the code, not this file.")
+        lines = [f"# {line}" for part in text for line in textwrap.wrap(part, 88)]
+        return "\n".join(lines) + "\n\n" + self.runs[label].to_toml()
 
 
 def _case(c_z: float, c_phi: float, alpha: float, speed: dict, duration: float,
@@ -659,3 +662,25 @@ def cases() -> dict[str, Case]:
         for label, name in pc.file_names().items()
     }
 
+
+
+def write_examples(directory: str | PathLike[str]) -> list[Path]:
+    """Write every case as a TOML file (``fig08.toml``, ``fig18a.toml``, ...).
+
+    Parameters
+    ----------
+    directory
+        Where to write (the repository's ``examples``).
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
+    written = []
+    for pc in FIGURES.values():
+        for label, name in pc.file_names().items():
+            path = Path(directory) / name
+            path.write_text(pc.toml(label), encoding="utf-8")
+            written.append(path)
+    return written
