@@ -106,6 +106,11 @@ def main() -> None:
             f"({n * n / wall:.2f} points/s), {separated} of {n * n} points separate; "
             f"coordinator CPU {1e3 * cpu / (n * n):.1f} ms per point"
         )
+        # The sub-map samples the same ranges, so its serial rate is the per-point speed
+        # of single runs over this map.
+        per_worker = n * n / wall / args.workers
+        print(f"  per worker {per_worker:.2f} points/s = "
+              f"{per_worker * serial / spec.n_points:.2f} x the serial rate")
         if args.figure:
             plot_separation_map(store, args.figure)
             print(f"wrote {args.figure}")
