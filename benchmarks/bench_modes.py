@@ -17,17 +17,14 @@ import time
 import numpy as np
 from scipy import integrate, optimize, special
 
+from fivdisc.case import Case
 from fivdisc.plate import AnnularPlate, clear_cache
 
-TABLE1 = {
-    "inner_radius": 0.044,
-    "outer_radius": 0.12,
-    "thickness": 0.002,
-    "density": 7200.0,
-    "youngs_modulus": 150e9,
-    "poisson_ratio": 0.211,
-}
-R0 = 0.1  # slider track radius [m] (Table 1)
+# The paper's Table 1 plate and track radius, from the case defaults.
+_DEFAULT = Case()
+TABLE1 = {key: getattr(_DEFAULT.disc, key) for key in (
+    "inner_radius", "outer_radius", "thickness", "density", "youngs_modulus", "poisson_ratio")}
+R0 = _DEFAULT.slider.track_radius  # [m]
 PAIRS = [(k, n) for n in range(10) for k in range(4)]
 REPEATS = 7
 BASELINE_REPEATS = 3

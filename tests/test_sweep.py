@@ -457,20 +457,16 @@ def _session(sid: int) -> list[int]:
     return pids
 
 
+def _command(sweep_file: Path, store: Path, *extra: str) -> list[str]:
+    """`fivdisc sweep` in a fresh interpreter, without the progress bar."""
+    return [sys.executable, "-c", "from fivdisc.cli.sweep import sweep; sweep()",
+            str(sweep_file), "-o", str(store), *extra, "--no-progress"]
+
+
 def _start(sweep_file: Path, store: Path) -> subprocess.Popen:
-    command = [
-        sys.executable,
-        "-c",
-        "from fivdisc.cli.sweep import sweep; sweep()",
-        str(sweep_file),
-        "-o",
-        str(store),
-        "--workers",
-        "1",
-        "--no-progress",
-    ]
     return subprocess.Popen(
-        command, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        _command(sweep_file, store, "--workers", "1"), start_new_session=True,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
 
 
@@ -514,16 +510,8 @@ def test_interrupted_and_killed_sweeps_resume(reference, sweep_file, tmp_path) -
     killed = int(read_mask(store).sum())
     assert interrupted < killed < 12
 
-    command = [
-        sys.executable,
-        "-c",
-        "from fivdisc.cli.sweep import sweep; sweep()",
-        str(sweep_file),
-        "-o",
-        str(store),
-        "--no-progress",
-    ]
-    finished = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    finished = subprocess.run(_command(sweep_file, store), capture_output=True, text=True,
+                              timeout=300)
     assert finished.returncode == 0, finished.stderr
     assert f"12 points: {killed} already stored, {12 - killed} computed" in finished.stdout
     xr.testing.assert_identical(open_sweep(store), open_sweep(reference))
