@@ -1,9 +1,10 @@
 """Case files: everything one simulation needs, as validated, immutable data.
 
 A case is a tree of frozen pydantic models that mirrors the TOML file section by
-section (``[disc]``, ``[slider]``, ``[friction]``, ``[speed]``, ``[simulation]``
-and ``[simulation.perturbation]``). Every key has a default (the paper's Table 1,
-a disc spinning at a constant 2 pi rad/s), so an empty file is a valid case.
+section (``[disc]``, ``[slider]`` or ``[[sliders]]``, ``[friction]``, ``[speed]``,
+``[simulation]`` and ``[simulation.perturbation]``). Every key has a default (the
+paper's Table 1: one slider, a disc spinning at a constant 2 pi rad/s), so an empty
+file is a valid case.
 
 Every invalid input raises :class:`fivdisc.errors.CaseError` with a one-line
 message that names the dotted key, the value given and the allowed range.
@@ -21,7 +22,7 @@ import tomllib
 from collections.abc import Iterator, Mapping
 from os import PathLike
 from pathlib import Path
-from typing import Annotated, Any, ClassVar, Literal
+from typing import Annotated, Any, ClassVar, Literal, Union
 
 import annotated_types
 import numpy as np
@@ -33,6 +34,7 @@ from pydantic import (
     ConfigDict,
     Discriminator,
     Field,
+    PlainValidator,
     Strict,
     Tag,
     ValidationError,
@@ -49,11 +51,14 @@ __all__ = [
     "ConstantSpeed",
     "DeceleratingSpeed",
     "Disc",
+    "ExponentialFriction",
     "Friction",
     "Perturbation",
     "Simulation",
     "Slider",
     "Speed",
+    "StribeckFriction",
+    "TableFriction",
     "TableSpeed",
     "load_case",
     "unit_of",
@@ -117,7 +122,8 @@ Flag = Annotated[bool, Strict(), BeforeValidator(_plain)]
 ModeIndex = Annotated[int, Strict(), Field(ge=0), BeforeValidator(_plain)]
 Mode = Annotated[tuple[ModeIndex, ModeIndex], _pair("k, l")]
 Probe = Annotated[tuple[Real, Real], _pair("r, theta")]
-SpeedValues = Annotated[tuple[Annotated[Real, Field(ge=0)], ...], BeforeValidator(_plain)]
+NonNegative = Annotated[Real, Field(ge=0)]
+SpeedValues = Annotated[tuple[NonNegative, ...], BeforeValidator(_plain)]
 
 
 def _field(default: Any, unit: str = "", **constraints: Any) -> Any:
@@ -135,15 +141,34 @@ def _distinct_modes(modes: tuple[tuple[int, int], ...]) -> tuple[tuple[int, int]
     return modes
 
 
-def _increasing_from_zero(times: tuple[float, ...]) -> tuple[float, ...]:
-    """Reject a time grid that does not start at 0 or does not strictly increase."""
-    # An empty grid is left to the field's min_length check.
-    if times and times[0] != 0.0:
-        raise _rule("must start at 0 [s]")
-    for earlier, later in itertools.pairwise(times):
-        if later <= earlier:
-            raise _rule(f"must strictly increase [s]; {later!r} follows {earlier!r}")
-    return times
+def _damping_ratios(value: Any) -> float | tuple[float, ...]:
+    """One damping ratio >= 0, or an array of them."""
+    value = _plain(value)
+    items = value if isinstance(value, list | tuple) else [value]
+    for i, item in enumerate(items):
+        where = f"entry {i} " if isinstance(value, list | tuple) else ""
+        if isinstance(item, bool) or not isinstance(item, int | float):
+            raise _rule(f"{where}must be a number >= 0, or an array of them")
+        if not (math.isfinite(item) and item >= 0):
+            raise _rule(f"{where}must be a finite number >= 0")
+    if isinstance(value, list | tuple):
+        return tuple(float(v) for v in value)
+    return float(value)
+
+
+def _increasing_from_zero(unit: str) -> AfterValidator:
+    """Reject a grid that does not start at 0 or does not strictly increase."""
+
+    def check(points: tuple[float, ...]) -> tuple[float, ...]:
+        # An empty grid is left to the field's min_length check.
+        if points and points[0] != 0.0:
+            raise _rule(f"must start at 0 [{unit}]")
+        for earlier, later in itertools.pairwise(points):
+            if later <= earlier:
+                raise _rule(f"must strictly increase [{unit}]; {later!r} follows {earlier!r}")
+        return points
+
+    return AfterValidator(check)
 
 
 # --- the tables ------------------------------------------------------------------------------
@@ -161,7 +186,7 @@ class _Table(BaseModel):
         try:
             super().__init__(**data)
         except ValidationError as exc:
-            raise CaseError(_describe(exc, type(self))) from None
+            raise CaseError(_describe(exc, type(self), data)) from None
 
     # Marks this __init__ as pydantic's own, as pydantic's RootModel does: otherwise
     # pydantic calls it while validating a parent table, and the CaseError raised
@@ -190,6 +215,12 @@ class Disc(_Table):
         (k, l) = (nodal circles, nodal diameters) of the modes kept; each l >= 1
         stands for a doublet (cos and sin). Distinct; empty means a rigid disc
         (N = N0), the classic 1-DOF oscillator on a moving belt.
+    damping_ratio
+        zeta, modal damping ratio [-], >= 0: one number for every mode, or one per
+        entry of `modes` (the two coordinates of a doublet share it).
+    damping_frame
+        "material": the damping acts on the velocity of the disc's material,
+        w_t + Omega w_theta (rotating-frame damping, the default); "space": on w_t.
     """
 
     _key: ClassVar[tuple[str, ...]] = ("disc",)
@@ -203,6 +234,8 @@ class Disc(_Table):
     modes: Annotated[tuple[Mode, ...], AfterValidator(_distinct_modes)] = _field(
         ((0, 0), (0, 1), (0, 2), (0, 3))
     )
+    damping_ratio: Annotated[float | tuple[float, ...], PlainValidator(_damping_ratios)] = 0.0
+    damping_frame: Literal["material", "space"] = "material"
 
     @model_validator(mode="after")
     def _check_annulus(self) -> Disc:
@@ -212,28 +245,46 @@ class Disc(_Table):
                 "outer_radius",
                 self.outer_radius,
             )
+        if isinstance(self.damping_ratio, tuple) and len(self.damping_ratio) != len(self.modes):
+            raise _rule(
+                f"must be one number, or one per entry of disc.modes ({len(self.modes)})",
+                "damping_ratio",
+                self.damping_ratio,
+            )
         return self
+
+    def mode_damping(self) -> tuple[float, ...]:
+        """Damping ratio of each entry of `modes` [-]."""
+        if isinstance(self.damping_ratio, tuple):
+            return self.damping_ratio
+        return (self.damping_ratio,) * len(self.modes)
 
 
 class Slider(_Table):
-    """The slider: a mass on a transverse spring-damper and an in-plane one.
+    """A slider: a mass on a transverse spring-damper and an in-plane one.
 
     Attributes
     ----------
     track_radius
-        r0, radius of the slider's track [m]; strictly between the disc's radii.
+        r_j, radius of the slider's track [m]; strictly between the disc's radii.
     mass
-        m [kg]; its moment of inertia about the disc axis is m r0^2.
+        m_j [kg]; its moment of inertia about the disc axis is m_j r_j^2.
     normal_stiffness
         k_z [N/m].
     normal_damping
         c_z [N s/m].
     rotational_stiffness
-        r0^2 k_phi [N m/rad].
+        r_j^2 k_phi [N m/rad].
     rotational_damping
-        r0^2 c_phi [N m s/rad].
+        r_j^2 c_phi [N m s/rad].
     preload
-        N0, normal preload [N].
+        N0, normal preload [N], pressing the slider onto its face.
+    angle
+        theta_j, space-fixed angle of the slider's base [rad]; the slider sits at
+        theta_j + phi_j.
+    face
+        "top" (the paper's side, on +w, pressed towards -w) or "bottom" (on -w,
+        pressed towards +w).
     """
 
     _key: ClassVar[tuple[str, ...]] = ("slider",)
@@ -245,34 +296,29 @@ class Slider(_Table):
     rotational_stiffness: Real = _field(2e3, "N m/rad", gt=0)
     rotational_damping: Real = _field(0.1, "N m s/rad", ge=0)
     preload: Real = _field(500.0, "N", ge=0)
+    angle: Real = _field(0.0, "rad")
+    face: Literal["top", "bottom"] = "top"
+
+    @property
+    def sigma(self) -> float:
+        """+1 on the top face, -1 on the bottom face."""
+        return 1.0 if self.face == "top" else -1.0
 
 
-class Friction(_Table):
-    """Friction law ``mu(v) = mu_1 + (mu_0 - mu_1) exp(-alpha |r0 v|)`` and static limit.
-
-    Attributes
-    ----------
-    static
-        mu_s, static coefficient; not below mu_0 nor mu_1.
-    kinetic_max
-        mu_0, kinetic coefficient at zero relative speed.
-    kinetic_min
-        mu_1, kinetic coefficient at high relative speed.
-    decay
-        alpha, decay rate of the kinetic coefficient with sliding speed [s/m].
-    """
+class _FrictionLaw(_Table):
+    """Common part of the friction laws: the static limit."""
 
     _key: ClassVar[tuple[str, ...]] = ("friction",)
 
     static: Real = _field(0.8, ge=0)
-    kinetic_max: Real = _field(0.6, ge=0)
-    kinetic_min: Real = _field(0.35, ge=0)
-    decay: Real = _field(1.0, "s/m", ge=0)
+
+    def kinetic_at_rest(self) -> tuple[tuple[str, float], ...]:
+        """(key, value) pairs that the static coefficient may not be below."""
+        raise NotImplementedError
 
     @model_validator(mode="after")
-    def _check_static_limit(self) -> Friction:
-        for name in ("kinetic_max", "kinetic_min"):
-            kinetic = getattr(self, name)
+    def _check_static_limit(self) -> _FrictionLaw:
+        for name, kinetic in self.kinetic_at_rest():
             if self.static < kinetic:
                 raise _rule(
                     f"must be >= friction.{name} = {kinetic!r} "
@@ -281,6 +327,105 @@ class Friction(_Table):
                     self.static,
                 )
         return self
+
+
+class ExponentialFriction(_FrictionLaw):
+    """The paper's law ``mu(u) = mu_1 + (mu_0 - mu_1) exp(-alpha u)``, u = r |Omega - phidot|.
+
+    Attributes
+    ----------
+    law
+        "exponential".
+    static
+        mu_s, static coefficient; not below mu_0 nor mu_1.
+    kinetic_max
+        mu_0, kinetic coefficient at zero sliding speed.
+    kinetic_min
+        mu_1, kinetic coefficient at high sliding speed.
+    decay
+        alpha, decay rate of the kinetic coefficient with sliding speed [s/m].
+    """
+
+    law: Literal["exponential"] = "exponential"
+    kinetic_max: Real = _field(0.6, ge=0)
+    kinetic_min: Real = _field(0.35, ge=0)
+    decay: Real = _field(1.0, "s/m", ge=0)
+
+    def kinetic_at_rest(self) -> tuple[tuple[str, float], ...]:
+        return (("kinetic_max", self.kinetic_max), ("kinetic_min", self.kinetic_min))
+
+
+class StribeckFriction(_FrictionLaw):
+    """Stribeck law ``mu(u) = mu_1 + (mu_0 - mu_1) exp(-(u / v_s)^delta) + mu_v u``.
+
+    Attributes
+    ----------
+    law
+        "stribeck".
+    static
+        mu_s, static coefficient; not below mu_0 nor mu_1.
+    kinetic_max
+        mu_0, kinetic coefficient at zero sliding speed.
+    kinetic_min
+        mu_1, the Coulomb level at high sliding speed (before the viscous part).
+    stribeck_velocity
+        v_s, Stribeck velocity [m/s], > 0.
+    stribeck_exponent
+        delta, shape exponent, > 0 (1: the exponential law with alpha = 1 / v_s).
+    viscous
+        mu_v, viscous friction coefficient [s/m], >= 0.
+    """
+
+    law: Literal["stribeck"] = "stribeck"
+    kinetic_max: Real = _field(0.6, ge=0)
+    kinetic_min: Real = _field(0.35, ge=0)
+    stribeck_velocity: Real = _field(1.0, "m/s", gt=0)
+    stribeck_exponent: Real = _field(2.0, gt=0)
+    viscous: Real = _field(0.0, "s/m", ge=0)
+
+    def kinetic_at_rest(self) -> tuple[tuple[str, float], ...]:
+        return (("kinetic_max", self.kinetic_max), ("kinetic_min", self.kinetic_min))
+
+
+class TableFriction(_FrictionLaw):
+    """Measured friction curve: PCHIP through (sliding speed, mu), constant beyond the last.
+
+    Attributes
+    ----------
+    law
+        "table".
+    static
+        mu_s, static coefficient; not below the first tabulated value.
+    speeds
+        Sliding speeds u [m/s]: start at 0, strictly increase, at least two.
+    values
+        Kinetic coefficients at `speeds`, each >= 0; as many as `speeds`.
+    """
+
+    law: Literal["table"] = "table"
+    speeds: Annotated[tuple[Real, ...], _increasing_from_zero("m/s")] = _field(
+        (0.0, 1.0), "m/s", min_length=2
+    )
+    values: Annotated[tuple[NonNegative, ...], BeforeValidator(_plain)] = _field(
+        (0.6, 0.35), min_length=2
+    )
+
+    @model_validator(mode="after")
+    def _check_lengths(self) -> TableFriction:
+        if len(self.values) != len(self.speeds):
+            raise _rule(
+                f"must have as many entries as friction.speeds ({len(self.speeds)})",
+                "values",
+                self.values,
+            )
+        return self
+
+    def kinetic_at_rest(self) -> tuple[tuple[str, float], ...]:
+        return (("values[0]", self.values[0]),)
+
+
+Friction = ExponentialFriction
+"""The default friction law, the paper's (:class:`ExponentialFriction`)."""
 
 
 class ConstantSpeed(_Table):
@@ -360,7 +505,7 @@ class TableSpeed(_Table):
     _key: ClassVar[tuple[str, ...]] = ("speed",)
 
     profile: Literal["table"] = "table"
-    times: Annotated[tuple[Real, ...], AfterValidator(_increasing_from_zero)] = _field(
+    times: Annotated[tuple[Real, ...], _increasing_from_zero("s")] = _field(
         (0.0, 1.0), "s", min_length=2
     )
     values: SpeedValues = _field((_TWO_PI, _TWO_PI), "rad/s", min_length=2)
@@ -382,27 +527,56 @@ _SPEEDS: dict[str, type[_Table]] = {
     "accelerating": AcceleratingSpeed,
     "table": TableSpeed,
 }
+_LAWS: dict[str, type[_Table]] = {
+    "exponential": ExponentialFriction,
+    "stribeck": StribeckFriction,
+    "table": TableFriction,
+}
 
 
-def _speed_profile(data: Any) -> Any:
-    """The tag that selects the speed model; a table without `profile` is constant."""
-    if isinstance(data, Mapping):
-        return data.get("profile", "constant")
-    return getattr(data, "profile", None)
+class _Union:
+    """A table that is one of several models, told apart by a tag key."""
+
+    def __init__(self, table: str, tag: str, models: dict[str, type[_Table]], what: str) -> None:
+        self.table = table
+        self.tag = tag
+        self.models = models
+        self.default = next(iter(models))
+        self.what = what
+
+    def tag_of(self, data: Any) -> Any:
+        """The tag that selects the model; a table without the tag key takes the default."""
+        if isinstance(data, Mapping):
+            return data.get(self.tag, self.default)
+        return getattr(data, self.tag, None)
+
+    def annotation(self) -> Any:
+        members = tuple(Annotated[model, Tag(name)] for name, model in self.models.items())
+        return Annotated[
+            Union[members],  # noqa: UP007 - a runtime union of a tuple of members
+            Discriminator(self.tag_of, custom_error_type="union_tag",
+                          custom_error_message=f"unknown {self.what}"),
+        ]
+
+    def keys(self) -> list[str]:
+        """Every key of every member, in order of first appearance."""
+        return list(dict.fromkeys(n for m in self.models.values() for n in m.model_fields))
+
+    def owner(self, name: str) -> list[str]:
+        """Tags of the members that have key `name`."""
+        return [tag for tag, model in self.models.items() if name in model.model_fields]
 
 
-Speed = Annotated[
-    Annotated[ConstantSpeed, Tag("constant")]
-    | Annotated[DeceleratingSpeed, Tag("decelerating")]
-    | Annotated[AcceleratingSpeed, Tag("accelerating")]
-    | Annotated[TableSpeed, Tag("table")],
-    Discriminator(
-        _speed_profile,
-        custom_error_type="speed_profile",
-        custom_error_message="unknown speed profile",
-    ),
-]
+_UNIONS: dict[str, _Union] = {
+    "speed": _Union("speed", "profile", _SPEEDS, "speed profile"),
+    "friction": _Union("friction", "law", _LAWS, "friction law"),
+}
+
+Speed = _UNIONS["speed"].annotation()
 """Any of the four disc-speed profiles, told apart by their `profile` key."""
+
+FrictionLaw = _UNIONS["friction"].annotation()
+"""Any of the friction laws, told apart by their `law` key."""
 
 
 class Perturbation(_Table):
@@ -453,8 +627,16 @@ class Simulation(_Table):
         Largest integrator step [s]; 0 means no limit.
     max_switches
         Phase switches (slip, stick, separation) after which the run stops, >= 1.
+    min_flight_time
+        Shortest flight of a slider that is resolved [s], > 0: a landing impact that
+        would release another slider for less than this keeps it in contact (it ends
+        the ever shorter flights of an impact cascade between several sliders).
+    energy_balance
+        Integrate the power of every force alongside the state, so that
+        :func:`fivdisc.energy_balance` can account for the energy of the run.
     perturbation
-        Offsets from the sliding equilibrium used when `initial_state` is "equilibrium".
+        Offsets from the sliding equilibrium used when `initial_state` is "equilibrium"
+        (the same offsets for every slider).
     """
 
     _key: ClassVar[tuple[str, ...]] = ("simulation",)
@@ -470,24 +652,29 @@ class Simulation(_Table):
     atol: Real = _field(1e-9, gt=0)
     max_step: Real = _field(0.0, "s", ge=0)
     max_switches: Count = _field(10_000_000, ge=1)
+    min_flight_time: Real = _field(1e-11, "s", gt=0)
+    energy_balance: Flag = False
     perturbation: Perturbation = Perturbation()
 
 
 class Case(_Table):
-    """One simulation case: the disc, the slider, friction, disc speed and run settings.
+    """One simulation case: the disc, its sliders, friction, disc speed and run settings.
 
-    Build it with keyword tables (``Case(slider={"normal_damping": 2.0})``), from
-    TOML (:func:`load_case`, :meth:`from_toml`) or from another case
-    (:meth:`replace`). Instances are immutable; equal cases compare equal.
+    Build it with keyword tables (``Case(slider={"normal_damping": 2.0})`` or
+    ``Case(sliders=[{...}, {...}])``), from TOML (:func:`load_case`,
+    :meth:`from_toml`) or from another case (:meth:`replace`). Instances are
+    immutable; equal cases compare equal.
 
     Attributes
     ----------
     disc
-        The annular disc and its modes.
-    slider
-        The slider and its springs, dampers and preload.
+        The annular disc, its modes and damping.
+    sliders
+        The sliders (one or more), each with its springs, dampers, preload, base
+        angle and face. A file gives either one ``[slider]`` table or an array of
+        ``[[sliders]]`` tables.
     friction
-        The friction law.
+        The friction law (the same for every slider).
     speed
         The disc speed profile Omega(t).
     simulation
@@ -495,21 +682,68 @@ class Case(_Table):
     """
 
     disc: Disc = Disc()
-    slider: Slider = Slider()
-    friction: Friction = Friction()
+    sliders: tuple[Slider, ...] = Field((Slider(),), min_length=1)
+    friction: FrictionLaw = ExponentialFriction()
     speed: Speed = ConstantSpeed()
     simulation: Simulation = Simulation()
+
+    @model_validator(mode="before")
+    @classmethod
+    def _one_slider_table(cls, data: Any) -> Any:
+        # `[slider]` is the one-slider spelling of `[[sliders]]`.
+        if isinstance(data, Mapping) and "slider" in data:
+            if "sliders" in data:
+                raise _rule(
+                    "a case has either one [slider] table or [[sliders]] tables, not both; "
+                    "pick one",
+                    "slider",
+                    data["slider"],
+                )
+            data = {("sliders" if k == "slider" else k): v for k, v in data.items()}
+            data["sliders"] = [_plain(data["sliders"])]
+        return data
+
+    @property
+    def slider(self) -> Slider:
+        """The slider of a one-slider case.
+
+        Raises
+        ------
+        CaseError
+            The case has several sliders (use :attr:`sliders`).
+        """
+        if len(self.sliders) != 1:
+            raise CaseError(
+                f"the case has {len(self.sliders)} sliders: use case.sliders[j] "
+                "(and keys sliders.J.KEY) instead of case.slider"
+            )
+        return self.sliders[0]
+
+    def slider_key(self, j: int) -> str:
+        """Dotted prefix of slider `j` in keys and messages: ``slider`` or ``sliders.J``."""
+        return "slider" if len(self.sliders) == 1 else f"sliders.{j}"
 
     @model_validator(mode="after")
     def _check_geometry_and_start(self) -> Case:
         a, b = self.disc.inner_radius, self.disc.outer_radius
-        r0 = self.slider.track_radius
-        if not a < r0 < b:
-            raise _rule(
-                f"must lie in (disc.inner_radius, disc.outer_radius) = ({a!r}, {b!r}) [m]",
-                "slider.track_radius",
-                r0,
-            )
+        seen: dict[tuple[float, float, str], int] = {}
+        for j, slider in enumerate(self.sliders):
+            r0 = slider.track_radius
+            if not a < r0 < b:
+                raise _rule(
+                    f"must lie in (disc.inner_radius, disc.outer_radius) = ({a!r}, {b!r}) [m]",
+                    f"{self.slider_key(j)}.track_radius",
+                    r0,
+                )
+            place = (r0, round(math.remainder(slider.angle, _TWO_PI), 12), slider.face)
+            if place in seen:
+                raise _rule(
+                    f"puts sliders.{j} where sliders.{seen[place]} is (r = {r0!r} m on the "
+                    f"{slider.face} face): sliders on one face need different angles or radii",
+                    f"sliders.{j}.angle",
+                    slider.angle,
+                )
+            seen[place] = j
         for i, probe in enumerate(self.simulation.probes):
             if not a <= probe[0] <= b:
                 raise _rule(
@@ -544,8 +778,15 @@ class Case(_Table):
         return _parse(text, source=None)
 
     def to_toml(self) -> str:
-        """The case as TOML text, every key written out (defaults included)."""
-        return tomli_w.dumps(self.model_dump(mode="json"))
+        """The case as TOML text, every key written out (defaults included).
+
+        One slider is written as a ``[slider]`` table, several as ``[[sliders]]``.
+        """
+        data = self.model_dump(mode="json")
+        if len(self.sliders) == 1:
+            data = {("slider" if k == "sliders" else k): (v[0] if k == "sliders" else v)
+                    for k, v in data.items()}
+        return tomli_w.dumps(data)
 
     def save(self, path: str | PathLike[str]) -> None:
         """Write the case as a TOML file (see :meth:`to_toml`)."""
@@ -555,8 +796,10 @@ class Case(_Table):
     def valid_keys(cls) -> list[str]:
         """All dotted keys of values (not tables), e.g. ``"slider.mass"``.
 
-        The speed keys of every profile are included (``speed.value``,
-        ``speed.initial``, ``speed.duration``, ...).
+        The keys of every speed profile and friction law are included
+        (``speed.value``, ``speed.initial``, ``friction.decay``, ...). A slider's
+        keys are listed as ``slider.KEY`` (the one slider); slider ``J`` of a case
+        with several is ``sliders.J.KEY``.
         """
         return list(_LEAVES)
 
@@ -569,11 +812,40 @@ class Case(_Table):
             The key does not exist in this case.
         """
         node: Any = self
-        for name in key.split("."):
-            if not isinstance(node, BaseModel) or name not in type(node).model_fields:
-                raise CaseError(_unknown_key(key, profile=self.speed.profile))
-            node = getattr(node, name)
+        for name in self._path(key):
+            if isinstance(node, tuple):
+                node = node[name]
+            elif isinstance(node, BaseModel) and name in type(node).model_fields:
+                node = getattr(node, name)
+            else:
+                raise CaseError(self._unknown(key))
         return node
+
+    def _unknown(self, key: str) -> str:
+        return _unknown_key(key, profile=self.speed.profile, law=self.friction.law)
+
+    def _path(self, key: str) -> list[str | int]:
+        """Path of a dotted key through the model: ``slider.X`` and ``sliders.J.X`` lead to
+        ``["sliders", J, "X"]``."""
+        parts: list[str | int] = list(key.split("."))
+        if parts[0] == "slider":
+            if len(self.sliders) != 1:
+                raise CaseError(
+                    f"'{key}' is ambiguous: the case has {len(self.sliders)} sliders; write "
+                    f"sliders.J.{'.'.join(map(str, parts[1:])) or 'KEY'} with J from 0 to "
+                    f"{len(self.sliders) - 1}"
+                )
+            return ["sliders", 0, *parts[1:]]
+        if parts[0] == "sliders" and len(parts) > 1:
+            index = parts[1]
+            if not (isinstance(index, str) and index.isdigit()
+                    and int(index) < len(self.sliders)):
+                raise CaseError(
+                    f"'{key}': slider index {index!r} is invalid: the case has "
+                    f"{len(self.sliders)} slider(s), numbered from 0"
+                )
+            return ["sliders", int(index), *parts[2:]]
+        return parts
 
     def replace(self, updates: Mapping[str, Any]) -> Case:
         """A new, validated case with some values changed.
@@ -581,14 +853,15 @@ class Case(_Table):
         Parameters
         ----------
         updates
-            Dotted key -> new value, e.g. ``{"slider.normal_damping": 2.0}``. A
-            key may also name a whole table (``"speed"``, ``"simulation"``,
-            ``"simulation.perturbation"``), whose value (a dict or model) then
-            replaces that table; keys it leaves out take their defaults. Tables
-            are applied before the keys inside them. Setting ``speed.profile`` to
-            a different profile starts the speed table afresh, so
-            ``{"speed.profile": "decelerating", "speed.initial": 10.0}`` works
-            from any case.
+            Dotted key -> new value, e.g. ``{"slider.normal_damping": 2.0}`` or, with
+            several sliders, ``{"sliders.1.preload": 300.0}``. A key may also name a
+            whole table (``"speed"``, ``"simulation"``, ``"sliders.1"``,
+            ``"simulation.perturbation"``) or the list ``"sliders"``, whose value (a
+            dict or model, or a list of them) then replaces it; keys it leaves out take
+            their defaults. Tables are applied before the keys inside them. Setting
+            ``speed.profile`` (``friction.law``) to a different profile (law) starts
+            that table afresh, so ``{"speed.profile": "decelerating",
+            "speed.initial": 10.0}`` works from any case.
 
         Raises
         ------
@@ -596,27 +869,38 @@ class Case(_Table):
             An unknown key or an invalid resulting case.
         """
         data = self.model_dump()
-        # Shallow keys first, then speed.profile before its sibling speed keys.
-        for key in sorted(updates, key=lambda k: (k.count("."), k != "speed.profile")):
-            if key not in _LEAVES and key not in _TABLES:
-                raise CaseError(_unknown_key(key))
-            *path, name = key.split(".")
-            table = data
+        tags = {f"{u.table}.{u.tag}" for u in _UNIONS.values()}
+        # Shallow keys first, then a union's tag before its sibling keys.
+        for key in sorted(updates, key=lambda k: (k.count("."), k not in tags)):
+            if _template(key) not in _LEAVES and _template(key) not in _TABLES:
+                raise CaseError(self._unknown(key))
+            *path, name = self._path(key)
+            table: Any = data
             for i, part in enumerate(path):
-                child = table.get(part, {})
+                child = table[part] if isinstance(part, int) else table.get(part, {})
                 if isinstance(child, BaseModel):
                     child = child.model_dump()
-                elif not isinstance(child, Mapping):
+                elif not isinstance(child, Mapping | list | tuple):
                     raise CaseError(
-                        f"cannot set '{key}': {'.'.join(path[: i + 1])} = {_show(child)} "
+                        f"cannot set '{key}': {_join(path[: i + 1])} = {_show(child)} "
                         "is not a table"
                     )
-                table[part] = dict(child)
+                table[part] = list(child) if isinstance(child, list | tuple) else dict(child)
                 table = table[part]
-            if key == "speed.profile" and updates[key] != table.get("profile", "constant"):
-                table.clear()
-            table[name] = updates[key]
+            if key in tags:
+                union = _UNIONS[key.split(".")[0]]
+                if updates[key] != table.get(union.tag, union.default):
+                    table.clear()
+            table[name] = _plain(updates[key])
         return _validate(data, source=None)
+
+
+def _template(key: str) -> str:
+    """The key with a slider index removed: ``sliders.2.mass`` -> ``slider.mass``."""
+    parts = key.split(".")
+    if parts[0] == "sliders" and len(parts) > 1 and parts[1].isdigit():
+        return ".".join(["slider", *parts[2:]])
+    return key
 
 
 # --- reading ---------------------------------------------------------------------------------
@@ -661,7 +945,7 @@ def _validate(data: Any, source: str | None) -> Case:
     try:
         return Case.model_validate(data)
     except ValidationError as exc:
-        message = _describe(exc, Case)
+        message = _describe(exc, Case, data)
         raise CaseError(f"{source}: {message}" if source else message) from None
 
 
@@ -672,10 +956,14 @@ def _walk(model: type[BaseModel], prefix: str) -> Iterator[tuple[str, list[str] 
     """Yield (dotted key, names inside it) for every table and leaf; names is None for a leaf."""
     for name, info in model.model_fields.items():
         key = f"{prefix}{name}"
-        if model is Case and name == "speed":
-            yield key, list(dict.fromkeys(n for s in _SPEEDS.values() for n in s.model_fields))
-            for sub in _SPEEDS.values():
+        if model is Case and name in _UNIONS:
+            union = _UNIONS[name]
+            yield key, union.keys()
+            for sub in union.models.values():
                 yield from _walk(sub, key + ".")
+        elif model is Case and name == "sliders":
+            yield "slider", list(Slider.model_fields)
+            yield from _walk(Slider, "slider.")
         elif isinstance(info.annotation, type) and issubclass(info.annotation, _Table):
             yield key, list(info.annotation.model_fields)
             yield from _walk(info.annotation, key + ".")
@@ -685,7 +973,7 @@ def _walk(model: type[BaseModel], prefix: str) -> Iterator[tuple[str, list[str] 
 
 def _tables() -> dict[str, list[str]]:
     """Dotted table key -> names of its keys ("" is the top level)."""
-    tables = {"": list(Case.model_fields)}
+    tables = {"": ["slider", *Case.model_fields]}
     for key, names in _walk(Case, ""):
         if names is not None:
             tables[key] = names
@@ -694,10 +982,11 @@ def _tables() -> dict[str, list[str]]:
 
 _LEAVES: tuple[str, ...] = tuple(dict.fromkeys(k for k, names in _walk(Case, "") if names is None))
 _TABLE_NAMES: dict[str, list[str]] = _tables()
-_TABLES: frozenset[str] = frozenset(_TABLE_NAMES) - {""}
+_TABLES: frozenset[str] = frozenset([*_TABLE_NAMES, "sliders"]) - {""}
 
 
-def _unknown_key(key: str, names: list[str] | None = None, profile: str | None = None) -> str:
+def _unknown_key(key: str, names: list[str] | None = None, profile: str | None = None,
+                 law: str | None = None) -> str:
     """Message for an unknown dotted key, with the nearest valid key if there is one.
 
     Parameters
@@ -706,15 +995,20 @@ def _unknown_key(key: str, names: list[str] | None = None, profile: str | None =
         The dotted key.
     names
         The valid names in the key's table; None looks them up by the key's path.
-    profile
-        The case's speed profile, to explain a speed key that belongs to another one.
+    profile, law
+        The case's speed profile and friction law, to explain a key that belongs to
+        another profile or law.
     """
     table, _, name = key.rpartition(".")
-    if table == "speed" and profile in _SPEEDS and key in _LEAVES:
-        own = ", ".join(f"'{n}'" for n in _SPEEDS[profile].model_fields)
-        return f"unknown key '{key}' for speed profile '{profile}', which takes {own}"
+    template_table = _template(table) if table else table
+    for union, tag in ((_UNIONS["speed"], profile), (_UNIONS["friction"], law)):
+        if table == union.table and tag in union.models and key in _LEAVES:
+            own = ", ".join(f"'{n}'" for n in union.models[tag].model_fields)
+            owners = " or ".join(f"'{o}'" for o in union.owner(name))
+            return (f"unknown key '{key}' for {union.what} '{tag}', which takes {own} "
+                    f"('{name}' belongs to {union.what} {owners})")
     if names is None:
-        names = _TABLE_NAMES.get(table)
+        names = _TABLE_NAMES.get(template_table)
     if names is not None:
         matches = difflib.get_close_matches(name, names, n=1)
         suggestion = f"{table}.{matches[0]}" if matches and table else (matches or [""])[0]
@@ -759,15 +1053,24 @@ def _join(parts: list[str | int]) -> str:
 
 
 def _locate(
-    root: type[_Table], loc: tuple[str | int, ...]
+    root: type[_Table], loc: tuple[str | int, ...], single: bool
 ) -> tuple[list[str | int], type[BaseModel] | None, FieldInfo | None, bool]:
     """Follow a pydantic error location through the case tables.
+
+    Parameters
+    ----------
+    root
+        The model that was validated.
+    loc
+        pydantic's location of the error.
+    single
+        Whether the case has one slider, named ``slider`` rather than ``sliders.J``.
 
     Returns
     -------
     parts
-        Key path from the top of a case file, without the speed profile tag
-        pydantic inserts for the discriminated union.
+        Key path from the top of a case file, without the profile or law tag
+        pydantic inserts for a discriminated union.
     owner
         The model that holds (or should hold) the last named key.
     field
@@ -779,24 +1082,34 @@ def _locate(
     model: type[BaseModel] | None = root
     owner: type[BaseModel] | None = root
     field: FieldInfo | None = None
-    after_speed = False
+    union: _Union | None = None
+    in_sliders = False
     for part in loc:
+        if in_sliders and isinstance(part, int):
+            # Slider J is keyed `sliders.J` (or `slider` when it is the only one).
+            parts[-1:] = ["slider"] if single else ["sliders", str(part)]
+            model = owner = Slider
+            in_sliders = False
+            continue
+        in_sliders = False
         if isinstance(part, int):
             parts.append(part)
             continue
-        if after_speed and part in _SPEEDS:
-            model = owner = _SPEEDS[part]
-            after_speed = False
+        if union is not None and part in union.models:
+            model = owner = union.models[part]
+            union = None
             continue
-        after_speed = False
+        union = None
         parts.append(part)
         owner = model
         field = model.model_fields.get(part) if model is not None else None
         model = None
         if field is None:
             continue
-        if owner is Case and part == "speed":
-            after_speed = True
+        if owner is Case and part in _UNIONS:
+            union = _UNIONS[part]
+        elif owner is Case and part == "sliders":
+            in_sliders = True
         elif isinstance(field.annotation, type) and issubclass(field.annotation, _Table):
             model = field.annotation
     return parts, owner, field, bool(loc) and isinstance(loc[-1], int)
@@ -837,21 +1150,25 @@ _TYPE_RULES = {
 }
 
 
-def _describe_error(error: ErrorDetails, root: type[_Table]) -> str:
+def _describe_error(error: ErrorDetails, root: type[_Table], single: bool) -> str:
     """One pydantic error as "key = value is invalid: rule [unit]"."""
-    parts, owner, field, item = _locate(root, error["loc"])
+    parts, owner, field, item = _locate(root, error["loc"], single)
     kind = error["type"]
     ctx = error.get("ctx", {})
     value = error["input"]
 
     if kind == "extra_forbidden":
         names = list(owner.model_fields) if owner is not None else None
-        profile = owner.model_fields["profile"].default if owner in _SPEEDS.values() else None
-        return _unknown_key(_join(parts), names, profile)
-    if kind == "speed_profile":
-        if isinstance(value, Mapping):
-            parts, value = [*parts, "profile"], value.get("profile")
-            rule = "must be one of " + ", ".join(f'"{p}"' for p in _SPEEDS)
+        if owner is Case:
+            names = _TABLE_NAMES[""]
+        tags = {u.table: owner.model_fields[u.tag].default
+                for u in _UNIONS.values() if owner in u.models.values()}
+        return _unknown_key(_join(parts), names, tags.get("speed"), tags.get("friction"))
+    if kind == "union_tag":
+        union = _UNIONS[str(parts[-1])] if parts and parts[-1] in _UNIONS else None
+        if isinstance(value, Mapping) and union is not None:
+            parts, value = [*parts, union.tag], value.get(union.tag)
+            rule = "must be one of " + ", ".join(f'"{p}"' for p in union.models)
         else:
             rule = "must be a table"
     elif kind == "case_rule":
@@ -875,8 +1192,11 @@ def _describe_error(error: ErrorDetails, root: type[_Table]) -> str:
     return f"{_join(parts) or 'case'} = {_show(value)} is invalid: {rule}"
 
 
-def _describe(exc: ValidationError, root: type[_Table]) -> str:
-    """The first few errors of a ValidationError, on one line."""
+def _describe(exc: ValidationError, root: type[_Table], data: Any = None) -> str:
+    """The first few errors of a ValidationError, on one line.
+
+    `data` is the input that was validated (to name the sliders as the file does).
+    """
     errors = exc.errors(include_url=False)
     # pydantic counts only the valid items against an array's minimum length, so a
     # bad item also triggers a spurious "too short" on its array: report the item.
@@ -889,20 +1209,26 @@ def _describe(exc: ValidationError, root: type[_Table]) -> str:
             len(loc) > len(e["loc"]) and loc[: len(e["loc"])] == e["loc"] for loc in item_locs
         )
     ]
-    messages = [_describe_error(e, root) for e in errors[:_MAX_REPORTED_ERRORS]]
+    sliders = data.get("sliders") if isinstance(data, Mapping) else None
+    single = not isinstance(sliders, list | tuple) or len(sliders) == 1
+    messages = [_describe_error(e, root, single) for e in errors[:_MAX_REPORTED_ERRORS]]
     if len(errors) > _MAX_REPORTED_ERRORS:
         messages.append(f"and {len(errors) - _MAX_REPORTED_ERRORS} more errors")
     return "; ".join(messages)
 
 
 def unit_of(key: str) -> str:
-    """Unit of a dotted case key (``"slider.normal_damping"`` -> ``"N s/m"``), "" if none."""
-    table, _, name = key.rpartition(".")
+    """Unit of a dotted case key (``"slider.normal_damping"`` -> ``"N s/m"``), "" if none.
+
+    ``sliders.J.KEY`` is the unit of ``slider.KEY``; the keys of every speed profile
+    and friction law are known.
+    """
+    table, _, name = _template(key).rpartition(".")
     models = {
         "disc": (Disc,),
         "slider": (Slider,),
-        "friction": (Friction,),
-        "speed": (ConstantSpeed, DeceleratingSpeed, AcceleratingSpeed, TableSpeed),
+        "friction": tuple(_LAWS.values()),
+        "speed": tuple(_SPEEDS.values()),
         "simulation": (Simulation,),
         "simulation.perturbation": (Perturbation,),
     }.get(table, ())
@@ -911,4 +1237,3 @@ def unit_of(key: str) -> str:
         if field is not None:
             return str((field.json_schema_extra or {}).get("unit", ""))
     return ""
-
