@@ -25,42 +25,53 @@ def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarr
     model : fivdisc.model.Model
         The model that was integrated.
     out_y : ndarray
-        ``(n_time, 2 n + 4)`` sampled states (slider z, zdot already filled in contact).
+        ``(n_time, 2 (n + 2 S) [+ K])`` sampled states (the sliders' z, zdot already
+        filled in contact), with the K energy accumulators last when recorded.
     out_aux : ndarray
-        ``(n_time, 5)``: normal force [N], friction force [N], phase, disc w under the
-        slider [m], disc speed [rad/s].
+        ``(n_time, 4 S + 1)``: per slider the normal force [N], friction force [N],
+        phase and the disc's w under it [m]; then the disc speed [rad/s].
     times : ndarray
         Sample times [s].
     events : (ndarray, ndarray)
-        Event times [s] and ``(n_event, 3)`` integer rows (kind, from phase, to phase).
+        Event times [s] and ``(n_event, 4)`` integer rows (kind, from phase, to phase,
+        slider).
     attrs : dict
         Global attributes (status, message, statistics, case text, ...).
     """
-    n = model.n
+    n, ns = model.n, model.n_sliders
     q = out_y[:, :n]
-    q_dot = out_y[:, n + 2 : 2 * n + 2]
+    q_dot = out_y[:, n + 2 * ns : 2 * n + 2 * ns]
+
+    def block(what: str) -> np.ndarray:
+        start = model.index(what)
+        return out_y[:, start : start + ns]
+
+    normal = out_aux[:, :ns]
+    friction = out_aux[:, ns : 2 * ns]
+    phase = out_aux[:, 2 * ns : 3 * ns]
+    w_under = out_aux[:, 3 * ns : 4 * ns]
     ev_t, ev_i = events
     probes = np.asarray(model.case.simulation.probes, dtype=float).reshape(-1, 2)
+    sliders = model.case.sliders
+    per = ("time", "slider")
+    flags = {"flag_values": np.array([0, 1, 2], dtype=np.int8),
+             "flag_meanings": " ".join(PHASE_NAMES)}
     data = {
-        "phi": _var("time", out_y[:, n], "rad", "slider circumferential angle"),
-        "phi_dot": _var("time", out_y[:, 2 * n + 2], "rad/s", "slider angular velocity"),
-        "disc_speed": _var("time", out_aux[:, 4], "rad/s", "disc spinning speed"),
-        "normal_force": _var("time", out_aux[:, 0], "N", "normal contact force"),
+        "phi": _var(per, block("phi"), "rad", "slider circumferential angle"),
+        "phi_dot": _var(per, block("phi_dot"), "rad/s", "slider angular velocity"),
+        "disc_speed": _var("time", out_aux[:, 4 * ns], "rad/s", "disc spinning speed"),
+        "normal_force": _var(per, normal, "N", "normal contact force"),
         "friction_force": _var(
-            "time", out_aux[:, 1], "N", "friction force on the slider (positive along +phi)"
+            per, friction, "N", "friction force on the slider (positive along +phi)"
         ),
-        "phase": _var(
-            "time",
-            out_aux[:, 2].astype(np.int8),
-            "1",
-            "contact phase",
-            flag_values=np.array([0, 1, 2], dtype=np.int8),
-            flag_meanings=" ".join(PHASE_NAMES),
-        ),
-        "z": _var("time", out_y[:, n + 1], "m", "slider normal displacement"),
-        "z_dot": _var("time", out_y[:, 2 * n + 3], "m/s", "slider normal velocity"),
+        "phase": _var(per, phase.astype(np.int8), "1", "contact phase", **flags),
+        "z": _var(per, block("z"), "m", "slider normal displacement"),
+        "z_dot": _var(per, block("z_dot"), "m/s", "slider normal velocity"),
         "gap": _var(
-            "time", out_y[:, n + 1] - out_aux[:, 3], "m", "gap between slider and disc surface"
+            per,
+            model.kernel.sigma * (block("z") - w_under),
+            "m",
+            "gap between slider and disc surface (positive when apart)",
         ),
         # einsum: numpy's BLAS matmul on this tall strided array is ~6x slower.
         "w": _var(("time", "probe"), np.einsum("tj,pj->tp", q, model.probe_shapes), "m",
@@ -75,22 +86,40 @@ def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarr
             "kind of switch (" + ", ".join(EVENT_KINDS) + ")",
         ),
         "event_from": _var("event", ev_i[:, 1].astype(np.int8), "1", "phase before the switch",
-                           flag_values=np.array([0, 1, 2], dtype=np.int8),
-                           flag_meanings=" ".join(PHASE_NAMES)),
+                           **flags),
         "event_to": _var("event", ev_i[:, 2].astype(np.int8), "1", "phase after the switch",
-                         flag_values=np.array([0, 1, 2], dtype=np.int8),
-                         flag_meanings=" ".join(PHASE_NAMES)),
+                         **flags),
+        "event_slider": _var("event", ev_i[:, 3].astype(np.int16), "1",
+                             "slider that switched"),
     }
+    n_dyn = model.state_size
+    if out_y.shape[1] > n_dyn:
+        from fivdisc._kernels.layout import ENERGY_NAMES
+
+        data["energy_work"] = _var(
+            ("time", "energy_term"), out_y[:, n_dyn:], "J",
+            "work done since t = 0 by each kind of force (impact terms: sum of the jumps)",
+        )
     coords = {
         "time": _var("time", times, "s", "time"),
         "coordinate": ("coordinate", list(model.labels),
                        {"units": "1", "long_name": "modal coordinate (C/D, k, l)"}),
         "k": _var("coordinate", model.k, "1", "nodal circles"),
         "l": _var("coordinate", model.l, "1", "nodal diameters"),
+        "slider": ("slider", np.arange(ns), {"units": "1", "long_name": "slider index"}),
+        "angle": _var("slider", np.array([s.angle for s in sliders]), "rad",
+                      "space-fixed angle of the slider's base"),
+        "face": ("slider", np.array([s.face for s in sliders], dtype=object),
+                 {"units": "1", "long_name": "face of the disc the slider presses on"}),
+        "track_radius": _var("slider", np.array([s.track_radius for s in sliders]), "m",
+                             "radius of the slider's track"),
         "probe": ("probe", np.arange(len(probes)), {"units": "1", "long_name": "probe index"}),
         "probe_r": _var("probe", probes[:, 0], "m", "probe radius"),
         "probe_theta": _var("probe", probes[:, 1], "rad", "probe angle (space-fixed)"),
     }
+    if "energy_work" in data:
+        coords["energy_term"] = ("energy_term", list(ENERGY_NAMES),
+                                 {"units": "1", "long_name": "kind of force"})
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 

@@ -9,7 +9,7 @@ from importlib.metadata import version
 import numpy as np
 
 from fivdisc._kernels import integrate as kern
-from fivdisc._kernels.dynamics import SLIP
+from fivdisc._kernels import layout as lay
 from fivdisc.case import Case
 from fivdisc.errors import SimulationError
 from fivdisc.model import Model, build_model
@@ -32,7 +32,7 @@ _ZENO_COUNT = 1000
 
 
 def initial_state(model: Model, initial=None) -> np.ndarray:
-    """Kernel state at t = 0.
+    """Kernel state at t = 0 (without energy accumulators).
 
     Parameters
     ----------
@@ -40,14 +40,17 @@ def initial_state(model: Model, initial=None) -> np.ndarray:
         The model.
     initial : None, "rest", "equilibrium", mapping or array
         ``None`` takes the case's ``simulation.initial_state``. A mapping may give
-        ``q`` [m], ``q_dot`` [m/s], ``phi`` [rad], ``phi_dot`` [rad/s] (missing ones
-        are zero); an array is a full state of length ``2 n + 4``.
+        ``q`` [m] and ``q_dot`` [m/s] (one per modal coordinate), ``phi`` [rad] and
+        ``phi_dot`` [rad/s] (one per slider, or one number for all); missing ones are
+        zero. An array is a full state of length ``2 (n + 2 S)``.
     """
     sim = model.case.simulation
     if initial is None:
         initial = sim.initial_state
+    n, ns = model.n, model.n_sliders
     y = np.zeros(model.state_size)
-    n = model.n
+    phi = slice(model.index("phi"), model.index("phi") + ns)
+    phi_dot = slice(model.index("phi_dot"), model.index("phi_dot") + ns)
     if isinstance(initial, str):
         if initial == "rest":
             return y
@@ -55,8 +58,8 @@ def initial_state(model: Model, initial=None) -> np.ndarray:
             from fivdisc.analysis.equilibrium import sliding_equilibrium
 
             y = sliding_equilibrium(model).state.copy()
-            y[n] += sim.perturbation.phi
-            y[2 * n + 2] += sim.perturbation.phi_dot
+            y[phi] += sim.perturbation.phi
+            y[phi_dot] += sim.perturbation.phi_dot
             return y
         raise SimulationError(
             f"initial = {initial!r} is invalid: must be 'rest', 'equilibrium', a mapping "
@@ -69,22 +72,26 @@ def initial_state(model: Model, initial=None) -> np.ndarray:
             raise SimulationError(
                 f"initial has unknown keys {sorted(unknown)}: allowed are {sorted(allowed)}"
             )
-        for key, sl in (("q", slice(0, n)), ("q_dot", slice(n + 2, 2 * n + 2))):
-            if key in initial:
-                val = np.asarray(initial[key], dtype=float)
-                if val.shape != (n,):
-                    raise SimulationError(
-                        f"initial[{key!r}] has shape {val.shape}: must be ({n},), one per "
-                        "modal coordinate"
-                    )
-                y[sl] = val
-        y[n] = float(initial.get("phi", 0.0))
-        y[2 * n + 2] = float(initial.get("phi_dot", 0.0))
+        blocks = (("q", slice(0, n), n, "modal coordinate"),
+                  ("q_dot", slice(n + 2 * ns, 2 * n + 2 * ns), n, "modal coordinate"),
+                  ("phi", phi, ns, "slider"), ("phi_dot", phi_dot, ns, "slider"))
+        for key, sl, size, what in blocks:
+            if key not in initial:
+                continue
+            val = np.asarray(initial[key], dtype=float)
+            if what == "slider" and val.ndim == 0:
+                val = np.full(ns, float(val))
+            if val.shape != (size,):
+                raise SimulationError(
+                    f"initial[{key!r}] has shape {val.shape}: must be ({size},), one per {what}"
+                )
+            y[sl] = val
     else:
         y = np.array(initial, dtype=float)
         if y.shape != (model.state_size,):
             raise SimulationError(
-                f"initial state has shape {y.shape}: must be ({model.state_size},) = 2 n + 4"
+                f"initial state has shape {y.shape}: must be ({model.state_size},) = "
+                "2 (n + 2 S)"
             )
     if not np.all(np.isfinite(y)):
         raise SimulationError("initial state is invalid: all values must be finite")
@@ -132,13 +139,16 @@ def simulate(
                 f"stop_on = {kind!r} is invalid: must be one of {', '.join(EVENT_KINDS)}"
             )
     model = build_model(case, speed)
-    y = initial_state(model, initial)
+    y0 = initial_state(model, initial)
+    n_acc = lay.N_ENERGY if sim.energy_balance else 0
+    y = np.concatenate([y0, np.zeros(n_acc)])
 
     n_out = int(np.floor(sim.duration * sim.output_rate + 1e-9)) + 1
-    ns = model.state_size
+    ns = y.size
+    n_sl = model.n_sliders
     # Rows past the last written sample are cut off, so they need no fill.
     out_y = np.empty((n_out, ns))
-    out_aux = np.empty((n_out, 5))
+    out_aux = np.empty((n_out, 4 * n_sl + 1))
     ctl = np.zeros(kern.N_CONTROL)
     ctl[kern.C_RTOL] = sim.rtol
     ctl[kern.C_ATOL] = sim.atol
@@ -152,20 +162,30 @@ def simulate(
     fst = np.zeros(kern.N_FSTATE)
     fst[kern.F_LAST_SWITCH] = -np.inf
     ist = np.zeros(kern.N_ISTATE, dtype=np.int64)
-    ist[kern.I_PHASE] = SLIP
-    ist[kern.I_SIGN] = 1
+    ph = np.full(n_sl, lay.SLIP, dtype=np.int64)
+    sg = np.ones(n_sl, dtype=np.int64)
     k = np.zeros((7, ns))
-    ev_prev = np.zeros(3)
+    ev_prev = np.zeros(3 * n_sl)
     ev_t = np.empty(_EVENT_BUFFER)
-    ev_i = np.empty((_EVENT_BUFFER, 3), dtype=np.int64)
+    ev_i = np.empty((_EVENT_BUFFER, kern.N_EVI), dtype=np.int64)
     breaks = np.unique(model.speed.breakpoints[model.speed.breakpoints < sim.duration])
     mdl = model.kernel_args
     ev_times: list[np.ndarray] = []
     ev_rows: list[np.ndarray] = []
 
+    def advance(target: float) -> int:
+        status = kern.run(target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y,
+                          out_aux, ev_t, ev_i)
+        n_ev = ist[kern.I_EVENTS]
+        if n_ev:
+            ev_times.append(ev_t[:n_ev].copy())
+            ev_rows.append(ev_i[:n_ev].copy())
+            ist[kern.I_EVENTS] = 0
+        return status
+
     # A first call with target 0 only sets up the start: it compiles or loads the kernel
     # before the progress bar starts, so the bar's rate and estimate are the integrator's.
-    kern.run(0.0, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_t, ev_i)
+    advance(0.0)
     bar = None
     if progress:
         from tqdm import tqdm
@@ -179,13 +199,7 @@ def simulate(
         for chunk in range(1, _CHUNKS + 1):
             target = sim.duration * chunk / _CHUNKS
             while True:
-                status = kern.run(target, mdl, ctl, fst, ist, y, k, ev_prev, breaks,
-                                  out_y, out_aux, ev_t, ev_i)
-                n_ev = ist[kern.I_EVENTS]
-                if n_ev:
-                    ev_times.append(ev_t[:n_ev].copy())
-                    ev_rows.append(ev_i[:n_ev].copy())
-                    ist[kern.I_EVENTS] = 0
+                status = advance(target)
                 if status != kern.ST_RUNNING or fst[kern.F_T] >= target:
                     break
             if bar is not None:
@@ -200,17 +214,17 @@ def simulate(
     wall = _time.perf_counter() - start
 
     t_end = fst[kern.F_T]
-    phase_name = PHASE_NAMES[ist[kern.I_PHASE]]
+    phases = ", ".join(PHASE_NAMES[p] for p in ph)
     if interrupted:
-        name, message = "interrupted", f"interrupted at t = {t_end:.9g} s in {phase_name}"
+        name, message = "interrupted", f"interrupted at t = {t_end:.9g} s in {phases}"
     else:
         name = _STATUS.get(status, "unknown")
-        message = _message(name, t_end, PHASE_NAMES[ist[kern.I_FAIL_PHASE]], sim)
+        message = _message(name, t_end, phases, sim)
     n_done = int(ist[kern.I_OUT_NEXT])
     times = np.minimum(np.arange(n_done) / sim.output_rate, sim.duration)
     events = (
         np.concatenate(ev_times) if ev_times else np.empty(0),
-        np.concatenate(ev_rows) if ev_rows else np.empty((0, 3), dtype=np.int64),
+        np.concatenate(ev_rows) if ev_rows else np.empty((0, kern.N_EVI), dtype=np.int64),
     )
     attrs = {
         "status": name,
@@ -225,7 +239,7 @@ def simulate(
         "n_rhs": int(ist[kern.I_RHS]),
         "n_rhs_events": int(ist[kern.I_EVAL_EVENTS]),
         "n_switches": int(ist[kern.I_SWITCHES]),
-        "final_phase": int(ist[kern.I_PHASE]),
+        "final_phase": ph.copy(),
         "final_state": y.copy(),
     }
     ds = build_dataset(model, out_y[:n_done], out_aux[:n_done], times, events, attrs)

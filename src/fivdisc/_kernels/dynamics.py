@@ -1,22 +1,16 @@
-"""Equations of motion of the slider-on-disc system (numba, arrays in and out).
+"""Equations of motion of S sliders on the spinning disc (numba, arrays in and out).
 
-State vector ``y`` of length ``2 n + 4`` for ``n`` modal coordinates::
+The state layout and the model tuple are described in :mod:`fivdisc._kernels.layout`.
+Every function here is written without comparisons on the state's value in the
+arithmetic that produces derivatives (phases and signs are passed in), so that it also
+compiles for complex arrays: complex-step Jacobians come from the same code.
 
-    y = [q_0 .. q_{n-1}, phi, z, qdot_0 .. qdot_{n-1}, phidot, zdot]
-
-``z`` and ``zdot`` are the slider's own normal displacement and velocity; they are
-integrated only in separation (in contact the slider follows the disc and they are
-held constant). Every function here is written without comparisons on the state so
-that it also compiles for complex arrays (complex-step Jacobians).
-
-The model tuple ``mdl`` is ``(par, li, R0, minv, kd, ml2, gyr, sgn, partner, knots,
-coef)``: ``par`` scalar parameters indexed by the ``P_*`` constants; per modal
-coordinate the nodal-diameter count ``li``, the mode shape at the track ``R0``, the
-inverse modal mass ``minv = 1/M``, the modal stiffness ``kd = M omega^2``,
-``ml2 = M l^2``, the gyroscopic factor ``gyr = sgn l M``, ``sgn`` = +1 for a cosine (C)
-and -1 for a sine (D) coordinate, and ``partner`` = index of the other member of a
-doublet (-1 for l = 0); ``knots``/``coef`` are the piecewise-cubic speed profile
-(positions ``M_*`` below).
+The accelerations solve a linear system at every evaluation: the disc's is diagonal
+(modal masses) plus one row and column per slider in contact (its normal force). The
+normal forces are eliminated first: a system of one equation per slider in contact
+(its matrix is the capacitance matrix of the Woodbury identity), then the disc's
+accelerations follow in O(n S). For one slider this is the closed-form rank-one
+elimination, operation for operation.
 """
 
 from __future__ import annotations
@@ -24,32 +18,48 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-SLIP = 0
-STICK = 1
-SEPARATION = 2
-
-P_MASS = 0
-P_INERTIA = 1
-P_KZ = 2
-P_CZ = 3
-P_KPHI = 4
-P_CPHI = 5
-P_N0 = 6
-P_R0 = 7
-P_HALF_H_OVER_R0 = 8
-P_MUS = 9
-P_MU0 = 10
-P_MU1 = 11
-P_ALPHA = 12
-P_OMDOT = 13
-P_IMPACT = 14
-P_LMAX = 15
-N_PAR = 16
-
-M_PAR = 0
-M_MINV = 3
-M_KNOTS = 9
-M_COEF = 10
+from fivdisc._kernels.layout import (
+    A_F,
+    A_FPHI,
+    A_GPQ,
+    A_GPQD,
+    A_KNOWN,
+    A_L2GQ,
+    A_N,
+    A_PHID,
+    A_SGF,
+    A_SGG,
+    A_SGGP,
+    A_SMU,
+    A_V,
+    A_WC,
+    A_WCD,
+    E_DISC_DAMPING,
+    E_DRIVE,
+    E_FRICTION,
+    E_MOMENT,
+    E_SLIDER_DAMPING,
+    E_SLOPE,
+    F_ALPHA,
+    F_DELTA,
+    F_LAW,
+    F_MU0,
+    F_MU1,
+    F_MUS,
+    F_MUV,
+    F_VS,
+    LAW_EXPONENTIAL,
+    LAW_STRIBECK,
+    N_AUX,
+    O_DAMPED,
+    O_LMAX,
+    O_OMDOT,
+    SEPARATION,
+    SLIP,
+    STICK,
+    n_dynamic,
+    sizes,
+)
 
 
 @njit(cache=True)
@@ -77,36 +87,90 @@ def speed_at(t, knots, coef, right):
 
 
 @njit(cache=True)
-def evaluate(t, y, phase, s, right, mdl, work, dy):
-    """Time derivative ``dy`` of the state in the given phase.
+def kinetic_friction(mdl, r, s, v):
+    """Kinetic friction coefficient at relative speed ``v`` [rad/s] in slip with sign ``s``.
 
-    Returns ``(N, f, w_c, wdot_c, v)``: normal force [N], friction force on the
-    slider [N] (positive along +phi), the disc's transverse displacement [m] and
-    velocity [m/s] under the slider, and the relative speed ``Omega - phidot``
-    [rad/s]. ``work`` is a ``(5, m)`` scratch array of the state's dtype.
+    The sliding speed is ``u = r s v`` [m/s]; inside a Runge-Kutta step that crosses
+    v = 0 it may be slightly negative, where each law is continued smoothly: the
+    exponential law analytically, the Stribeck exponent oddly, the table linearly.
     """
-    par, li, R0, minv, kd, ml2, gyr, sgn, partner, knots, coef = mdl
-    n = li.shape[0]
-    m = par[P_MASS]
-    inertia = par[P_INERTIA]
-    om, omd = speed_at(t, knots, coef, right)
-    eps = par[P_OMDOT]
+    fr = mdl.fric
+    law = fr[F_LAW]
+    if law == LAW_EXPONENTIAL:
+        return fr[F_MU1] + (fr[F_MU0] - fr[F_MU1]) * np.exp(-fr[F_ALPHA] * r * s * v)
+    u = r * s * v
+    if law == LAW_STRIBECK:
+        x = u / fr[F_VS]
+        if x.real >= 0.0:
+            e = x ** fr[F_DELTA]
+        else:
+            e = -((-x) ** fr[F_DELTA])
+        return fr[F_MU1] + (fr[F_MU0] - fr[F_MU1]) * np.exp(-e) + fr[F_MUV] * u
+    xs = mdl.ftab_x
+    c = mdl.ftab_c
+    k = np.searchsorted(xs, u.real, side="right") - 1
+    if k < 0:
+        return c[0, 0] + c[0, 1] * u
+    tau = u - xs[k]
+    return c[k, 0] + tau * (c[k, 1] + tau * (c[k, 2] + tau * c[k, 3]))
 
-    phi = y[n]
-    phid = y[2 * n + 2]
-    if phase == STICK:
+
+@njit(cache=True)
+def new_work(mdl, like):
+    """Scratch arrays of ``evaluate`` in the dtype of ``like`` (float or complex)."""
+    n, ns, _ = sizes(mdl)
+    width = int(mdl.opts[O_LMAX]) + 2
+    dt = like.dtype
+    return (
+        np.zeros((ns, n), dt),  # g_j
+        np.zeros((ns, n), dt),  # g'_j
+        np.zeros(n, dt),  # disc forces without the contacts
+        np.zeros(width, dt),  # cos(l psi)
+        np.zeros(width, dt),  # sin(l psi)
+        np.zeros((N_AUX, ns), dt),  # per-slider quantities (layout.A_*)
+        np.zeros((ns, ns), dt),  # the normal forces' system
+        np.zeros(ns, dt),  # its right-hand side
+        np.zeros(ns, np.int64),  # sliders in contact
+    )
+
+
+@njit(cache=True)
+def _disc_forces(t, y, om, omd, mdl, fq, dy):
+    """Disc forces that do not depend on the contacts: stiffness, spin, damping."""
+    n, _, half = sizes(mdl)
+    eps = mdl.opts[O_OMDOT]
+    damped = mdl.opts[O_DAMPED] != 0.0
+    om2 = om * om
+    for i in range(n):
+        qi = y[i]
+        p = mdl.partner[i]
+        fi = -(mdl.kd[i] - mdl.ml2[i] * om2) * qi
+        if p >= 0:
+            fi -= mdl.gyr[i] * (2.0 * om * y[half + p] + eps * omd * y[p] * mdl.omd_fix[i])
+        if damped:
+            fi -= mdl.cdamp[i] * y[half + i]
+            if p >= 0:
+                fi -= mdl.cdamp_om[i] * om * y[p]
+        fq[i] = fi
+        dy[i] = y[half + i]
+
+
+@njit(cache=True)
+def _slider_sums(j, y, ph, om, mdl, wk):
+    """Mode shapes at slider j (rows j of g, g') and the sums over the modal coordinates
+    that its contact needs (rows of ``aux``)."""
+    g, gp, fq, cl, sl, aux, _, _, _ = wk
+    n, _, half = sizes(mdl)
+    phi = y[n + j]
+    phid = y[half + n + j]
+    if ph[j] == STICK:
         phid = phid * 0.0 + om
     zero = phi * 0.0
-
-    g = work[0]
-    gp = work[1]
-    fq = work[2]
-    cl = work[3]
-    sl = work[4]
-    lmax = int(par[P_LMAX])
-    # cos(l phi), sin(l phi) by the Chebyshev recurrence: two trig calls per evaluation.
-    c1 = np.cos(phi)
-    s1 = np.sin(phi)
+    psi = mdl.theta[j] + phi
+    lmax = int(mdl.opts[O_LMAX])
+    # cos(l psi), sin(l psi) by the Chebyshev recurrence: two trig calls per slider.
+    c1 = np.cos(psi)
+    s1 = np.sin(psi)
     cl[0] = 1.0 + zero
     sl[0] = zero
     if lmax >= 1:
@@ -115,8 +179,6 @@ def evaluate(t, y, phase, s, right, mdl, work, dy):
     for k in range(1, lmax):
         cl[k + 1] = 2.0 * c1 * cl[k] - cl[k - 1]
         sl[k + 1] = 2.0 * c1 * sl[k] - sl[k - 1]
-
-    om2 = om * om
     wc = zero
     wcd = zero
     gpq = zero
@@ -125,138 +187,283 @@ def evaluate(t, y, phase, s, right, mdl, work, dy):
     s_gf = zero
     s_gg = zero
     s_ggp = zero
-    for j in range(n):
-        lj = li[j]
-        # Branch-free g = R cos(l phi) (C, sgn = 1) or R sin(l phi) (D, sgn = -1).
-        cs = 0.5 + 0.5 * sgn[j]
-        sn = 0.5 - 0.5 * sgn[j]
-        gj = R0[j] * (cs * cl[lj] + sn * sl[lj])
-        gpj = lj * R0[j] * (sn * cl[lj] - cs * sl[lj])
-        g[j] = gj
-        gp[j] = gpj
-        qj = y[j]
-        qdj = y[n + 2 + j]
-        wc += gj * qj
-        wcd += gj * qdj
-        gpq += gpj * qj
-        gpqd += gpj * qdj
-        l2gq += lj * lj * gj * qj
-        p = partner[j]
-        fj = -(kd[j] - ml2[j] * om2) * qj
-        if p >= 0:
-            fj -= gyr[j] * (2.0 * om * y[n + 2 + p] + eps * omd * y[p])
-        fq[j] = fj
-        s_gf += gj * fj * minv[j]
-        s_gg += gj * gj * minv[j]
-        s_ggp += gj * gpj * minv[j]
-        dy[j] = qdj
+    shape = mdl.shape[j]
+    for i in range(n):
+        li = mdl.l[i]
+        # Branch-free g = R cos(l psi) (C, sgn = 1) or R sin(l psi) (D, sgn = -1).
+        cs = 0.5 + 0.5 * mdl.sgn[i]
+        sn = 0.5 - 0.5 * mdl.sgn[i]
+        gi = shape[i] * (cs * cl[li] + sn * sl[li])
+        gpi = li * shape[i] * (sn * cl[li] - cs * sl[li])
+        g[j, i] = gi
+        gp[j, i] = gpi
+        qi = y[i]
+        qdi = y[half + i]
+        wc += gi * qi
+        wcd += gi * qdi
+        gpq += gpi * qi
+        gpqd += gpi * qdi
+        l2gq += li * li * gi * qi
+        s_gf += gi * fq[i] * mdl.minv[i]
+        s_gg += gi * gi * mdl.minv[i]
+        s_ggp += gi * gpi * mdl.minv[i]
     wcd += phid * gpq
-    v = om - phid
+    aux[A_WC, j] = wc
+    aux[A_WCD, j] = wcd
+    aux[A_V, j] = om - phid
+    aux[A_GPQ, j] = gpq
+    aux[A_GPQD, j] = gpqd
+    aux[A_L2GQ, j] = l2gq
+    aux[A_SGF, j] = s_gf
+    aux[A_SGG, j] = s_gg
+    aux[A_SGGP, j] = s_ggp
+    aux[A_PHID, j] = phid
+    aux[A_N, j] = zero
+    aux[A_F, j] = zero
 
-    dy[n] = phid
-    if phase == SEPARATION:
-        for j in range(n):
-            dy[n + 2 + j] = fq[j] * minv[j]
-        dy[2 * n + 2] = (-par[P_CPHI] * phid - par[P_KPHI] * phi) / inertia
-        dy[n + 1] = y[2 * n + 3]
-        dy[2 * n + 3] = (-par[P_N0] - par[P_CZ] * y[2 * n + 3] - par[P_KZ] * y[n + 1]) / m
-        return zero, zero, wc, wcd, v
 
-    dy[n + 1] = zero
-    dy[2 * n + 3] = zero
-    # Normal force without the slider-acceleration terms that depend on the unknowns.
-    n_known = (
-        par[P_N0]
-        + m * (2.0 * phid * gpqd - phid * phid * l2gq)
-        + par[P_CZ] * wcd
-        + par[P_KZ] * wc
-    )
-    hh = par[P_HALF_H_OVER_R0]
-    r0 = par[P_R0]
-    if phase == SLIP:
-        mu = par[P_MU1] + (par[P_MU0] - par[P_MU1]) * np.exp(-par[P_ALPHA] * r0 * s * v)
-        smu = s * mu
-        fphi = -par[P_CPHI] * phid - par[P_KPHI] * phi
-        # Rank-one elimination of N from [M q'' + N e = Fq; I phi'' = Fphi + r0 s mu N;
-        # N = n_known + m (g.q'' + g'.q phi'')] with e = g - hh s mu g': O(n), no solve.
-        nf = (n_known + m * s_gf + m * gpq * fphi / inertia) / (
-            1.0 + m * (s_gg - hh * smu * s_ggp) - m * gpq * r0 * smu / inertia
+@njit(cache=True)
+def solve_small(a, b, m):
+    """Solve the leading ``m x m`` block of ``a x = b`` in place (``b`` becomes x) by
+    Gaussian elimination with partial pivoting on the real parts. For m = 1 it is one
+    division."""
+    for c in range(m):
+        piv = c
+        best = abs(a[c, c].real)
+        for r in range(c + 1, m):
+            if abs(a[r, c].real) > best:
+                best = abs(a[r, c].real)
+                piv = r
+        if piv != c:
+            for k in range(m):
+                tmp = a[c, k]
+                a[c, k] = a[piv, k]
+                a[piv, k] = tmp
+            tmp = b[c]
+            b[c] = b[piv]
+            b[piv] = tmp
+        for r in range(c + 1, m):
+            fac = a[r, c] / a[c, c]
+            for k in range(c, m):
+                a[r, k] -= fac * a[c, k]
+            b[r] -= fac * b[c]
+    for c in range(m - 1, -1, -1):
+        acc = b[c]
+        for k in range(c + 1, m):
+            acc -= a[c, k] * b[k]
+        b[c] = acc / a[c, c]
+
+
+@njit(cache=True)
+def evaluate(t, y, ph, sg, right, mdl, wk, dy):
+    """Time derivative ``dy`` of the state, slider j in phase ``ph[j]`` (slip sign
+    ``sg[j]``).
+
+    Fills ``wk``'s per-slider rows (``layout.A_*``): normal force [N], friction force
+    on the slider [N] (positive along +phi), the disc's w under it [m] and its rate
+    [m/s], the relative speed ``Omega - phidot`` [rad/s], ... and rows of g and g' at
+    every slider. ``right`` picks the right limit of the speed at a knot.
+    """
+    g, gp, fq, cl, sl, aux, amat, bvec, cidx = wk
+    n, ns, half = sizes(mdl)
+    om, omd = speed_at(t, mdl.knots, mdl.coef, right)
+    _disc_forces(t, y, om, omd, mdl, fq, dy)
+
+    nc = 0
+    for j in range(ns):
+        _slider_sums(j, y, ph, om, mdl, wk)
+        phid = aux[A_PHID, j]
+        phi = y[n + j]
+        dy[n + j] = phid
+        if ph[j] == SEPARATION:
+            zj = y[n + ns + j]
+            zdj = y[half + n + ns + j]
+            dy[half + n + j] = (-mdl.cphi[j] * phid - mdl.kphi[j] * phi) / mdl.inertia[j]
+            dy[n + ns + j] = zdj
+            dy[half + n + ns + j] = (-mdl.sn0[j] - mdl.cz[j] * zdj - mdl.kz[j] * zj) / mdl.mass[j]
+            continue
+        dy[n + ns + j] = phi * 0.0
+        dy[half + n + ns + j] = phi * 0.0
+        cidx[nc] = j
+        nc += 1
+        # The part of N that does not depend on the unknown accelerations.
+        aux[A_KNOWN, j] = (
+            mdl.n0[j]
+            + mdl.smass[j] * (2.0 * phid * aux[A_GPQD, j] - phid * phid * aux[A_L2GQ, j])
+            + mdl.scz[j] * aux[A_WCD, j]
+            + mdl.skz[j] * aux[A_WC, j]
         )
-        f = smu * nf
-        for j in range(n):
-            dy[n + 2 + j] = (fq[j] - nf * (g[j] - hh * smu * gp[j])) * minv[j]
-        dy[2 * n + 2] = (fphi + r0 * f) / inertia
-        return nf, f, wc, wcd, v
+        if ph[j] == SLIP:
+            aux[A_SMU, j] = sg[j] * kinetic_friction(mdl, mdl.radius[j], sg[j], aux[A_V, j])
+            aux[A_FPHI, j] = -mdl.cphi[j] * phid - mdl.kphi[j] * phi
+        else:
+            # Stick: phi'' = Omegadot, friction is the reaction of the in-plane oscillator.
+            aux[A_F, j] = (mdl.inertia[j] * omd + mdl.cphi[j] * om + mdl.kphi[j] * phi) / (
+                mdl.radius[j]
+            )
 
-    # Stick: phi'' = Omegadot, friction is the reaction of the in-plane oscillator.
-    f = (inertia * omd + par[P_CPHI] * om + par[P_KPHI] * phi) / r0
-    nf = (n_known + m * (s_gf + hh * f * s_ggp) + m * gpq * omd) / (1.0 + m * s_gg)
-    for j in range(n):
-        dy[n + 2 + j] = (fq[j] + hh * f * gp[j] - nf * g[j]) * minv[j]
-    dy[2 * n + 2] = omd + zero
-    return nf, f, wc, wcd, v
+    # One equation per slider in contact for its normal force: N_j = known_j +
+    # sigma_j m_j (g_j.q'' + g'_j.q phi_j''), with q'' = M^-1 (F + sum_k sigma_k (-N_k g_k
+    # + h_k f_k g'_k)) and, in slip, phi_j'' = (F_phi + r s mu N_j) / I.
+    for a in range(nc):
+        j = cidx[a]
+        m = mdl.mass[j]
+        sm = mdl.smass[j]
+        gpq = aux[A_GPQ, j]
+        cross = y[n] * 0.0
+        for b in range(nc):
+            k = cidx[b]
+            if k == j:
+                continue
+            # g_j M^-1 g_k and g_j M^-1 g'_k.
+            sgg = cross * 0.0
+            sggp = cross * 0.0
+            for i in range(n):
+                sgg += g[j, i] * g[k, i] * mdl.minv[i]
+                sggp += g[j, i] * gp[k, i] * mdl.minv[i]
+            sig = mdl.sigma[j] * mdl.sigma[k]
+            if ph[k] == SLIP:
+                amat[a, b] = sig * m * (sgg - mdl.hh[k] * aux[A_SMU, k] * sggp)
+            else:
+                amat[a, b] = sig * m * sgg
+                cross += mdl.shh[k] * aux[A_F, k] * sggp
+        if ph[j] == SLIP:
+            smu = aux[A_SMU, j]
+            amat[a, a] = (
+                1.0
+                + m * (aux[A_SGG, j] - mdl.hh[j] * smu * aux[A_SGGP, j])
+                - sm * gpq * mdl.radius[j] * smu / mdl.inertia[j]
+            )
+            bvec[a] = (
+                aux[A_KNOWN, j]
+                + sm * (aux[A_SGF, j] + cross)
+                + sm * gpq * aux[A_FPHI, j] / mdl.inertia[j]
+            )
+        else:
+            amat[a, a] = 1.0 + m * aux[A_SGG, j]
+            bvec[a] = (
+                aux[A_KNOWN, j]
+                + sm * (aux[A_SGF, j] + mdl.shh[j] * aux[A_F, j] * aux[A_SGGP, j] + cross)
+                + sm * gpq * omd
+            )
+    solve_small(amat, bvec, nc)
+
+    for i in range(n):
+        acc = fq[i]
+        for a in range(nc):
+            j = cidx[a]
+            sn = mdl.sigma[j] * bvec[a]
+            if ph[j] == SLIP:
+                acc = acc - sn * (g[j, i] - mdl.hh[j] * aux[A_SMU, j] * gp[j, i])
+            else:
+                acc = acc + mdl.shh[j] * aux[A_F, j] * gp[j, i]
+                acc = acc - sn * g[j, i]
+        dy[half + i] = acc * mdl.minv[i]
+    for a in range(nc):
+        j = cidx[a]
+        aux[A_N, j] = bvec[a]
+        if ph[j] == SLIP:
+            aux[A_F, j] = aux[A_SMU, j] * bvec[a]
+            dy[half + n + j] = (aux[A_FPHI, j] + mdl.radius[j] * aux[A_F, j]) / mdl.inertia[j]
+        else:
+            dy[half + n + j] = omd + y[n + j] * 0.0
+
+    if y.shape[0] > n_dynamic(mdl):
+        _powers(y, ph, om, omd, mdl, wk, dy)
 
 
 @njit(cache=True)
-def event_values(phase, s, nf, f, wc, v, y, par, out):
-    """Event functions of a phase, positive while the phase holds; unused slots +inf."""
-    n = (y.shape[0] - 4) // 2
-    out[0] = np.inf
-    out[1] = np.inf
-    out[2] = np.inf
-    if phase == SLIP:
-        out[0] = s * v
-        out[1] = nf
-    elif phase == STICK:
-        mus = par[P_MUS]
-        out[0] = mus * nf - f
-        out[1] = mus * nf + f
-        out[2] = nf
-    else:
-        out[0] = y[n + 1] - wc
+def _powers(y, ph, om, omd, mdl, wk, dy):
+    """Rates of the energy accumulators (``layout.E_*``) [W]."""
+    gp = wk[1]
+    aux = wk[5]
+    n, ns, half = sizes(mdl)
+    e0 = n_dynamic(mdl)
+    zero = y[n] * 0.0
+    fric = zero
+    drive = zero
+    moment = zero
+    slope = zero
+    sdamp = zero
+    ddamp = zero
+    for j in range(ns):
+        phid = aux[A_PHID, j]
+        f = aux[A_F, j]
+        r = mdl.radius[j]
+        fric += f * r * (phid - om)
+        drive += f * r * om
+        gpqd = zero
+        for i in range(n):
+            gpqd += gp[j, i] * y[half + i]
+        moment += mdl.shh[j] * f * gpqd
+        slope += mdl.sigma[j] * aux[A_N, j] * phid * aux[A_GPQ, j]
+        if ph[j] == SEPARATION:
+            zd = y[half + n + ns + j]
+        else:
+            zd = aux[A_WCD, j]
+        sdamp -= mdl.cz[j] * zd * zd + mdl.cphi[j] * phid * phid
+    eps = mdl.opts[O_OMDOT]
+    for i in range(n):
+        p = mdl.partner[i]
+        qdi = y[half + i]
+        drive -= mdl.ml2[i] * om * omd * y[i] * y[i]
+        if p >= 0:
+            drive -= qdi * mdl.gyr[i] * (2.0 * om * y[half + p] + eps * omd * y[p] * mdl.omd_fix[i])
+            ddamp -= qdi * mdl.cdamp_om[i] * om * y[p]
+        ddamp -= qdi * mdl.cdamp[i] * qdi
+    dy[e0 + E_FRICTION] = fric
+    dy[e0 + E_DRIVE] = drive
+    dy[e0 + E_MOMENT] = moment
+    dy[e0 + E_SLOPE] = slope
+    dy[e0 + E_SLIDER_DAMPING] = sdamp
+    dy[e0 + E_DISC_DAMPING] = ddamp
+    for c in range(E_DISC_DAMPING + 1, y.shape[0] - e0):
+        dy[e0 + c] = zero
 
 
 @njit(cache=True)
-def plastic_impact(y, mdl, work):
-    """Perfectly plastic re-contact (paper Eqs. 47-56): positions kept, slider and disc
-    leave with one normal velocity. ``work[0]``/``work[1]`` must hold g, g' at ``y``."""
-    par = mdl[M_PAR]
-    minv = mdl[M_MINV]
-    n = minv.shape[0]
-    m = par[P_MASS]
-    g = work[0]
-    gp = work[1]
-    zd_minus = y[2 * n + 3]
-    ratio = 0.0
-    disc = 0.0
-    for j in range(n):
-        ratio += m * g[j] * g[j] * minv[j]
-        disc += g[j] * y[n + 2 + j] + y[2 * n + 2] * gp[j] * y[j]
-    zd_plus = (disc + ratio * zd_minus) / (1.0 + ratio)
-    for j in range(n):
-        y[n + 2 + j] -= m * g[j] * minv[j] * (zd_plus - zd_minus)
-    y[2 * n + 3] = zd_plus
+def event_values(ph, sg, y, mdl, wk, out):
+    """Event functions of every slider's phase, positive while it holds (3 per slider;
+    unused slots +inf). Needs ``wk`` filled by ``evaluate`` at ``y``."""
+    aux = wk[5]
+    n, ns, _ = sizes(mdl)
+    mus = mdl.fric[F_MUS]
+    for j in range(ns):
+        o = 3 * j
+        out[o] = np.inf
+        out[o + 1] = np.inf
+        out[o + 2] = np.inf
+        nf = aux[A_N, j]
+        if ph[j] == SLIP:
+            out[o] = sg[j] * aux[A_V, j]
+            out[o + 1] = nf
+        elif ph[j] == STICK:
+            f = aux[A_F, j]
+            out[o] = mus * nf - f
+            out[o + 1] = mus * nf + f
+            out[o + 2] = nf
+        else:
+            out[o] = mdl.sigma[j] * (y[n + ns + j] - aux[A_WC, j])
 
 
 @njit(cache=True)
-def complex_step_jacobian(t, y, phase, s, mdl):
-    """Exact Jacobian d(dy/dt)/dy of a contact or separation phase by the complex step.
+def complex_step_jacobian(t, y, ph, sg, mdl):
+    """Exact Jacobian d(dy/dt)/dy of the phases ``ph`` by the complex step.
 
     Each column costs one complex evaluation; the result has no subtractive
     cancellation, so it is exact to rounding (step 1e-30).
     """
     ns = y.shape[0]
-    width = max(ns, int(mdl[0][P_LMAX]) + 2)
-    work = np.zeros((5, width), dtype=np.complex128)
     yc = np.empty(ns, dtype=np.complex128)
     dy = np.empty(ns, dtype=np.complex128)
+    wk = new_work(mdl, yc)
     jac = np.empty((ns, ns))
     step = 1e-30
     for i in range(ns):
         for j in range(ns):
             yc[j] = y[j]
         yc[i] = y[i] + 1j * step
-        evaluate(t, yc, phase, s, True, mdl, work, dy)
+        evaluate(t, yc, ph, sg, True, mdl, wk, dy)
         for j in range(ns):
             jac[j, i] = dy[j].imag / step
     return jac

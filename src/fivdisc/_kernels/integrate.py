@@ -17,19 +17,31 @@ import numpy as np
 from numba import njit
 
 from fivdisc._kernels.dopri5 import A, C, E, dense_coefficients, dense_eval
-from fivdisc._kernels.dynamics import (
-    M_COEF,
-    M_KNOTS,
-    P_IMPACT,
-    P_LMAX,
-    P_MUS,
+from fivdisc._kernels.dynamics import evaluate, event_values, new_work, speed_at
+from fivdisc._kernels.impact import contact_impact, contact_velocity, single_impact
+from fivdisc._kernels.layout import (
+    A_F,
+    A_GPQ,
+    A_GPQD,
+    A_L2GQ,
+    A_N,
+    A_PHID,
+    A_WC,
+    A_WCD,
+    E_IMPACT,
+    EV_RECONTACT,
+    EV_REVERSAL,
+    EV_SEPARATION,
+    EV_SLIP,
+    EV_STICK,
+    F_MUS,
+    O_IMPACT,
+    O_MIN_FLIGHT,
     SEPARATION,
     SLIP,
     STICK,
-    evaluate,
-    event_values,
-    plastic_impact,
-    speed_at,
+    n_dynamic,
+    sizes,
 )
 
 # Status codes (``ist[I_STATUS]``).
@@ -48,34 +60,25 @@ _EXPO1 = 0.2 - 0.75 * _BETA
 # Interior points (+1) at which a near-zero event function is probed within a step.
 _PROBES = 4
 
-# Event kinds.
-EV_STICK = 0
-EV_SLIP = 1
-EV_REVERSAL = 2
-EV_SEPARATION = 3
-EV_RECONTACT = 4
-
 # Integer state slots.
-I_PHASE = 0
-I_SIGN = 1
-I_STATUS = 2
-I_STEPS = 3
-I_REJECTED = 4
-I_RHS = 5
-I_OUT_NEXT = 6
-I_EVENTS = 7
-I_SWITCHES = 8
-I_ZENO = 9
-I_STARTED = 10
-I_FAIL_PHASE = 11
-I_EVAL_EVENTS = 12
-N_ISTATE = 13
+I_STATUS = 0
+I_STEPS = 1
+I_REJECTED = 2
+I_RHS = 3
+I_OUT_NEXT = 4
+I_EVENTS = 5
+I_SWITCHES = 6
+I_ZENO = 7
+I_STARTED = 8
+I_EVAL_EVENTS = 9
+N_ISTATE = 10
 
 # Float state slots.
 F_T = 0
 F_H = 1
 F_LAST_SWITCH = 2
-N_FSTATE = 3
+F_H_CAP = 3
+N_FSTATE = 4
 
 # Control slots.
 C_RTOL = 0
@@ -89,29 +92,41 @@ C_ZENO_COUNT = 7
 C_STOP_MASK = 8
 N_CONTROL = 9
 
+# Columns of the event table's integer part.
+EVI_KIND = 0
+EVI_FROM = 1
+EVI_TO = 2
+EVI_SLIDER = 3
+N_EVI = 4
+
 
 @njit(cache=True)
-def _contact_kinematics_into_slider(y, wc, wcd):
-    n = (y.shape[0] - 4) // 2
-    y[n + 1] = wc
-    y[2 * n + 3] = wcd
+def _separate(j, y, ph, mdl, wk):
+    """Slider j leaves the disc: its own z, zdot start from the contact kinematics that
+    the last ``evaluate`` left in ``wk``."""
+    aux = wk[5]
+    n, ns, half = sizes(mdl)
+    y[n + ns + j] = aux[A_WC, j]
+    y[half + n + ns + j] = aux[A_WCD, j]
+    ph[j] = SEPARATION
 
 
 @njit(cache=True)
-def choose_contact_phase(t, y, s_hint, mdl, work, dy):
-    """Phase of a slider in contact at state ``y``: stick, slip (with its sign) or,
-    where contact would need a pulling normal force, separation."""
-    par = mdl[0]
-    knots = mdl[M_KNOTS]
-    coef = mdl[M_COEF]
-    n = (y.shape[0] - 4) // 2
-    om, _ = speed_at(t, knots, coef, True)
-    v = om - y[2 * n + 2]
-    s = s_hint
+def choose_phase(j, t, y, ph, sg, mdl, wk, dy):
+    """Phase of slider j in contact at state ``y``, the others' phases held: stick, slip
+    (with its sign) or, where contact would need a pulling normal force, separation."""
+    aux = wk[5]
+    n, ns, half = sizes(mdl)
+    om, _ = speed_at(t, mdl.knots, mdl.coef, True)
+    v = om - y[half + n + j]
+    s = sg[j]
     if v == 0.0:
-        nf, f, wc, wcd, _ = evaluate(t, y, STICK, s, True, mdl, work, dy)
-        if nf > 0.0 and abs(f) < par[P_MUS] * nf:
-            return STICK, s
+        ph[j] = STICK
+        evaluate(t, y, ph, sg, True, mdl, wk, dy)
+        nf = aux[A_N, j]
+        f = aux[A_F, j]
+        if nf > 0.0 and abs(f) < mdl.fric[F_MUS] * nf:
+            return
         if f > 0.0:
             s = 1
         elif f < 0.0:
@@ -120,29 +135,30 @@ def choose_contact_phase(t, y, s_hint, mdl, work, dy):
         s = 1
     else:
         s = -1
-    nf, f, wc, wcd, _ = evaluate(t, y, SLIP, s, True, mdl, work, dy)
-    if nf < 0.0:
-        _contact_kinematics_into_slider(y, wc, wcd)
-        return SEPARATION, s
-    return SLIP, s
+    ph[j] = SLIP
+    sg[j] = s
+    evaluate(t, y, ph, sg, True, mdl, wk, dy)
+    if aux[A_N, j] < 0.0:
+        _separate(j, y, ph, mdl, wk)
 
 
 @njit(cache=True)
-def _record(t, kind, frm, to, ev_t, ev_i, ist):
+def _record(t, kind, frm, to, j, ev_t, ev_i, ist):
     i = ist[I_EVENTS]
     if i < ev_t.shape[0]:
         ev_t[i] = t
-        ev_i[i, 0] = kind
-        ev_i[i, 1] = frm
-        ev_i[i, 2] = to
+        ev_i[i, EVI_KIND] = kind
+        ev_i[i, EVI_FROM] = frm
+        ev_i[i, EVI_TO] = to
+        ev_i[i, EVI_SLIDER] = j
         ist[I_EVENTS] = i + 1
 
 
 @njit(cache=True)
-def _record_change(t, old_phase, old_s, new_phase, new_s, ev_t, ev_i, ist):
+def _record_change(t, old_phase, old_s, new_phase, new_s, j, ev_t, ev_i, ist):
     if old_phase == new_phase:
         if new_phase == SLIP and old_s != new_s:
-            _record(t, EV_REVERSAL, old_phase, new_phase, ev_t, ev_i, ist)
+            _record(t, EV_REVERSAL, old_phase, new_phase, j, ev_t, ev_i, ist)
         return
     if new_phase == SEPARATION:
         kind = EV_SEPARATION
@@ -152,57 +168,214 @@ def _record_change(t, old_phase, old_s, new_phase, new_s, ev_t, ev_i, ist):
         kind = EV_STICK
     else:
         kind = EV_SLIP
-    _record(t, kind, old_phase, new_phase, ev_t, ev_i, ist)
+    _record(t, kind, old_phase, new_phase, j, ev_t, ev_i, ist)
 
 
 @njit(cache=True)
-def apply_switch(which, t, y, phase, s, mdl, work, dy, ev_t, ev_i, ist):
-    """Carry the state across the switch triggered by event ``which`` of ``phase``."""
-    par = mdl[0]
-    knots = mdl[M_KNOTS]
-    coef = mdl[M_COEF]
-    n = (y.shape[0] - 4) // 2
-    if phase == SEPARATION:
-        # Re-contact: fill g, g' for the impact map, then pick the contact phase.
-        evaluate(t, y, SEPARATION, s, True, mdl, work, dy)
-        if par[P_IMPACT] != 0.0:
-            plastic_impact(y, mdl, work)
-        _record(t, EV_RECONTACT, SEPARATION, SLIP, ev_t, ev_i, ist)
-        new_phase, new_s = choose_contact_phase(t, y, s, mdl, work, dy)
-        if new_phase == SEPARATION:
-            _record(t, EV_SEPARATION, SLIP, SEPARATION, ev_t, ev_i, ist)
+def settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist):
+    """After a switch, re-check every slider in contact (several sliders only): one that
+    would need N < 0 separates, a sticking one beyond the static limit slips; violators
+    switch one at a time, lowest index first, until none is left."""
+    aux = wk[5]
+    n, ns, half = sizes(mdl)
+    if ns == 1:
+        return
+    om, _ = speed_at(t, mdl.knots, mdl.coef, True)
+    for _ in range(4 * ns + 4):
+        evaluate(t, y, ph, sg, True, mdl, wk, dy)
+        changed = False
+        for k in range(ns):
+            if ph[k] == SEPARATION:
+                continue
+            nf = aux[A_N, k]
+            f = aux[A_F, k]
+            if nf < 0.0:
+                old = ph[k]
+                if old == STICK:
+                    y[half + n + k] = om
+                _separate(k, y, ph, mdl, wk)
+                _record(t, EV_SEPARATION, old, SEPARATION, k, ev_t, ev_i, ist)
+                changed = True
+                break
+            if ph[k] == STICK and abs(f) > mdl.fric[F_MUS] * nf:
+                ph[k] = SLIP
+                sg[k] = 1 if f > 0.0 else -1
+                _record(t, EV_SLIP, STICK, SLIP, k, ev_t, ev_i, ist)
+                changed = True
+                break
+        if not changed:
+            return
+
+
+@njit(cache=True)
+def _surface_acceleration(k, y, mdl, wk, dy):
+    """Normal acceleration of the disc's surface under slider k, from ``evaluate``'s
+    derivatives ``dy`` at ``y`` [m/s^2]."""
+    g = wk[0]
+    aux = wk[5]
+    n, ns, half = sizes(mdl)
+    phid = aux[A_PHID, k]
+    acc = 2.0 * phid * aux[A_GPQD, k] - phid * phid * aux[A_L2GQ, k]
+    acc += dy[half + n + k] * aux[A_GPQ, k]
+    for i in range(n):
+        acc += g[k, i] * dy[half + i]
+    return acc
+
+
+@njit(cache=True)
+def _impact(j, t, y, ph, sg, mdl, wk, dy, fst, released):
+    """Plastic impact of slider j landing while others are in contact.
+
+    Contacts the impact releases are returned in ``released`` (count returned). A
+    release whose flight would last less than the minimum flight time, or whose peak
+    gap is below round-off, is closed instead (the contact is made bilateral and the
+    impact solved again): this ends an impact cascade. Shorter steps are asked for
+    (``fst[F_H_CAP]``) so that the flights that remain are resolved.
+    """
+    n, ns, half = sizes(mdl)
+    members = np.empty(ns, np.int64)
+    members[0] = j
+    count = 1
+    for k in range(ns):
+        if k != j and ph[k] != SEPARATION:
+            members[count] = k
+            count += 1
+    if count == 1:
+        single_impact(j, y, mdl, wk)
+        return 0
+    aux = wk[5]
+    for a in range(1, count):
+        k = members[a]
+        y[half + n + ns + k] = contact_velocity(k, y, mdl, wk)
+    y_pre = y.copy()
+    forced = np.zeros(count, np.bool_)
+    w = np.empty(count)
+    old_ph = ph.copy()
+    min_flight = mdl.opts[O_MIN_FLIGHT]
+    nrel = 0
+    for _ in range(count + 1):
+        y[:] = y_pre
+        contact_impact(members[:count], count, y, mdl, wk, forced, w)
+        nrel = 0
+        for a in range(count):
+            if w[a] > 0.0:
+                released[nrel] = members[a]
+                nrel += 1
+        if nrel == 0:
+            break
+        # Predict each flight from the gap's velocity and acceleration just after, with
+        # the landing slider in contact unless it leaves too.
+        for a in range(count):
+            k = members[a]
+            if w[a] > 0.0:
+                ph[k] = SEPARATION
+                y[n + ns + k] = aux[A_WC, k]
+            elif k == j:
+                ph[k] = SLIP
+        evaluate(t, y, ph, sg, True, mdl, wk, dy)
+        again = False
+        for a in range(count):
+            if w[a] <= 0.0:
+                continue
+            k = members[a]
+            gdd = mdl.sigma[k] * (dy[half + n + ns + k] - _surface_acceleration(k, y, mdl, wk, dy))
+            if gdd >= 0.0:
+                continue
+            flight = 2.0 * w[a] / -gdd
+            peak = 0.5 * w[a] * w[a] / -gdd
+            zscale = abs(y[n + ns + k]) + abs(aux[A_WC, k])
+            if flight < min_flight or peak <= 4.0 * 2.220446049250313e-16 * zscale:
+                forced[a] = True
+                again = True
+            else:
+                fst[F_H_CAP] = min(fst[F_H_CAP], flight)
+        for a in range(count):
+            ph[members[a]] = old_ph[members[a]]
+        if not again:
+            break
+        nrel = 0
+    return nrel
+
+
+@njit(cache=True)
+def apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst):
+    """Carry the state across the switch triggered by event ``e`` (slider e // 3)."""
+    aux = wk[5]
+    n, ns, half = sizes(mdl)
+    j = e // 3
+    which = e % 3
+    if ph[j] == SEPARATION:
+        # Re-contact: g, g' at the landing state for the impact map, then the phases.
+        evaluate(t, y, ph, sg, True, mdl, wk, dy)
+        released = np.empty(ns, np.int64)
+        nrel = 0
+        if mdl.opts[O_IMPACT] != 0.0:
+            nrel = _impact(j, t, y, ph, sg, mdl, wk, dy, fst, released)
         else:
-            ev_i[ist[I_EVENTS] - 1, 2] = new_phase
-        return new_phase, new_s
-    is_normal_force_event = (phase == SLIP and which == 1) or (phase == STICK and which == 2)
+            # Velocities are kept; the slider takes the disc's normal velocity.
+            zd_old = y[half + n + ns + j]
+            zd_new = contact_velocity(j, y, mdl, wk)
+            y[half + n + ns + j] = zd_new
+            e0 = n_dynamic(mdl)
+            if y.shape[0] > e0:
+                y[e0 + E_IMPACT] += 0.5 * mdl.mass[j] * (zd_new * zd_new - zd_old * zd_old)
+        # Contacts the impact released fly from where they are.
+        before = ph.copy()
+        landing_leaves = False
+        for a in range(nrel):
+            k = released[a]
+            landing_leaves = landing_leaves or k == j
+            ph[k] = SEPARATION
+            y[n + ns + k] = aux[A_WC, k]
+        _record(t, EV_RECONTACT, SEPARATION, SLIP, j, ev_t, ev_i, ist)
+        first = ist[I_EVENTS] - 1
+        if landing_leaves:
+            _record(t, EV_SEPARATION, SLIP, SEPARATION, j, ev_t, ev_i, ist)
+        else:
+            choose_phase(j, t, y, ph, sg, mdl, wk, dy)
+            if ph[j] == SEPARATION:
+                _record(t, EV_SEPARATION, SLIP, SEPARATION, j, ev_t, ev_i, ist)
+            elif first >= 0:
+                ev_i[first, EVI_TO] = ph[j]
+        for a in range(nrel):
+            k = released[a]
+            if k != j:
+                _record(t, EV_SEPARATION, before[k], SEPARATION, k, ev_t, ev_i, ist)
+        settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
+        return
+    is_normal_force_event = (ph[j] == SLIP and which == 1) or (ph[j] == STICK and which == 2)
     if is_normal_force_event:
-        _, _, wc, wcd, _ = evaluate(t, y, phase, s, True, mdl, work, dy)
-        if phase == STICK:
-            om, _ = speed_at(t, knots, coef, True)
-            y[2 * n + 2] = om
-        _contact_kinematics_into_slider(y, wc, wcd)
-        _record(t, EV_SEPARATION, phase, SEPARATION, ev_t, ev_i, ist)
-        return SEPARATION, s
+        evaluate(t, y, ph, sg, True, mdl, wk, dy)
+        old = ph[j]
+        if old == STICK:
+            om, _ = speed_at(t, mdl.knots, mdl.coef, True)
+            y[half + n + j] = om
+        _separate(j, y, ph, mdl, wk)
+        _record(t, EV_SEPARATION, old, SEPARATION, j, ev_t, ev_i, ist)
+        settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
+        return
     # Relative velocity reached zero (slip) or the static limit was reached (stick):
     # the slider moves with the disc at this instant; decide from the forces.
-    om, _ = speed_at(t, knots, coef, True)
-    y[2 * n + 2] = om
-    new_phase, new_s = choose_contact_phase(t, y, s, mdl, work, dy)
-    _record_change(t, phase, s, new_phase, new_s, ev_t, ev_i, ist)
-    return new_phase, new_s
+    om, _ = speed_at(t, mdl.knots, mdl.coef, True)
+    y[half + n + j] = om
+    old = ph[j]
+    old_s = sg[j]
+    choose_phase(j, t, y, ph, sg, mdl, wk, dy)
+    _record_change(t, old, old_s, ph[j], sg[j], j, ev_t, ev_i, ist)
+    settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
 
 
 @njit(cache=True)
-def _event_at(theta, i, t, h, rc, phase, s, mdl, work, dy, ytmp, evt, ist):
+def _event_at(theta, i, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist):
     ist[I_EVAL_EVENTS] += 1
     dense_eval(rc, theta, ytmp)
-    nf, f, wc, _, v = evaluate(t + theta * h, ytmp, phase, s, False, mdl, work, dy)
-    event_values(phase, s, nf, f, wc, v, ytmp, mdl[0], evt)
+    evaluate(t + theta * h, ytmp, ph, sg, False, mdl, wk, dy)
+    event_values(ph, sg, ytmp, mdl, wk, evt)
     return evt[i]
 
 
 @njit(cache=True)
-def locate(i, lo, hi, g_lo, g_hi, t, h, rc, phase, s, mdl, work, dy, ytmp, evt, ist):
+def locate(i, lo, hi, g_lo, g_hi, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist):
     """Fraction of the step at which event ``i`` crosses zero, taken on the far side.
 
     Illinois false position on the bracket [lo, hi] with g(lo) > 0 >= g(hi): the kept
@@ -228,7 +401,7 @@ def locate(i, lo, hi, g_lo, g_hi, t, h, rc, phase, s, mdl, work, dy, ytmp, evt, 
             mid = lo + width * g_lo / (g_lo - g_hi)
         # Keep the trial point strictly inside so that the bracket always shrinks.
         mid = min(max(mid, lo + 0.5 * tol), hi - 0.5 * tol)
-        gm = _event_at(mid, i, t, h, rc, phase, s, mdl, work, dy, ytmp, evt, ist)
+        gm = _event_at(mid, i, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist)
         if gm > 0.0:
             lo = mid
             g_lo = gm
@@ -245,7 +418,7 @@ def locate(i, lo, hi, g_lo, g_hi, t, h, rc, phase, s, mdl, work, dy, ytmp, evt, 
 
 
 @njit(cache=True)
-def _write_outputs(t0, t1, h, rc, phase, s, mdl, work, dy, ytmp, ctl, out_y, out_aux, ist):
+def _write_outputs(t0, t1, h, rc, ph, sg, mdl, wk, dy, ytmp, ctl, out_y, out_aux, ist):
     """Sample the dense output of the step [t0, t0 + h] at output times in (t0, t1]."""
     i = ist[I_OUT_NEXT]
     n_out = out_y.shape[0]
@@ -256,55 +429,60 @@ def _write_outputs(t0, t1, h, rc, phase, s, mdl, work, dy, ytmp, ctl, out_y, out
         if ti > t1:
             break
         dense_eval(rc, (ti - t0) / h, ytmp)
-        _write_sample(i, ti, ytmp, phase, s, mdl, work, dy, out_y, out_aux)
+        _write_sample(i, ti, ytmp, ph, sg, mdl, wk, dy, out_y, out_aux)
         i += 1
     ist[I_OUT_NEXT] = i
 
 
 @njit(cache=True)
-def _write_sample(i, ti, ys, phase, s, mdl, work, dy, out_y, out_aux):
-    n = (ys.shape[0] - 4) // 2
-    nf, f, wc, wcd, _ = evaluate(ti, ys, phase, s, False, mdl, work, dy)
-    om, _ = speed_at(ti, mdl[M_KNOTS], mdl[M_COEF], False)
-    if phase == STICK:
-        ys[2 * n + 2] = om
-    if phase != SEPARATION:
-        ys[n + 1] = wc
-        ys[2 * n + 3] = wcd
+def _write_sample(i, ti, ys, ph, sg, mdl, wk, dy, out_y, out_aux):
+    """One output row: the state with the contact kinematics filled in, and per slider
+    N, f, phase, w under it (columns j, S + j, 2 S + j, 3 S + j), then Omega."""
+    aux = wk[5]
+    n, ns, half = sizes(mdl)
+    evaluate(ti, ys, ph, sg, False, mdl, wk, dy)
+    om, _ = speed_at(ti, mdl.knots, mdl.coef, False)
+    for j in range(ns):
+        if ph[j] == STICK:
+            ys[half + n + j] = om
+        if ph[j] != SEPARATION:
+            ys[n + ns + j] = aux[A_WC, j]
+            ys[half + n + ns + j] = aux[A_WCD, j]
+        out_aux[i, j] = aux[A_N, j]
+        out_aux[i, ns + j] = aux[A_F, j]
+        out_aux[i, 2 * ns + j] = ph[j]
+        out_aux[i, 3 * ns + j] = aux[A_WC, j]
     out_y[i, :] = ys
-    out_aux[i, 0] = nf
-    out_aux[i, 1] = f
-    out_aux[i, 2] = phase
-    out_aux[i, 3] = wc
-    out_aux[i, 4] = om
+    out_aux[i, 4 * ns] = om
 
 
 @njit(cache=True)
-def _rms_scaled(a, y0, y1, atol, rtol):
+def _rms_scaled(a, y0, y1, atol, rtol, m):
+    """RMS of ``a[:m]`` scaled by ``atol + rtol max(|y0|, |y1|)``."""
     acc = 0.0
-    for i in range(a.shape[0]):
+    for i in range(m):
         sc = atol + rtol * max(abs(y0[i]), abs(y1[i]))
         acc += (a[i] / sc) ** 2
-    return np.sqrt(acc / a.shape[0])
+    return np.sqrt(acc / m)
 
 
 @njit(cache=True)
-def _initial_step(t, y, f0, phase, s, mdl, work, ctl, ytmp, dy):
+def _initial_step(t, y, f0, ph, sg, mdl, wk, ctl, ytmp, dy, m):
     """Starting step size (Hairer, Norsett & Wanner, Sec. II.4)."""
     rtol = ctl[C_RTOL]
     atol = ctl[C_ATOL]
-    d0 = _rms_scaled(y, y, y, atol, rtol)
-    d1 = _rms_scaled(f0, y, y, atol, rtol)
+    d0 = _rms_scaled(y, y, y, atol, rtol, m)
+    d1 = _rms_scaled(f0, y, y, atol, rtol, m)
     if d0 < 1e-5 or d1 < 1e-5:
         h0 = 1e-6
     else:
         h0 = 0.01 * d0 / d1
     for i in range(y.shape[0]):
         ytmp[i] = y[i] + h0 * f0[i]
-    evaluate(t + h0, ytmp, phase, s, False, mdl, work, dy)
+    evaluate(t + h0, ytmp, ph, sg, False, mdl, wk, dy)
     for i in range(y.shape[0]):
         dy[i] = (dy[i] - f0[i]) / h0
-    d2 = _rms_scaled(dy, y, y, atol, rtol)
+    d2 = _rms_scaled(dy, y, y, atol, rtol, m)
     if max(d1, d2) <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
     else:
@@ -313,25 +491,42 @@ def _initial_step(t, y, f0, phase, s, mdl, work, ctl, ytmp, dy):
 
 
 @njit(cache=True)
-def _restart(t, y, phase, s, mdl, work, k, ev_prev):
-    nf, f, wc, _, v = evaluate(t, y, phase, s, True, mdl, work, k[0])
-    event_values(phase, s, nf, f, wc, v, y, mdl[0], ev_prev)
+def _restart(t, y, ph, sg, mdl, wk, k, ev_prev):
+    evaluate(t, y, ph, sg, True, mdl, wk, k[0])
+    event_values(ph, sg, y, mdl, wk, ev_prev)
 
 
 @njit(cache=True)
-def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_t, ev_i):
+def start(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist):
+    """Phases at the start: each slider in contact takes the phase its state allows, in
+    slider order; one whose contact would need N < 0 starts separated (recorded)."""
+    ns = ph.shape[0]
+    for j in range(ns):
+        if ph[j] != SEPARATION:
+            choose_phase(j, t, y, ph, sg, mdl, wk, dy)
+            if ph[j] == SEPARATION:
+                _record(t, EV_SEPARATION, SLIP, SEPARATION, j, ev_t, ev_i, ist)
+    settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
+
+
+@njit(cache=True)
+def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_aux, ev_t,
+        ev_i):
     """Advance the integration until ``t >= t_target``, the end, a failure, or a nearly
-    full event buffer. All arrays are updated in place; returns the status."""
+    full event buffer. All arrays are updated in place (``ph``/``sg``: every slider's
+    phase and slip sign); returns the status."""
     ns = y.shape[0]
-    width = max(ns, int(mdl[0][P_LMAX]) + 2)
-    work = np.zeros((5, width))
+    nd = n_dynamic(mdl)
+    n_ev = ev_prev.shape[0]
+    wk = new_work(mdl, y)
+    n, n_sl, half = sizes(mdl)
     ynew = np.empty(ns)
     ytmp = np.empty(ns)
     yout = np.empty(ns)
     dy = np.empty(ns)
     rc = np.empty((5, ns))
-    evn = np.empty(3)
-    evt = np.empty(3)
+    evn = np.empty(n_ev)
+    evt = np.empty(n_ev)
     err_vec = np.empty(ns)
     rtol = ctl[C_RTOL]
     atol = ctl[C_ATOL]
@@ -341,17 +536,14 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
 
     t = fst[F_T]
     h = fst[F_H]
-    phase = ist[I_PHASE]
-    s = ist[I_SIGN]
     if ist[I_STARTED] == 0:
-        if phase != SEPARATION:
-            phase, s = choose_contact_phase(t, y, s, mdl, work, dy)
-        _restart(t, y, phase, s, mdl, work, k, ev_prev)
+        start(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
+        _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
         if h <= 0.0:
-            h = _initial_step(t, y, k[0], phase, s, mdl, work, ctl, ytmp, dy)
+            h = _initial_step(t, y, k[0], ph, sg, mdl, wk, ctl, ytmp, dy, nd)
         if ist[I_OUT_NEXT] == 0 and out_y.shape[0] > 0:
             yout[:] = y
-            _write_sample(0, t, yout, phase, s, mdl, work, dy, out_y, out_aux)
+            _write_sample(0, t, yout, ph, sg, mdl, wk, dy, out_y, out_aux)
             ist[I_OUT_NEXT] = 1
         ist[I_STARTED] = 1
         ist[I_RHS] += 2
@@ -363,7 +555,7 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
         if t >= t_final:
             status = ST_DONE
             break
-        if t >= t_target or ist[I_EVENTS] > cap - 4:
+        if t >= t_target or ist[I_EVENTS] > cap - 4 * n_sl - 4:
             break
         kb = np.searchsorted(breaks, t, side="right")
         tb = breaks[kb] if kb < breaks.shape[0] else t_final
@@ -383,7 +575,7 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
                 if a != 0.0:
                     for i in range(ns):
                         ytmp[i] += a * k[j, i]
-            nf, f, wc, _, v = evaluate(t + C[st] * hs, ytmp, phase, s, False, mdl, work, k[st])
+            evaluate(t + C[st] * hs, ytmp, ph, sg, False, mdl, wk, k[st])
         ynew[:] = ytmp
         ist[I_RHS] += 6
         err_vec[:] = 0.0
@@ -392,7 +584,7 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
             if a != 0.0:
                 for i in range(ns):
                     err_vec[i] += a * k[st, i]
-        err = _rms_scaled(err_vec, y, ynew, atol, rtol)
+        err = _rms_scaled(err_vec, y, ynew, atol, rtol, nd)
 
         if not np.isfinite(err) or err > 1.0:
             if np.isfinite(err):
@@ -403,25 +595,25 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
             after_reject = True
             if h < 1e-14 * max(1.0, abs(t)):
                 status = ST_UNDERFLOW if np.isfinite(err) else ST_NONFINITE
-                ist[I_FAIL_PHASE] = phase
                 break
             continue
 
         ist[I_STEPS] += 1
         t_new = tb if land else t + hs
-        event_values(phase, s, nf, f, wc, v, ynew, mdl[0], evn)
+        # The last stage is at the step's end: its evaluation left the event data there.
+        event_values(ph, sg, ynew, mdl, wk, evn)
 
         have_rc = False
         which = -1
         theta = 2.0
-        for i in range(3):
+        for i in range(n_ev):
             if evn[i] == np.inf:
                 continue
             if ev_prev[i] > 0.0 and evn[i] <= 0.0:
                 if not have_rc:
                     dense_coefficients(y, ynew, k, hs, rc)
                     have_rc = True
-                th = locate(i, 0.0, 1.0, ev_prev[i], evn[i], t, hs, rc, phase, s, mdl, work,
+                th = locate(i, 0.0, 1.0, ev_prev[i], evn[i], t, hs, rc, ph, sg, mdl, wk,
                             dy, ytmp, evt, ist)
             elif ev_prev[i] > 0.0 and min(ev_prev[i], evn[i]) < 2.0 * abs(evn[i] - ev_prev[i]):
                 # Both ends positive but close to zero for the change over the step: the
@@ -434,10 +626,10 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
                 g_lo = ev_prev[i]
                 for p in range(1, _PROBES):
                     tp = p / _PROBES
-                    gp = _event_at(tp, i, t, hs, rc, phase, s, mdl, work, dy, ytmp, evt, ist)
+                    gp = _event_at(tp, i, t, hs, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist)
                     if gp <= 0.0:
-                        th = locate(i, (p - 1) / _PROBES, tp, g_lo, gp, t, hs, rc, phase, s,
-                                    mdl, work, dy, ytmp, evt, ist)
+                        th = locate(i, (p - 1) / _PROBES, tp, g_lo, gp, t, hs, rc, ph, sg,
+                                    mdl, wk, dy, ytmp, evt, ist)
                         break
                     g_lo = gp
                 if th > 1.0:
@@ -464,16 +656,17 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
             if not have_rc:
                 dense_coefficients(y, ynew, k, hs, rc)
             t_e = t_new if theta >= 1.0 else t + theta * hs
-            _write_outputs(t, t_e, hs, rc, phase, s, mdl, work, dy, yout, ctl, out_y, out_aux, ist)
+            _write_outputs(t, t_e, hs, rc, ph, sg, mdl, wk, dy, yout, ctl, out_y, out_aux, ist)
             dense_eval(rc, theta, y)
             first_new = ist[I_EVENTS]
-            phase, s = apply_switch(which, t_e, y, phase, s, mdl, work, dy, ev_t, ev_i, ist)
+            fst[F_H_CAP] = np.inf
+            apply_switch(which, t_e, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst)
             stop_mask = int(ctl[C_STOP_MASK])
             for e in range(first_new, ist[I_EVENTS]):
-                if stop_mask & (1 << ev_i[e, 0]):
+                if stop_mask & (1 << ev_i[e, EVI_KIND]):
                     status = ST_STOPPED
             t = t_e
-            _restart(t, y, phase, s, mdl, work, k, ev_prev)
+            _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
             ist[I_RHS] += 1
             ist[I_SWITCHES] += 1
             if t - fst[F_LAST_SWITCH] < ctl[C_ZENO_DT]:
@@ -482,15 +675,15 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
                 ist[I_ZENO] = 0
             fst[F_LAST_SWITCH] = t
             h = hs * min(fac, 1.0)
+            if fst[F_H_CAP] < np.inf:
+                h = min(h, 0.25 * fst[F_H_CAP])
             if status == ST_STOPPED:
                 break
             if ist[I_ZENO] >= ctl[C_ZENO_COUNT]:
                 status = ST_ZENO
-                ist[I_FAIL_PHASE] = phase
                 break
             if ist[I_SWITCHES] >= ctl[C_MAX_SWITCHES]:
                 status = ST_MAX_SWITCHES
-                ist[I_FAIL_PHASE] = phase
                 break
             continue
 
@@ -498,37 +691,37 @@ def run(t_target, mdl, ctl, fst, ist, y, k, ev_prev, breaks, out_y, out_aux, ev_
             if not np.isfinite(ynew[i]):
                 status = ST_NONFINITE
         if status != ST_RUNNING:
-            ist[I_FAIL_PHASE] = phase
             break
         next_out = min(ist[I_OUT_NEXT] * ctl[C_OUT_DT], t_final)
         if ist[I_OUT_NEXT] < out_y.shape[0] and next_out <= t_new:
             if not have_rc:
                 dense_coefficients(y, ynew, k, hs, rc)
-            _write_outputs(t, t_new, hs, rc, phase, s, mdl, work, dy, yout, ctl, out_y, out_aux,
+            _write_outputs(t, t_new, hs, rc, ph, sg, mdl, wk, dy, yout, ctl, out_y, out_aux,
                            ist)
         y[:] = ynew
         for i in range(ns):
             k[0, i] = k[6, i]
-        for i in range(3):
+        for i in range(n_ev):
             ev_prev[i] = evn[i]
         t = t_new
         h = hs * fac
         if land and t < t_final:
             # Speed-profile kink: Omegadot jumps, so the stick reaction does too.
-            if phase != SEPARATION:
-                old_phase = phase
-                old_s = s
-                if phase == STICK:
-                    om, _ = speed_at(t, mdl[M_KNOTS], mdl[M_COEF], True)
-                    y[ns - 2] = om
-                phase, s = choose_contact_phase(t, y, s, mdl, work, dy)
-                _record_change(t, old_phase, old_s, phase, s, ev_t, ev_i, ist)
-            _restart(t, y, phase, s, mdl, work, k, ev_prev)
+            om, _ = speed_at(t, mdl.knots, mdl.coef, True)
+            for j in range(n_sl):
+                if ph[j] == SEPARATION:
+                    continue
+                old = ph[j]
+                old_s = sg[j]
+                if old == STICK:
+                    y[half + n + j] = om
+                choose_phase(j, t, y, ph, sg, mdl, wk, dy)
+                _record_change(t, old, old_s, ph[j], sg[j], j, ev_t, ev_i, ist)
+            settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
+            _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
             ist[I_RHS] += 1
 
     fst[F_T] = t
     fst[F_H] = h
-    ist[I_PHASE] = phase
-    ist[I_SIGN] = s
     ist[I_STATUS] = status
     return status

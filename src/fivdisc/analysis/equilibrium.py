@@ -1,4 +1,4 @@
-"""Sliding equilibrium at constant disc speed (paper section 3.1)."""
+"""Sliding equilibrium at constant disc speed (paper section 3.1), for any number of sliders."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fivdisc._kernels import dynamics as dyn
+from fivdisc._kernels import layout as lay
 from fivdisc.case import Case
 from fivdisc.errors import SimulationError
 from fivdisc.model import Model, build_model
@@ -14,18 +15,18 @@ from fivdisc.model import Model, build_model
 
 @dataclass(frozen=True)
 class Equilibrium:
-    """Steady sliding at constant disc speed.
+    """Steady sliding at constant disc speed: every slider slips forward, nothing moves.
 
     Attributes
     ----------
     q : ndarray
         Modal coordinates [m] (per unit mode shape).
-    phi : float
-        Slider angle [rad].
-    normal_force : float
-        N [N].
-    friction_force : float
-        f [N].
+    phi : ndarray
+        Slider angles [rad], one per slider.
+    normal_force : ndarray
+        N [N], one per slider.
+    friction_force : ndarray
+        f [N], one per slider.
     speed : float
         The constant disc speed Omega_c [rad/s].
     state : ndarray
@@ -33,30 +34,44 @@ class Equilibrium:
     """
 
     q: np.ndarray
-    phi: float
-    normal_force: float
-    friction_force: float
+    phi: np.ndarray
+    normal_force: np.ndarray
+    friction_force: np.ndarray
     speed: float
     state: np.ndarray
 
 
-def _accelerations(model: Model, y: np.ndarray) -> tuple[np.ndarray, float, float]:
-    n = model.n
-    width = max(model.state_size, int(model.par[dyn.P_LMAX]) + 2)
-    work = np.zeros((5, width))
+def slip_phases(model: Model) -> tuple[np.ndarray, np.ndarray]:
+    """Phase and sign arrays of every slider slipping forward (``v = Omega - phidot > 0``)."""
+    ns = model.n_sliders
+    return np.full(ns, lay.SLIP, dtype=np.int64), np.ones(ns, dtype=np.int64)
+
+
+def _evaluate(model: Model, y: np.ndarray) -> tuple[np.ndarray, tuple]:
+    ph, sg = slip_phases(model)
+    mdl = model.kernel_args
+    wk = dyn.new_work(mdl, y)
     dy = np.empty(model.state_size)
-    nf, f, *_ = dyn.evaluate(0.0, y, dyn.SLIP, 1, True, model.kernel_args, work, dy)
-    return dy[n + 2 : 2 * n + 3], nf, f
+    dyn.evaluate(0.0, y, ph, sg, True, mdl, wk, dy)
+    return dy, wk
+
+
+def _unknowns(model: Model) -> np.ndarray:
+    """State indices of the equilibrium's unknowns (q, phi) and of their accelerations."""
+    n, ns = model.n, model.n_sliders
+    return np.r_[0 : n + ns]
 
 
 def sliding_equilibrium(
     case: Case | Model, xtol: float = 1e-13, guess: Equilibrium | None = None
 ) -> Equilibrium:
-    """Solve the slip equations (s = +1) with all velocities and accelerations zero.
+    """Solve the slip equations (s = +1 for every slider) with all velocities and
+    accelerations zero.
 
-    The residual is the vector of generalised forces that remain when the
-    kernel's slip accelerations are multiplied by their inertias; it vanishes exactly
-    at the equilibrium of Eqs. (33), (34), (36) with the time derivatives set to zero.
+    The residual is the vector of generalised forces that remain when the kernel's
+    slip accelerations are multiplied by their inertias; it vanishes exactly at the
+    equilibrium of the equations of motion with the time derivatives set to zero (the
+    material-frame disc damping leaves its ``l Omega`` terms in it).
 
     Parameters
     ----------
@@ -66,7 +81,8 @@ def sliding_equilibrium(
         Relative tolerance of :func:`scipy.optimize.root` (``hybr``).
     guess : Equilibrium, optional
         Start of the iteration (for example the solution at a neighbouring parameter);
-        default: the rigid-disc equilibrium.
+        default: each slider on a rigid disc, the disc deflected statically by the
+        preloads.
 
     Raises
     ------
@@ -86,53 +102,62 @@ def sliding_equilibrium(
         raise SimulationError(
             f"speed.value = {omega_c} has no sliding equilibrium: the disc must spin (> 0 rad/s)"
         )
-    n = model.n
-    par = model.par
-    inertias = np.append(model.modal_mass, par[dyn.P_INERTIA])
-    mu = par[dyn.P_MU1] + (par[dyn.P_MU0] - par[dyn.P_MU1]) * np.exp(
-        -par[dyn.P_ALPHA] * par[dyn.P_R0] * omega_c
-    )
-    # Rigid-disc guess: N = N0, friction balanced by the in-plane spring.
-    phi0 = par[dyn.P_R0] * mu * par[dyn.P_N0] / par[dyn.P_KPHI]
+    n, ns = model.n, model.n_sliders
+    kern = model.kernel_args
+    unknowns = _unknowns(model)
+    acc_index = unknowns + n + 2 * ns
+    inertias = np.append(model.modal_mass, kern.inertia)
+    # Rigid-disc guess: N = N0, friction balanced by the in-plane spring; the disc
+    # deflected statically by the preloads.
+    mu = np.array([dyn.kinetic_friction(kern, kern.radius[j], 1, omega_c) for j in range(ns)])
+    phi0 = kern.radius * mu * kern.n0 / kern.kphi
     stiff = model.modal_mass * (model.omega**2 - model.l**2 * omega_c**2)
-    g = np.where(model.sgn > 0, np.cos(model.l * phi0), np.sin(model.l * phi0)) * model.R0
-    x0 = np.append(-par[dyn.P_N0] * g / stiff, phi0)
-    if guess is not None and guess.q.size == n:
+    q0 = np.zeros(n)
+    for j in range(ns):
+        psi = kern.theta[j] + phi0[j]
+        g = np.where(model.sgn > 0, np.cos(model.l * psi), np.sin(model.l * psi)) * model.shape[j]
+        q0 -= kern.sn0[j] * g / stiff
+    x0 = np.append(q0, phi0)
+    if guess is not None and guess.q.size == n and np.size(guess.phi) == ns:
         x0 = np.append(guess.q, guess.phi)
 
     def state(x: np.ndarray) -> np.ndarray:
         y = np.zeros(model.state_size)
-        y[: n + 1] = x
+        y[unknowns] = x
         return y
 
     def residual(x: np.ndarray) -> np.ndarray:
-        acc, *_ = _accelerations(model, state(x))
-        return acc * inertias
+        dy, _ = _evaluate(model, state(x))
+        return dy[acc_index] * inertias
 
     def jacobian(x: np.ndarray) -> np.ndarray:
-        jac = dyn.complex_step_jacobian(0.0, state(x), dyn.SLIP, 1, model.kernel_args)
-        return jac[n + 2 : 2 * n + 3, : n + 1] * inertias[:, None]
+        ph, sg = slip_phases(model)
+        jac = dyn.complex_step_jacobian(0.0, state(x), ph, sg, kern)
+        return jac[np.ix_(acc_index, unknowns)] * inertias[:, None]
 
     sol = root(residual, x0, jac=jacobian, method="hybr", options={"xtol": xtol})
     # hybr may report "no progress" once it sits at round-off: judge by the residual, in
     # generalised forces [N], against the preload.
-    scale = par[dyn.P_N0] + 1.0
+    scale = float(np.max(kern.n0)) + 1.0
     if not np.max(np.abs(sol.fun)) <= 1e-9 * scale:
         raise SimulationError(
             f"no sliding equilibrium found at Omega = {omega_c} rad/s ({sol.message.strip()})"
         )
     y = state(sol.x)
-    _, nf, f = _accelerations(model, y)
-    if nf <= 0.0:
+    _, wk = _evaluate(model, y)
+    aux = wk[5]
+    nf = aux[lay.A_N].copy()
+    if np.any(nf <= 0.0):
+        j = int(np.argmin(nf))
         raise SimulationError(
-            f"no sliding equilibrium at Omega = {omega_c} rad/s: the normal force would be "
-            f"{nf:.4g} N (contact lost)"
+            f"no sliding equilibrium at Omega = {omega_c} rad/s: the normal force of slider {j} "
+            f"would be {nf[j]:.4g} N (contact lost)"
         )
     return Equilibrium(
         q=sol.x[:n].copy(),
-        phi=float(sol.x[n]),
-        normal_force=float(nf),
-        friction_force=float(f),
+        phi=sol.x[n:].copy(),
+        normal_force=nf,
+        friction_force=aux[lay.A_F].copy(),
         speed=omega_c,
         state=y,
     )

@@ -9,24 +9,31 @@ import numpy as np
 import xarray as xr
 
 from fivdisc._kernels import dynamics as dyn
-from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium
+from fivdisc._kernels import layout as lay
+from fivdisc.analysis.equilibrium import Equilibrium, slip_phases, sliding_equilibrium
 from fivdisc.case import Case
 from fivdisc.errors import CaseError, SimulationError
 from fivdisc.model import Model, build_model
 from fivdisc.speed import SpeedProfile
 
-# Case keys that enter the model only through its parameter vector: a map over them
-# patches that vector instead of rebuilding the model (and the plate modes) per point.
-_PAR_KEYS = {
-    "slider.normal_damping": dyn.P_CZ,
-    "slider.rotational_damping": dyn.P_CPHI,
-    "slider.normal_stiffness": dyn.P_KZ,
-    "slider.rotational_stiffness": dyn.P_KPHI,
-    "slider.preload": dyn.P_N0,
-    "friction.static": dyn.P_MUS,
-    "friction.kinetic_max": dyn.P_MU0,
-    "friction.kinetic_min": dyn.P_MU1,
-    "friction.decay": dyn.P_ALPHA,
+# Per-slider case keys that enter the model only through a kernel array, and friction
+# keys that enter only through its friction slots: a map over them patches those arrays
+# instead of rebuilding the model (and the plate modes) per point.
+_SLIDER_ARRAYS = {
+    "normal_damping": "cz",
+    "rotational_damping": "cphi",
+    "normal_stiffness": "kz",
+    "rotational_stiffness": "kphi",
+    "preload": "n0",
+}
+_FRICTION_SLOTS = {
+    "static": lay.F_MUS,
+    "kinetic_max": lay.F_MU0,
+    "kinetic_min": lay.F_MU1,
+    "decay": lay.F_ALPHA,
+    "stribeck_velocity": lay.F_VS,
+    "stribeck_exponent": lay.F_DELTA,
+    "viscous": lay.F_MUV,
 }
 
 
@@ -39,14 +46,16 @@ class LinearStability:
     equilibrium : Equilibrium
         The sliding equilibrium.
     jacobian : ndarray
-        ``(2 n + 2, 2 n + 2)`` Jacobian in the variables ``(q, phi, qdot, phidot)``.
+        ``(2 (n + S), 2 (n + S))`` Jacobian in the variables ``(q, phi, qdot, phidot)``
+        (phi and phidot of every slider).
     eigenvalues : ndarray
         Complex eigenvalues [1/s], sorted by decreasing real part.
     eigenvectors : ndarray
         Right eigenvectors (columns), in the order of ``eigenvalues``.
     dominant : tuple of str
-        Per eigenvalue, the coordinate (``"C01"``, ..., ``"phi"``) with the largest share
-        of the eigenvector's kinetic energy.
+        Per eigenvalue, the coordinate (``"C01"``, ..., ``"phi"``; ``"phi0"``,
+        ``"phi1"``, ... with several sliders) with the largest share of the
+        eigenvector's kinetic energy.
     """
 
     equilibrium: Equilibrium
@@ -84,17 +93,24 @@ class LinearStability:
         ]
 
 
-def _reduced_indices(n: int) -> np.ndarray:
-    # Drop the slider's own z, zdot: in contact they are slaved to the disc.
-    return np.r_[0 : n + 1, n + 2 : 2 * n + 3]
+def _reduced_indices(model: Model) -> np.ndarray:
+    # Drop the sliders' own z, zdot: in contact they are slaved to the disc.
+    n, ns = model.n, model.n_sliders
+    half = n + 2 * ns
+    return np.r_[0 : n + ns, half : half + n + ns]
 
 
 def slip_jacobian(model: Model, state: np.ndarray) -> np.ndarray:
-    """Exact (complex-step) Jacobian of the slip equations (s = +1) at ``state``, in the
-    variables ``(q, phi, qdot, phidot)``."""
-    jac = dyn.complex_step_jacobian(0.0, state, dyn.SLIP, 1, model.kernel_args)
-    idx = _reduced_indices(model.n)
+    """Exact (complex-step) Jacobian of the slip equations (s = +1 for every slider) at
+    ``state``, in the variables ``(q, phi, qdot, phidot)``."""
+    ph, sg = slip_phases(model)
+    jac = dyn.complex_step_jacobian(0.0, state, ph, sg, model.kernel_args)
+    idx = _reduced_indices(model)
     return jac[np.ix_(idx, idx)]
+
+
+def _angle_names(model: Model) -> tuple[str, ...]:
+    return ("phi",) if model.n_sliders == 1 else tuple(f"phi{j}" for j in range(model.n_sliders))
 
 
 def linear_stability(case: Case | Model) -> LinearStability:
@@ -116,11 +132,11 @@ def linear_stability(case: Case | Model) -> LinearStability:
     order = np.lexsort((-lam.imag, -lam.real))
     lam = lam[order]
     vec = vec[:, order]
-    n = model.n
-    inertia = np.append(model.modal_mass, model.par[dyn.P_INERTIA])
+    size = model.n + model.n_sliders
+    inertia = np.append(model.modal_mass, model.kernel.inertia)
     # Velocity part of an eigenvector is lambda times its displacement part.
-    energy = inertia[:, None] * np.abs(vec[n + 1 :, :]) ** 2
-    names = (*model.labels, "phi")
+    energy = inertia[:, None] * np.abs(vec[size:, :]) ** 2
+    names = (*model.labels, *_angle_names(model))
     dominant = tuple(names[i] for i in np.argmax(energy, axis=0))
     return LinearStability(eq, jac, lam, vec, dominant)
 
@@ -130,7 +146,8 @@ class PerturbationTest:
     """The paper's stability test: perturb the equilibrium, simulate, compare amplitudes.
 
     Amplitudes are square roots of the deviation energy
-    ``sum M (qdot^2 + omega^2 (q - q_eq)^2) + I phidot^2 + r0^2 k_phi (phi - phi_eq)^2``,
+    ``sum M (qdot^2 + omega^2 (q - q_eq)^2) + sum_j I_j phidot_j^2 + r_j^2 k_phi_j (phi_j -
+    phi_eq_j)^2``,
     a norm of the whole state, so slowly growing disc modes count as much as the slider.
 
     Attributes
@@ -171,10 +188,11 @@ def perturbation_test(case: Case, duration: float | None = None) -> Perturbation
     eq = sliding_equilibrium(model)
     ds = simulate(run).dataset
     dq = ds["q"].values - eq.q
+    kern = model.kernel
     energy = (
         np.sum(model.modal_mass * (ds["q_dot"].values ** 2 + model.omega**2 * dq**2), axis=1)
-        + model.par[dyn.P_INERTIA] * ds["phi_dot"].values ** 2
-        + model.par[dyn.P_KPHI] * (ds["phi"].values - eq.phi) ** 2
+        + np.sum(kern.inertia * ds["phi_dot"].values ** 2, axis=1)
+        + np.sum(kern.kphi * (ds["phi"].values - eq.phi) ** 2, axis=1)
     )
     amplitude = np.sqrt(energy)
     span = max(1, amplitude.size // 10)
@@ -194,25 +212,32 @@ def _axis(spec, name: str) -> tuple[str, np.ndarray]:
 
 
 def _equilibrium_key(model: Model) -> tuple:
-    # Damping does not enter the equilibrium: maps over c_z, c_phi reuse one solve.
-    par = model.par.copy()
-    par[[dyn.P_CZ, dyn.P_CPHI]] = 0.0
-    return (tuple(par), tuple(model.speed.coefficients.ravel()), model.labels,
-            tuple(model.R0), tuple(model.omega))
+    # The sliders' dampers do not enter the equilibrium: maps over c_z, c_phi reuse one
+    # solve.
+    kern = model.kernel_args._replace(cz=None, scz=None, cphi=None)
+    return tuple(a.tobytes() if isinstance(a, np.ndarray) else a for a in kern)
 
 
 def _point_model(base: Model, case: Case, updates: dict[str, float]) -> Model:
     """Model of ``case`` with ``updates``, by patching ``base`` where that is exact."""
-    if not all(k in _PAR_KEYS or k == "speed.value" for k in updates):
-        return build_model(case.replace(updates))
-    par = base.par.copy()
-    speed = base.speed
+    model = base
     for key, value in updates.items():
+        parts = key.split(".")
         if key == "speed.value":
-            speed = SpeedProfile.constant(value)
+            model = model.with_speed(SpeedProfile.constant(value))
+        elif parts[0] in ("slider", "sliders") and parts[-1] in _SLIDER_ARRAYS:
+            j = 0 if parts[0] == "slider" else int(parts[1])
+            name = _SLIDER_ARRAYS[parts[-1]]
+            array = getattr(model.kernel, name).copy()
+            array[j] = value
+            model = model.with_sliders(**{name: array})
+        elif parts[0] == "friction" and parts[-1] in _FRICTION_SLOTS:
+            fric = model.kernel.fric.copy()
+            fric[_FRICTION_SLOTS[parts[-1]]] = value
+            model = replace(model, kernel=model.kernel._replace(fric=fric))
         else:
-            par[_PAR_KEYS[key]] = value
-    return replace(base, par=par, speed=speed)
+            return build_model(case.replace(updates))
+    return model
 
 
 def _validate_grid(case: Case, axes: list[tuple[str, np.ndarray]]) -> None:
@@ -285,7 +310,7 @@ def stability_map(
                     except SimulationError:
                         cache[key] = None
                 if cache[key] is None:
-                    jacs.append(np.full((2 * base.n + 2,) * 2, np.nan))
+                    jacs.append(np.full((2 * (base.n + base.n_sliders),) * 2, np.nan))
                     continue
                 guess = cache[key]
                 jacs.append(slip_jacobian(model, guess.state))
@@ -333,7 +358,9 @@ def resolve_key(key: str, option: str) -> str:
     import difflib
 
     keys = Case.valid_keys()
-    if key in keys:
+    parts = key.split(".")
+    if key in keys or (len(parts) == 3 and parts[0] == "sliders" and parts[1].isdigit()
+                       and f"slider.{parts[2]}" in keys):
         return key
     matches = [k for k in keys if k.rsplit(".", 1)[-1] == key]
     if len(matches) == 1:
