@@ -6,10 +6,13 @@ import numpy as np
 import pytest
 
 from fivdisc._kernels import dynamics as dyn
+from fivdisc._kernels import layout as lay
+from fivdisc._kernels.impact import single_impact
 from fivdisc.analysis.equilibrium import sliding_equilibrium
 from fivdisc.case import Case
 from fivdisc.errors import SimulationError
 from fivdisc.model import build_model
+from fivdisc.result import select_slider
 from fivdisc.simulate import simulate
 from fivdisc.speed import SpeedProfile
 from reference_model import jacobi_integral, mode_data_from_case
@@ -57,7 +60,7 @@ def test_jacobi_integral_conserved_without_friction_and_damping():
     eq = sliding_equilibrium(case)
     q = eq.q * (1.0 + 0.2 * np.cos(np.arange(eq.q.size)))
     res = simulate(case, initial={"q": q, "q_dot": 0.05 * np.sin(np.arange(q.size))})
-    ds = res.dataset
+    ds = select_slider(res.dataset)
     assert res.status == "success" and ds["normal_force"].min() > 100.0
     state = {
         "q": ds["q"].values,
@@ -81,9 +84,10 @@ def _energy(model, y, omega):
     M, l, partner, sgn = md.M, md.l, model.partner, model.sgn
     qp = np.where(partner >= 0, q[np.maximum(partner, 0)], 0.0)
     kinetic = 0.5 * np.sum(M * (qd + sgn * l * omega * qp) ** 2)
-    kinetic += 0.5 * model.par[dyn.P_MASS] * zd**2 + 0.5 * model.par[dyn.P_INERTIA] * phid**2
-    potential = 0.5 * np.sum(M * md.omega**2 * q**2) + 0.5 * model.par[dyn.P_KPHI] * phi**2
-    potential += 0.5 * model.par[dyn.P_KZ] * z**2 + model.par[dyn.P_N0] * z
+    kern = model.kernel
+    kinetic += 0.5 * kern.mass[0] * zd**2 + 0.5 * kern.inertia[0] * phid**2
+    potential = 0.5 * np.sum(M * md.omega**2 * q**2) + 0.5 * kern.kphi[0] * phi**2
+    potential += 0.5 * kern.kz[0] * z**2 + kern.n0[0] * z
     return kinetic + potential
 
 
@@ -91,8 +95,10 @@ def test_impact_map_equal_velocities_and_energy_loss():
     model = build_model(Case())
     n, omega = model.n, 2 * np.pi
     rng = np.random.default_rng(7)
-    work = np.zeros((5, model.state_size))
+    mdl = model.kernel_args
     dy = np.empty(model.state_size)
+    flying = np.array([dyn.SEPARATION])
+    sign = np.array([1])
     for trial in range(50):
         y = np.zeros(model.state_size)
         y[:n] = rng.normal(0, 1e-3, n)
@@ -100,20 +106,20 @@ def test_impact_map_equal_velocities_and_energy_loss():
         y[n] = rng.uniform(-0.5, 0.5)
         # Half the trials with the slider moving with the disc (v = 0).
         y[2 * n + 2] = omega if trial % 2 else rng.uniform(0, 2 * omega)
-        _, _, wc, wcd, _ = dyn.evaluate(0.0, y, dyn.SEPARATION, 1, True, model.kernel_args,
-                                        work, dy)
-        y[n + 1] = wc
-        y[-1] = wcd - abs(rng.normal(0, 0.5))  # slider approaching the disc surface
+        work = dyn.new_work(mdl, y)
+        dyn.evaluate(0.0, y, flying, sign, True, mdl, work, dy)
+        y[n + 1] = work[5][lay.A_WC, 0]
+        # Slider approaching the disc surface.
+        y[-1] = work[5][lay.A_WCD, 0] - abs(rng.normal(0, 0.5))
         before = y.copy()
-        dyn.plastic_impact(y, model.kernel_args, work)
-        _, _, wc, wcd, _ = dyn.evaluate(0.0, y, dyn.SEPARATION, 1, True, model.kernel_args,
-                                        work, dy)
-        assert y[-1] == pytest.approx(wcd, abs=1e-12 * abs(before[-1]))
+        single_impact(0, y, mdl, work)
+        dyn.evaluate(0.0, y, flying, sign, True, mdl, work, dy)
+        assert y[-1] == pytest.approx(work[5][lay.A_WCD, 0], abs=1e-12 * abs(before[-1]))
         # Classical plastic-impact loss: u^2 / (2 K), K = 1/m + sum g^2/M, with u the
         # approach velocity; the normal impulse p on a surface sloped by g'.q that slides
         # at v = Omega - phidot under the slider also does work -p v (g'.q).
-        g, gp = work[0, :n], work[1, :n]
-        m = model.par[dyn.P_MASS]
+        g, gp = work[0][0], work[1][0]
+        m = mdl.mass[0]
         kk = 1 / m + np.sum(g**2 / model.modal_mass)
         u = before[-1] - (g @ before[n + 2 : 2 * n + 2] + before[2 * n + 2] * (gp @ before[:n]))
         p = -u / kk
@@ -155,7 +161,7 @@ def test_decelerating_disc_stops_and_stays_stopped():
         speed={"profile": "decelerating", "initial": 2.0, "duration": 0.03},
         simulation={"duration": 0.08, "output_rate": 5000.0},
     )
-    ds = simulate(case).dataset
+    ds = select_slider(simulate(case).dataset)
     speed = ds["disc_speed"].values
     t = ds["time"].values
     np.testing.assert_allclose(speed[t >= 0.03], 0.0, atol=0)

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from fivdisc.case import Case
+from fivdisc.result import select_slider
 from fivdisc.simulate import simulate
 from reference_model import reference_simulate
 
@@ -55,7 +56,7 @@ def pair(request):
     kwargs, init = CASES[request.param]
     case = Case(**kwargs)
     initial = init(case) if init else None
-    fast = simulate(case, initial=initial).dataset
+    fast = select_slider(simulate(case, initial=initial).dataset)
     # solve_ivp looks for events only at step ends; a small max_step keeps it from stepping
     # over a brief dip of N below zero (the kernel probes inside its steps instead).
     ref = reference_simulate(case, SPAN, y0=initial, max_step=4e-6 if init else None)

@@ -71,7 +71,7 @@ def _reference_jacobian(case: Case, q, phi) -> np.ndarray:
 def test_eigenvalues_match_reference_finite_differences(name):
     case = Case(**PAPER[name])
     res = linear_stability(case)
-    ref = _reference_jacobian(case, res.equilibrium.q, res.equilibrium.phi)
+    ref = _reference_jacobian(case, res.equilibrium.q, res.equilibrium.phi[0])
     lam_ref = np.linalg.eigvals(ref)
     radius = np.abs(lam_ref).max()
     # Central differences carry ~1e-9 relative error (h^2 truncation and rounding at

@@ -30,6 +30,7 @@ from fivdisc.analysis.trajectories import (
     phase_portrait,
     separation_intervals,
 )
+from fivdisc.result import select_slider
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -227,7 +228,7 @@ def plot_spectrum(data: xr.Dataset | object, var: str = "phi", probe: int | None
 
 
 def plot_phase_portrait(data: xr.Dataset | object, window: Window = None,
-                        ax: Axes | None = None) -> Figure:
+                        ax: Axes | None = None, slider: int = 0) -> Figure:
     """Slider angular velocity against angle (paper Fig. 17a, c, e, ...).
 
     Parameters
@@ -238,12 +239,15 @@ def plot_phase_portrait(data: xr.Dataset | object, window: Window = None,
         Time window [s]; a short one (about 0.1 s) shows the limit cycle.
     ax : matplotlib Axes, optional
         Where to draw.
+    slider : int
+        Which slider (from 0).
     """
-    return _trajectory(phase_portrait(data, *_bounds(window)), "phi", "phi_dot", ax)
+    return _trajectory(phase_portrait(data, *_bounds(window), slider=slider), "phi", "phi_dot",
+                       ax)
 
 
 def plot_friction(data: xr.Dataset | object, window: Window = None,
-                  ax: Axes | None = None) -> Figure:
+                  ax: Axes | None = None, slider: int = 0) -> Figure:
     """Friction force against relative angular velocity (paper Fig. 17b, d, f, ...).
 
     Parameters
@@ -254,8 +258,10 @@ def plot_friction(data: xr.Dataset | object, window: Window = None,
         Time window [s].
     ax : matplotlib Axes, optional
         Where to draw.
+    slider : int
+        Which slider (from 0).
     """
-    ds = friction_trajectory(data, *_bounds(window))
+    ds = friction_trajectory(data, *_bounds(window), slider=slider)
     return _trajectory(ds, "relative_velocity", "friction_force", ax)
 
 
@@ -269,7 +275,7 @@ def _trajectory(ds: xr.Dataset, x: str, y: str, ax: Axes | None) -> Figure:
 
 
 def plot_normal_force(data: xr.Dataset | object, window: Window = None,
-                      ax: Axes | None = None) -> Figure:
+                      ax: Axes | None = None, slider: int = 0) -> Figure:
     """Normal contact force with separation intervals shaded (paper Figs. 18, 19, 24).
 
     Parameters
@@ -280,8 +286,10 @@ def plot_normal_force(data: xr.Dataset | object, window: Window = None,
         Time window [s].
     ax : matplotlib Axes, optional
         Where to draw.
+    slider : int
+        Which slider (from 0).
     """
-    ds = time_window(as_dataset(data), *_bounds(window))
+    ds = time_window(select_slider(as_dataset(data), slider), *_bounds(window))
     force = ds["normal_force"]
     fig, ax = _axes(ax)
     ax.plot(ds["time"].values, force.values, lw=0.8)

@@ -123,6 +123,36 @@ def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarr
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
+def select_slider(ds: xr.Dataset, slider: int = 0) -> xr.Dataset:
+    """The dataset as seen by one slider: per-slider variables at ``slider`` (the
+    ``slider`` dimension dropped) and only that slider's events.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A simulation dataset (a dataset without a ``slider`` dimension is returned as is).
+    slider : int
+        Slider index, from 0.
+
+    Raises
+    ------
+    ValueError
+        If ``slider`` is not an index of the dataset's sliders.
+    """
+    if "slider" not in ds.dims:
+        return ds
+    count = ds.sizes["slider"]
+    if isinstance(slider, bool) or not isinstance(slider, int | np.integer) or not (
+        0 <= slider < count
+    ):
+        raise ValueError(f"slider = {slider!r} is invalid: must be an index in [0, {count - 1}]"
+                         f" (the run has {count} slider{'s' if count > 1 else ''})")
+    out = ds.isel(slider=int(slider))
+    if "event_slider" in ds and "event" in ds.dims:
+        out = out.isel(event=np.flatnonzero(ds["event_slider"].values == slider))
+    return out
+
+
 @dataclass(frozen=True)
 class Result:
     """Outcome of :func:`fivdisc.simulate`.
@@ -161,20 +191,35 @@ class Result:
         return times[ds["event_kind"].values == kind]
 
     def summary(self) -> dict:
-        """Time in each phase [s], switches, impacts, peak normal force [N], largest |w| [m]."""
+        """Time in each phase [s], switches, separations, impacts, peak normal force [N],
+        largest |w| at the probes [m], wall time [s].
+
+        With several sliders the per-slider entries (time in each phase, separations,
+        peak normal force) are lists, one item per slider.
+        """
         ds = self.dataset
-        phase = ds["phase"].values
         dt = np.diff(ds["time"].values)
-        spent = {name: float(np.sum(dt[phase[:-1] == i])) for i, name in enumerate(PHASE_NAMES)}
         kinds = ds["event_kind"].values
+        sliders = ds["event_slider"].values
+        count = ds.sizes["slider"]
+        per: dict[str, list] = {"time_in_phase": [], "separations": [], "peak_normal_force": []}
+        for j in range(count):
+            phase = ds["phase"].values[:, j]
+            per["time_in_phase"].append(
+                {name: float(np.sum(dt[phase[:-1] == i])) for i, name in enumerate(PHASE_NAMES)}
+            )
+            per["separations"].append(int(np.sum((kinds == "separation") & (sliders == j))))
+            force = ds["normal_force"].values[:, j]
+            per["peak_normal_force"].append(float(np.nanmax(force, initial=np.nan)))
+        one = {k: v[0] for k, v in per.items()} if count == 1 else per
         impacts = int(np.sum(kinds == "recontact")) if ds.attrs.get("impact", 1) else 0
         return {
             "status": self.status,
-            "time_in_phase": spent,
+            "time_in_phase": one["time_in_phase"],
             "switches": int(kinds.size),
-            "separations": int(np.sum(kinds == "separation")),
+            "separations": one["separations"],
             "impacts": impacts,
-            "peak_normal_force": float(np.nanmax(ds["normal_force"].values, initial=np.nan)),
+            "peak_normal_force": one["peak_normal_force"],
             "max_abs_w": float(np.nanmax(np.abs(ds["w"].values), initial=0.0)),
             "wall_time": float(ds.attrs["wall_time"]),
         }

@@ -93,6 +93,37 @@ class LinearStability:
         ]
 
 
+    def to_dict(self) -> dict:
+        """The equilibrium and every eigenvalue as plain Python values (for JSON).
+
+        Keys: ``speed`` [rad/s]; ``equilibrium`` with ``q`` [m], and per slider ``phi``
+        [rad], ``normal_force`` [N], ``friction_force`` [N]; ``eigenvalues``, a list of
+        ``real`` [1/s], ``imag`` [rad/s], ``frequency`` [Hz], ``coordinate``;
+        ``stable``; ``max_growth_rate`` [1/s].
+        """
+        eq = self.equilibrium
+        return {
+            "speed": eq.speed,
+            "equilibrium": {
+                "q": eq.q.tolist(),
+                "phi": eq.phi.tolist(),
+                "normal_force": eq.normal_force.tolist(),
+                "friction_force": eq.friction_force.tolist(),
+            },
+            "eigenvalues": [
+                {
+                    "real": float(lam.real),
+                    "imag": float(lam.imag),
+                    "frequency": float(abs(lam.imag) / (2.0 * np.pi)),
+                    "coordinate": name,
+                }
+                for lam, name in zip(self.eigenvalues, self.dominant, strict=True)
+            ],
+            "stable": self.stable,
+            "max_growth_rate": self.max_growth_rate,
+        }
+
+
 def _reduced_indices(model: Model) -> np.ndarray:
     # Drop the sliders' own z, zdot: in contact they are slaved to the disc.
     n, ns = model.n, model.n_sliders

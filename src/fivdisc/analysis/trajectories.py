@@ -10,6 +10,7 @@ import numpy as np
 import xarray as xr
 
 from fivdisc.analysis.spectra import as_dataset, time_window
+from fivdisc.result import select_slider
 
 __all__ = ["friction_trajectory", "phase_portrait", "separation_intervals", "separation_stats"]
 
@@ -17,7 +18,7 @@ _SEPARATION = 2  # phase code of separation (see the dataset's flag_meanings)
 
 
 def phase_portrait(data: xr.Dataset | object, t0: float | None = None,
-                   t1: float | None = None) -> xr.Dataset:
+                   t1: float | None = None, slider: int = 0) -> xr.Dataset:
     """Slider angle and angular velocity over a window (paper Fig. 17a, c, ...).
 
     Parameters
@@ -26,6 +27,8 @@ def phase_portrait(data: xr.Dataset | object, t0: float | None = None,
         Simulation result.
     t0, t1 : float, optional
         Window [s].
+    slider : int
+        Which slider (from 0).
 
     Returns
     -------
@@ -37,11 +40,12 @@ def phase_portrait(data: xr.Dataset | object, t0: float | None = None,
     fivdisc.analysis.spectra.AnalysisError
         If the window is outside the data.
     """
-    return time_window(as_dataset(data)[["phi", "phi_dot"]], t0, t1)
+    ds = select_slider(as_dataset(data), slider)
+    return time_window(ds[["phi", "phi_dot"]], t0, t1)
 
 
 def friction_trajectory(data: xr.Dataset | object, t0: float | None = None,
-                        t1: float | None = None) -> xr.Dataset:
+                        t1: float | None = None, slider: int = 0) -> xr.Dataset:
     """Friction force against relative sliding speed (paper Fig. 17b, d, ...).
 
     Parameters
@@ -50,6 +54,8 @@ def friction_trajectory(data: xr.Dataset | object, t0: float | None = None,
         Simulation result.
     t0, t1 : float, optional
         Window [s].
+    slider : int
+        Which slider (from 0).
 
     Returns
     -------
@@ -62,15 +68,17 @@ def friction_trajectory(data: xr.Dataset | object, t0: float | None = None,
     fivdisc.analysis.spectra.AnalysisError
         If the window is outside the data.
     """
-    ds = time_window(as_dataset(data)[["disc_speed", "phi_dot", "friction_force"]], t0, t1)
+    ds = select_slider(as_dataset(data), slider)
+    ds = time_window(ds[["disc_speed", "phi_dot", "friction_force"]], t0, t1)
     relative = (ds["disc_speed"] - ds["phi_dot"]).assign_attrs(
         units="rad/s", long_name="relative angular velocity (disc minus slider)"
     )
     return xr.Dataset({"relative_velocity": relative, "friction_force": ds["friction_force"]})
 
 
-def separation_intervals(data: xr.Dataset | object) -> list[tuple[float, float]]:
-    """Time intervals [s] in which the slider is separated from the disc.
+def separation_intervals(data: xr.Dataset | object,
+                         slider: int = 0) -> list[tuple[float, float]]:
+    """Time intervals [s] in which a slider is separated from the disc.
 
     Taken from the event table (``separation`` to the next ``recontact`` event), which
     has the exact switch times; a dataset without one falls back to runs of
@@ -82,13 +90,15 @@ def separation_intervals(data: xr.Dataset | object) -> list[tuple[float, float]]
     ----------
     data : xarray.Dataset or Result
         Simulation result.
+    slider : int
+        Which slider (from 0).
 
     Returns
     -------
     list of (float, float)
         ``(start, end)`` pairs [s], in time order.
     """
-    ds = as_dataset(data)
+    ds = select_slider(as_dataset(data), slider)
     time = ds["time"].values
     first, last = float(time[0]), float(time[-1])
     if "event_time" in ds and "event_kind" in ds:
@@ -116,13 +126,15 @@ def separation_intervals(data: xr.Dataset | object) -> list[tuple[float, float]]
     return [(a, b) for a, b in clipped if b > a]
 
 
-def separation_stats(data: xr.Dataset | object) -> dict[str, float | int]:
-    """How much the slider separates from the disc.
+def separation_stats(data: xr.Dataset | object, slider: int = 0) -> dict[str, float | int]:
+    """How much a slider separates from the disc.
 
     Parameters
     ----------
     data : xarray.Dataset or Result
         Simulation result.
+    slider : int
+        Which slider (from 0).
 
     Returns
     -------
@@ -130,10 +142,10 @@ def separation_stats(data: xr.Dataset | object) -> dict[str, float | int]:
         ``count``: separation intervals; ``first_time``: start of the first [s] (nan
         if none); ``fraction``: share of the record spent separated; ``largest_gap``:
         maximum of ``gap`` [m] (0 if always in contact); ``impacts``: re-contact
-        events, 0 when the run ignored impacts (attribute ``impact`` false), as in
-        :meth:`fivdisc.result.Result.summary`.
+        events of the slider, 0 when the run ignored impacts (attribute ``impact``
+        false).
     """
-    ds = as_dataset(data)
+    ds = select_slider(as_dataset(data), slider)
     intervals = separation_intervals(ds)
     time = ds["time"].values
     span = float(time[-1] - time[0])

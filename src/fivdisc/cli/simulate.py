@@ -28,12 +28,16 @@ def simulate(case_file: Path, output: Path | None, progress: bool) -> None:
     result = run(case, progress=progress)
     result.to_netcdf(out)
     s = result.summary()
-    phases = ", ".join(f"{k} {v:.4g} s" for k, v in s["time_in_phase"].items())
     click.echo(f"wrote {out}")
-    click.echo(f"time in phase: {phases}")
+    several = isinstance(s["time_in_phase"], list)
+    spent = s["time_in_phase"] if several else [s["time_in_phase"]]
+    for j, times in enumerate(spent):
+        phases = ", ".join(f"{k} {v:.4g} s" for k, v in times.items())
+        click.echo(f"{f'slider {j} ' if several else ''}time in phase: {phases}")
+    peaks = s["peak_normal_force"] if several else [s["peak_normal_force"]]
     click.echo(f"switches: {s['switches']}, separations: {s['separations']}, "
                f"impacts: {s['impacts']}")
-    click.echo(f"peak normal force: {s['peak_normal_force']:.6g} N, "
+    click.echo(f"peak normal force: {', '.join(f'{p:.6g}' for p in peaks)} N, "
                f"largest |w| at probes: {s['max_abs_w']:.6g} m, wall time: {s['wall_time']:.3g} s")
     if not result.ok:
         click.echo(f"error: simulation failed: {result.message}", err=True)

@@ -19,9 +19,12 @@ from fivdisc.errors import FivdiscError
               help="One map and boundary curve per value, e.g. decay=0,1,10.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               help="map.nc (netCDF dataset) or map.png (figure).")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print the equilibrium and the eigenvalues as JSON (without a map).")
 @click.option("--progress/--no-progress", default=True, show_default=True)
 def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
-              curve_spec: str | None, output: Path | None, progress: bool) -> None:
+              curve_spec: str | None, output: Path | None, as_json: bool,
+              progress: bool) -> None:
     """Stability of the sliding equilibrium of CASE_FILE (default: Table 1 at 2 pi rad/s).
 
     Without --x/--y: prints the equilibrium and the eigenvalues of the linearised slip
@@ -34,9 +37,17 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
     case = load_case(case_file) if case_file else Case()
     if x_spec is None and y_spec is None:
         res = linear_stability(case)
+        if as_json:
+            import json
+
+            click.echo(json.dumps(res.to_dict(), indent=2))
+            return
         eq = res.equilibrium
-        click.echo(f"sliding equilibrium at Omega = {eq.speed:.6g} rad/s: phi = {eq.phi:.6g} rad,"
-                   f" N = {eq.normal_force:.6g} N, f = {eq.friction_force:.6g} N")
+        click.echo(f"sliding equilibrium at Omega = {eq.speed:.6g} rad/s:")
+        for j, (phi, nf, f) in enumerate(zip(eq.phi, eq.normal_force, eq.friction_force,
+                                             strict=True)):
+            who = f"slider {j}: " if eq.phi.size > 1 else ""
+            click.echo(f"  {who}phi = {phi:.6g} rad, N = {nf:.6g} N, f = {f:.6g} N")
         click.echo(f"{'growth rate [1/s]':>18} {'frequency [Hz]':>15}  mode")
         for row in res.table():
             click.echo(f"{row['growth_rate']:18.6g} {row['frequency_hz']:15.6g}  "
@@ -46,6 +57,8 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
         return
     if x_spec is None or y_spec is None:
         raise FivdiscError("a stability map needs both --x and --y (KEY=START:STOP:N)")
+    if as_json:
+        raise FivdiscError("--json prints the equilibrium and eigenvalues: leave out --x/--y")
     if output is not None and output.suffix not in (".nc", ".png"):
         raise FivdiscError(f"-o {output}: the file must end in .nc or .png")
     x = parse_range(x_spec, "--x")

@@ -33,6 +33,7 @@ from fivdisc.case import Case
 from fivdisc.model import build_model
 from fivdisc.paper import measure as ms
 from fivdisc.paper.cases import FIGURES, PaperCase
+from fivdisc.result import select_slider
 from fivdisc.simulate import initial_state, simulate
 
 if TYPE_CHECKING:
@@ -46,7 +47,7 @@ RECIPE = 1
 
 # Result variables a figure may draw, and the event table.
 _KEEP = ("phi", "phi_dot", "w", "normal_force", "friction_force", "phase", "disc_speed",
-         "event_time", "event_kind", "event_from")
+         "event_time", "event_kind", "event_from", "event_slider")
 _RUN_ATTRS = ("status", "message", "end_time", "impact", "case")
 _STFT_SEGMENT = 0.2  # [s]: 5 Hz resolution, fine enough to tell the disc modes apart
 _FMAX = 1000.0  # [Hz], the Nyquist frequency of the 2 kHz output
@@ -123,7 +124,8 @@ class Runs:
                 initial = initial_state(build_model(FIGURES[start_from].case))
             ds = simulate(case, initial=initial).dataset
             # A deep copy: the kept variables are views of the run's whole state buffer.
-            self._done[key] = ds[list(_KEEP)].copy(deep=True)
+            # The paper's cases have one slider: its variables are kept as plain series.
+            self._done[key] = select_slider(ds[list(_KEEP)], 0).copy(deep=True)
         return self._done[key]
 
     def printed(self, case: Case, start_from: int | None = None) -> xr.Dataset:
@@ -405,7 +407,7 @@ def _decay_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
     stab = linear_stability(pc.case)
     eq = sliding_equilibrium(pc.case)
     t = ds["time"].values
-    dev = np.abs(ds["phi"].values - eq.phi)
+    dev = np.abs(ds["phi"].values - eq.phi[0])
     initial = float(dev[0])
     after = float(np.max(dev[(t >= 1.0) & (t <= 1.1)]))
     final = float(np.max(dev[t >= t[-1] - 0.5]))

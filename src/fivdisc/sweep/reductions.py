@@ -100,11 +100,19 @@ def _first_separation(result: Result | None, case: Case) -> float:
     return float(times[0]) if times.size else math.nan
 
 
+def _per_slider(value: Any) -> list:
+    """A summary entry as a list over sliders (one-slider summaries hold the item)."""
+    return value if isinstance(value, list) else [value]
+
+
 def _phase_fraction(phase: str) -> Callable[[Result | None, Case], float]:
     def fraction(result: Result | None, case: Case) -> float:
-        spent = result.summary()["time_in_phase"]
-        total = sum(spent.values())
-        return spent[phase] / total if total > 0 else math.nan
+        shares = [
+            spent[phase] / sum(spent.values())
+            for spent in _per_slider(result.summary()["time_in_phase"])
+            if sum(spent.values()) > 0
+        ]
+        return sum(shares) / len(shares) if shares else math.nan
 
     return fraction
 
@@ -140,7 +148,7 @@ BUILTIN: dict[str, Reduction] = {
             "separated",
             lambda result, case: result.events("separation").size > 0,
             "1",
-            "the slider separated from the disc at least once",
+            "a slider separated from the disc at least once",
             dtype="bool",
             decided_by=("separation",),
         ),
@@ -148,20 +156,20 @@ BUILTIN: dict[str, Reduction] = {
             "first_separation_time",
             _first_separation,
             "s",
-            "time of the first separation (nan if none)",
+            "time of the first separation of any slider (nan if none)",
             decided_by=("separation",),
         ),
         _builtin(
             "stick_fraction",
             _phase_fraction("stick"),
             "1",
-            "fraction of the output samples' time spent in stick",
+            "fraction of the output samples' time spent in stick (mean over sliders)",
         ),
         _builtin(
             "separation_fraction",
             _phase_fraction("separation"),
             "1",
-            "fraction of the output samples' time spent in separation",
+            "fraction of the output samples' time spent in separation (mean over sliders)",
         ),
         _builtin(
             "max_abs_w",
@@ -171,15 +179,15 @@ BUILTIN: dict[str, Reduction] = {
         ),
         _builtin(
             "max_normal_force",
-            lambda result, case: result.summary()["peak_normal_force"],
+            lambda result, case: max(_per_slider(result.summary()["peak_normal_force"])),
             "N",
-            "largest normal contact force",
+            "largest normal contact force of any slider",
         ),
         _builtin(
             "dominant_frequency",
             _dominant_frequency,
             "Hz",
-            "dominant frequency of the slider angle phi",
+            "dominant frequency of the angle phi of slider 0",
         ),
         _builtin(
             "max_growth_rate",
