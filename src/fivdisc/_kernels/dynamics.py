@@ -264,7 +264,7 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
     [m/s], the relative speed ``Omega - phidot`` [rad/s], ... and rows of g and g' at
     every slider. ``right`` picks the right limit of the speed at a knot.
     """
-    g, gp, fq, cl, sl, aux, amat, bvec, cidx = wk
+    g, gp, fq, _, _, aux, amat, bvec, cidx = wk
     n, ns, half = sizes(mdl)
     om, omd = speed_at(t, mdl.knots, mdl.coef, right)
     _disc_forces(t, y, om, omd, mdl, fq, dy)

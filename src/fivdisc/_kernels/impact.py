@@ -27,7 +27,7 @@ def contact_velocity(j, y, mdl, wk):
     """Normal velocity of the disc's surface under slider j [m/s]; rows j of g, g' in
     ``wk`` must hold the mode shapes at ``y``."""
     g, gp = wk[0], wk[1]
-    n, ns, half = sizes(mdl)
+    n, _, half = sizes(mdl)
     phid = y[half + n + j]
     acc = 0.0
     for i in range(n):
@@ -171,7 +171,7 @@ def contact_impact(members, count, y, mdl, wk, forced, w_out):
     ``forced`` marks contacts that must stay closed. On return ``w_out[a]`` is the gap
     velocity of member a after the impact (> 0: it leaves the disc).
     """
-    g, gp = wk[0], wk[1]
+    g = wk[0]
     n, ns, half = sizes(mdl)
     u_minus = y.copy()
     before = _kinetic(y, mdl, members, count)

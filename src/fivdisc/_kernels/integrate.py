@@ -116,7 +116,7 @@ def choose_phase(j, t, y, ph, sg, mdl, wk, dy):
     """Phase of slider j in contact at state ``y``, the others' phases held: stick, slip
     (with its sign) or, where contact would need a pulling normal force, separation."""
     aux = wk[5]
-    n, ns, half = sizes(mdl)
+    n, _, half = sizes(mdl)
     om, _ = speed_at(t, mdl.knots, mdl.coef, True)
     v = om - y[half + n + j]
     s = sg[j]
@@ -213,7 +213,7 @@ def _surface_acceleration(k, y, mdl, wk, dy):
     derivatives ``dy`` at ``y`` [m/s^2]."""
     g = wk[0]
     aux = wk[5]
-    n, ns, half = sizes(mdl)
+    n, _, half = sizes(mdl)
     phid = aux[A_PHID, k]
     acc = 2.0 * phid * aux[A_GPQD, k] - phid * phid * aux[A_L2GQ, k]
     acc += dy[half + n + k] * aux[A_GPQ, k]

@@ -10,7 +10,7 @@ import xarray as xr
 
 from fivdisc._kernels import dynamics as dyn
 from fivdisc._kernels import layout as lay
-from fivdisc.analysis.equilibrium import Equilibrium, slip_phases, sliding_equilibrium
+from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium, slip_phases
 from fivdisc.case import Case
 from fivdisc.errors import CaseError, SimulationError
 from fivdisc.model import Model, build_model
