@@ -60,6 +60,7 @@ __all__ = [
     "StribeckFriction",
     "TableFriction",
     "TableSpeed",
+    "is_case_key",
     "load_case",
     "unit_of",
 ]
@@ -893,6 +894,12 @@ class Case(_Table):
                     table.clear()
             table[name] = _plain(updates[key])
         return _validate(data, source=None)
+
+
+def is_case_key(key: str) -> bool:
+    """Whether ``key`` names a value of some case: a key of :meth:`Case.valid_keys` or
+    ``sliders.J.KEY`` for a slider key (whether slider J exists depends on the case)."""
+    return _template(key) in _LEAVES
 
 
 def _template(key: str) -> str:

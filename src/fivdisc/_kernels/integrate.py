@@ -366,6 +366,31 @@ def apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst):
 
 
 @njit(cache=True)
+def _simultaneous(first, t, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k, ev_prev, ev_t, ev_i,
+                  ist, fst):
+    """Switches of other sliders whose events crossed zero at the same instant as event
+    ``first`` (identical sliders, say), taken one after the other in slider order; without
+    this they would be seen only at the end of the next step."""
+    n_sl = ph.shape[0]
+    handled = np.zeros(n_sl, np.bool_)
+    handled[first // 3] = True
+    for _ in range(n_sl):
+        nxt = -1
+        for i in range(ev_prev.shape[0]):
+            j = i // 3
+            if (not handled[j] and ph[j] == ph_start[j] and ev_start[i] > 0.0
+                    and ev_prev[i] <= 0.0):
+                nxt = i
+                break
+        if nxt < 0:
+            return
+        handled[nxt // 3] = True
+        apply_switch(nxt, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst)
+        _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
+        ist[I_RHS] += 1
+
+
+@njit(cache=True)
 def _event_at(theta, i, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist):
     ist[I_EVAL_EVENTS] += 1
     dense_eval(rc, theta, ytmp)
@@ -660,14 +685,19 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
             dense_eval(rc, theta, y)
             first_new = ist[I_EVENTS]
             fst[F_H_CAP] = np.inf
+            ph_start = ph.copy()
+            ev_start = ev_prev.copy()
             apply_switch(which, t_e, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst)
+            t = t_e
+            _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
+            ist[I_RHS] += 1
+            if n_sl > 1:
+                _simultaneous(which, t, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k, ev_prev,
+                              ev_t, ev_i, ist, fst)
             stop_mask = int(ctl[C_STOP_MASK])
             for e in range(first_new, ist[I_EVENTS]):
                 if stop_mask & (1 << ev_i[e, EVI_KIND]):
                     status = ST_STOPPED
-            t = t_e
-            _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
-            ist[I_RHS] += 1
             ist[I_SWITCHES] += 1
             if t - fst[F_LAST_SWITCH] < ctl[C_ZENO_DT]:
                 ist[I_ZENO] += 1

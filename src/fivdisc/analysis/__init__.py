@@ -1,5 +1,6 @@
 """Analyses of the slider-on-disc system: equilibrium, stability, spectra, trajectories."""
 
+from fivdisc.analysis.energy import energy_balance
 from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium
 from fivdisc.analysis.spectra import (
     Periodicity,
@@ -32,6 +33,7 @@ __all__ = [
     "Spectrum",
     "classify",
     "dominant_frequency",
+    "energy_balance",
     "find_peaks",
     "friction_trajectory",
     "linear_stability",

@@ -11,7 +11,7 @@ import xarray as xr
 from fivdisc._kernels import dynamics as dyn
 from fivdisc._kernels import layout as lay
 from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium, slip_phases
-from fivdisc.case import Case
+from fivdisc.case import Case, is_case_key
 from fivdisc.errors import CaseError, SimulationError
 from fivdisc.model import Model, build_model
 from fivdisc.speed import SpeedProfile
@@ -389,9 +389,7 @@ def resolve_key(key: str, option: str) -> str:
     import difflib
 
     keys = Case.valid_keys()
-    parts = key.split(".")
-    if key in keys or (len(parts) == 3 and parts[0] == "sliders" and parts[1].isdigit()
-                       and f"slider.{parts[2]}" in keys):
+    if is_case_key(key):
         return key
     matches = [k for k in keys if k.rsplit(".", 1)[-1] == key]
     if len(matches) == 1:

@@ -32,7 +32,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from fivdisc.case import Case, load_case
+from fivdisc.case import Case, is_case_key, load_case
 from fivdisc.errors import CaseError
 from fivdisc.sweep.reductions import Reduction, SweepError, nearest, resolve, stop_events
 
@@ -180,7 +180,7 @@ class Sweep:
             raise SweepError("axes is empty: name at least one case key to vary")
         axes: dict[str, tuple[Any, ...]] = {}
         for key, raw in self.axes.items():
-            if key not in valid:
+            if not is_case_key(key):
                 raise SweepError(f"axes: unknown case key '{key}'{nearest(key, valid)}")
             axes[key] = _axis_values(key, raw)
         if self.mode == "zip" and len({len(v) for v in axes.values()}) > 1:
@@ -190,11 +190,11 @@ class Sweep:
 
         link = dict(self.link)
         for target, origin in link.items():
-            if target not in valid:
+            if not is_case_key(target):
                 raise SweepError(f"link: unknown case key '{target}'{nearest(target, valid)}")
             if target in axes:
                 raise SweepError(f"link: '{target}' is an axis; it cannot also copy '{origin}'")
-            if not isinstance(origin, str) or origin not in valid:
+            if not isinstance(origin, str) or not is_case_key(origin):
                 raise SweepError(
                     f"link.'{target}' = {origin!r} is invalid: must be a case key"
                     f"{nearest(str(origin), valid)}"
