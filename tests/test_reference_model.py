@@ -61,7 +61,7 @@ def test_rigid_disc_stick_slip_period(omega):
     period = 2.0 * amp / omega + (math.pi + 2.0 * math.atan(omega / (w * amp))) / w
 
     res = rm.reference_simulate(case, 6.5 * period, mode_data=RIGID)
-    sticks = np.array([t for t, _, _, kind in res.events if kind == "stick"])
+    sticks = np.array([t for t, _, _, kind, _ in res.events if kind == "stick"])
     assert sticks.size >= 5
     # From the first stick on the motion is exactly on the limit cycle (every slip starts
     # at phi_k + A with phidot = Omega), so every later stick-to-stick time is the period.
@@ -70,7 +70,7 @@ def test_rigid_disc_stick_slip_period(omega):
     np.testing.assert_allclose(np.diff(sticks[1:]), period, rtol=1e-8)
     # every stick after the first lasts 2A/Omega (same reasoning for the tolerance); the
     # first one starts from the transient's phi, not from phi_k - A
-    slips = np.array([t for t, _, _, kind in res.events if kind == "slip"])
+    slips = np.array([t for t, _, _, kind, _ in res.events if kind == "slip"])
     k = min(sticks.size, slips.size)
     assert np.all(slips[:k] > sticks[:k])
     np.testing.assert_allclose(slips[1:k] - sticks[1:k], 2 * amp / omega, rtol=1e-8)
@@ -124,13 +124,13 @@ def _power(case, md, out):
     hk = case.disc.thickness / (2.0 * sl.track_radius)
     p = np.empty(out["t"].size)
     for i in range(p.size):
-        _, gp = _kin(md, out["phi"][i])
+        _, gp = _kin(md, out["phi"][i, 0])
         p[i] = (
-            out["normal_force"][i] * out["phi_dot"][i] * (gp @ out["q"][i])
-            + out["friction_force"][i]
-            * (sl.track_radius * out["phi_dot"][i] + hk * (gp @ out["q_dot"][i]))
-            - sl.rotational_damping * out["phi_dot"][i] ** 2
-            - sl.normal_damping * out["z_dot"][i] ** 2
+            out["normal_force"][i, 0] * out["phi_dot"][i, 0] * (gp @ out["q"][i])
+            + out["friction_force"][i, 0]
+            * (sl.track_radius * out["phi_dot"][i, 0] + hk * (gp @ out["q_dot"][i]))
+            - sl.rotational_damping * out["phi_dot"][i, 0] ** 2
+            - sl.normal_damping * out["z_dot"][i, 0] ** 2
         )
     return p
 
@@ -228,9 +228,9 @@ def test_recontact_with_impact(table1_modes, phid):
     assert imp["zdot_minus"] < g @ qdm + phidm * (gp @ qm)  # it was an approach
     # the later segment at t_r is in contact and reports the same normal velocity
     out = res.evaluate([t_r])
-    assert out["phase"][0] in rm.CONTACT_PHASES
-    assert out["z_dot"][0] == pytest.approx(imp["zdot_plus"], abs=1e-14)
-    assert out["normal_force"][0] >= 0.0
+    assert out["phase"][0, 0] in rm.CONTACT_PHASES
+    assert out["z_dot"][0, 0] == pytest.approx(imp["zdot_plus"], abs=1e-14)
+    assert out["normal_force"][0, 0] >= 0.0
     # T2 does not increase (here b = phidot g'.q is small against the approach velocity)
     t2 = [
         0.5 * np.sum(md.M * qd**2) + 0.5 * case.slider.mass * zd**2
