@@ -1690,6 +1690,7 @@ class _Runner:
             self.settle(t, y, ph, sg, piece, fresh, only_separations=True)
 
         stalled = 0
+        fresh: set[int] = set()  # sliders switched at the current instant
         while t < self.t_end:
             piece = _piece_at(pieces, t)
             t_stop = min(piece.t_b, self.t_end)
@@ -1723,10 +1724,12 @@ class _Runner:
                 if stalled > 50:
                     raise RuntimeError(f"phase switches do not advance in time at t = {t}")
             new_piece = _piece_at(pieces, t_new)
-            fresh = set()
+            if t_new > t:
+                fresh = set()
             if ivp.status == 1:
-                j, cause = names[which]
-                self.handle(t_new, y_new, ph, sg, j, cause, new_piece, fresh)
+                first = names[which]
+                for j, cause in self.simultaneous(t_new, y_new, ph, sg, piece, *first):
+                    self.handle(t_new, y_new, ph, sg, j, cause, new_piece, fresh)
                 self.settle(t_new, y_new, ph, sg, new_piece, fresh)
             elif t_new < self.t_end:  # a speed breakpoint: re-check with the new Omegadot
                 for j in range(S):
@@ -1743,6 +1746,34 @@ class _Runner:
                     fresh.add(j)
                 self.settle(t_new, y_new, ph, sg, new_piece, fresh)
             t, y = t_new, y_new
+
+    def simultaneous(self, t, y, ph, sg, piece, j0, cause0):
+        """The event (j0, cause0) and every other slider's exit condition met at the same
+        instant (to round-off), in slider order: [(slider, cause)].
+
+        Distances to each exit, relative: slip ``s v`` (tolerance ``vtol``), ``N`` and
+        ``mu_s N - |f|`` (1e-11 of N0 / of the force), the gap (round-off of z).  N = 0 takes
+        precedence over the other exit of the same slider."""
+        model = self.model
+        r = model.solve(ph, sg, t, y, piece)
+        found = {j0: cause0}
+        for j in range(model.S):
+            if j == j0:
+                continue
+            if ph[j] == SEPARATION:
+                if y[self.i_e + j] <= model.z_roundoff(j, r["z"][j]):
+                    found[j] = "gap0"
+                continue
+            if r["N"][j] <= 1e-11 * max(abs(model._N0[j]), 1.0):
+                found[j] = "N0"
+            elif ph[j] == SLIP:
+                if sg[j] * (piece.omega(t) - y[self.i_phid + j]) <= self.vtol(piece, t):
+                    found[j] = "v0"
+            else:
+                limit = model.mu_s * r["N"][j]
+                if limit - abs(r["f"][j]) <= 1e-11 * max(limit, abs(r["f"][j]), 1.0):
+                    found[j] = "friction_limit"
+        return sorted(found.items())
 
     def handle(self, t, y, ph, sg, j, cause, piece, fresh):
         model = self.model
