@@ -200,6 +200,7 @@ Two properties of the stated model (not of this code) that checks must respect
 
 from __future__ import annotations
 
+import bisect
 import itertools
 import math
 from collections.abc import Mapping, Sequence
@@ -290,8 +291,10 @@ class _Sliders:
 
         def arr(name, default=None):
             return np.array(
-                [float(getattr(s, name, default) if default is not None else getattr(s, name))
-                 for s in sl]
+                [
+                    float(getattr(s, name, default) if default is not None else getattr(s, name))
+                    for s in sl
+                ]
             )
 
         r = arr("track_radius")
@@ -317,9 +320,10 @@ class ModeData:
     """Per modal coordinate (C and D separately): R at the track radius, modal mass, omega,
     l, sine flag.
 
-    ``R0`` holds R at the first slider's radius (shape (n,)); ``R`` (optional, shape (S, n))
-    holds it at every slider's radius.  Without ``R`` every slider uses ``R0`` (sliders on
-    one track, or no modes).
+    ``R0`` holds R at the first slider's radius (shape (n,)).  Optional: ``R`` (shape (k, n))
+    holds R at the radii ``radii`` (k values).  A slider on radius r uses the row of ``R``
+    with that radius; without ``radii``, ``R`` must have one row per slider, and without
+    ``R`` every slider uses ``R0`` (sliders on one track, or no modes).
     """
 
     R0: np.ndarray
@@ -328,6 +332,7 @@ class ModeData:
     l: np.ndarray
     is_sine: np.ndarray
     R: np.ndarray | None = None
+    radii: tuple | None = None
 
     @property
     def n(self) -> int:
@@ -343,17 +348,27 @@ class ModeData:
                 part[j] = j + 1 if not self.is_sine[j] else j - 1
         return part
 
-    def radial(self, S: int) -> np.ndarray:
-        """R at each of S sliders' radii, shape (S, n)."""
-        if self.R is not None:
-            R = np.asarray(self.R, float)
+    def radial(self, radii) -> np.ndarray:
+        """R at the given sliders' radii, shape (S, n)."""
+        radii = [float(r) for r in radii]
+        S = len(radii)
+        if self.R is None:
+            return np.tile(self.R0, (S, 1))
+        R = np.asarray(self.R, float)
+        if self.radii is None:
             if R.shape != (S, self.n):
                 raise ValueError(f"ModeData.R has shape {R.shape}, expected {(S, self.n)}")
             return R
-        return np.tile(self.R0, (S, 1))
+        rows = []
+        for r in radii:
+            k = [i for i, ri in enumerate(self.radii) if abs(ri - r) <= 1e-14 * abs(r)]
+            if not k:
+                raise ValueError(f"ModeData has no mode shapes at radius {r} m")
+            rows.append(R[k[0]])
+        return np.array(rows).reshape(S, self.n)
 
     @classmethod
-    def from_lists(cls, R0, M, omega, l, is_sine, R=None) -> ModeData:
+    def from_lists(cls, R0, M, omega, l, is_sine, R=None, radii=None) -> ModeData:
         return cls(
             np.asarray(R0, float),
             np.asarray(M, float),
@@ -361,6 +376,7 @@ class ModeData:
             np.asarray(l, int),
             np.asarray(is_sine, bool),
             None if R is None else np.atleast_2d(np.asarray(R, float)),
+            None if radii is None else tuple(float(r) for r in radii),
         )
 
 
@@ -383,7 +399,7 @@ def mode_data_from_case(case: Any) -> ModeData:
                 ll.append(int(l))
                 sine.append(is_sine)
     R = np.array(cols, float).T.reshape(len(radii), len(cols))
-    return ModeData.from_lists(R[0], M, om, ll, sine, R=R)
+    return ModeData.from_lists(R[0], M, om, ll, sine, R=R, radii=radii)
 
 
 def _disc_damping(case: Any, md: ModeData) -> tuple[np.ndarray, bool]:
@@ -448,6 +464,9 @@ class FrictionLaw:
             self.pchip = PchipInterpolator(u, mu, extrapolate=False)
             self.mu_first = float(mu[0])
             self.slope_first = float(self.pchip.derivative()(u[0]))
+            # the PCHIP's cubic pieces, evaluated in plain Python (scipy's call is slow)
+            self._knots = [float(x) for x in self.pchip.x]
+            self._coef = [tuple(float(c) for c in col) for col in self.pchip.c.T]
         else:
             raise ValueError(f"unknown friction law {self.law!r}")
 
@@ -466,7 +485,10 @@ class FrictionLaw:
             return self.mu_last
         if u <= self.u_first:
             return self.mu_first + self.slope_first * (u - self.u_first)
-        return float(self.pchip(u))
+        i = min(bisect.bisect_right(self._knots, u) - 1, len(self._coef) - 1)
+        c3, c2, c1, c0 = self._coef[i]
+        dx = u - self._knots[i]
+        return ((c3 * dx + c2) * dx + c1) * dx + c0
 
 
 # --------------------------------------------------------------------------- speed profile
@@ -560,7 +582,7 @@ class _Model:
         self.n = md.n
         self.sl = _Sliders.from_case(case)
         self.S = self.sl.S
-        self.R = md.radial(self.S)
+        self.R = md.radial(self.sl.r)
         self.friction = FrictionLaw(fr)
         self.mu_s = self.friction.mu_s
         self.zeta, self.material = _disc_damping(case, md)
@@ -664,8 +686,10 @@ class _Model:
         """Normalised (phases, signs) tuples."""
         if isinstance(phases, tuple) and isinstance(signs, tuple) and len(phases) == self.S:
             return phases, signs
-        return (tuple(_as_phases(phases, self.S, "phases")),
-                tuple(_as_phases(signs, self.S, "signs")))
+        return (
+            tuple(_as_phases(phases, self.S, "phases")),
+            tuple(_as_phases(signs, self.S, "signs")),
+        )
 
     def solve(self, phases, signs, t, y, piece):
         """Accelerations, N, f, z, zdot of every slider for the phase combination."""
@@ -707,8 +731,9 @@ class _Model:
                 A[ie, :n] = m * G[j]
                 A[ie, ip] = m * gpq[j]
                 A[ie, ie] = sg * m
-                rhs[ie] = (-(self._cz[j] * zd[j] + self._kz[j] * z[j] + sg * self._N0[j])
-                           - m * centr[j])
+                rhs[ie] = (
+                    -(self._cz[j] * zd[j] + self._kz[j] * z[j] + sg * self._N0[j]) - m * centr[j]
+                )
                 continue
             if phases[j] == SLIP:
                 s = float(signs[j])
@@ -1118,7 +1143,7 @@ def _state_mapping(case: Any, md: ModeData, state, t, omega) -> Mapping:
     if y.size >= 2 * n + 4 * S:
         z, zd = y[2 * n + 2 * S : 2 * n + 3 * S], y[2 * n + 3 * S : 2 * n + 4 * S]
     else:  # in contact: the slider moves with the disc
-        g, gp, _ = _shapes(md, md.radial(S), sl.theta + phi)
+        g, gp, _ = _shapes(md, md.radial(sl.r), sl.theta + phi)
         z, zd = g @ q, g @ qd + phid * (gp @ q)
     if omega is None:
         omega = float(speed_at(case.speed, 0.0 if t is None else t)[0][0])
@@ -1137,9 +1162,8 @@ def _potential(case, md, sl, state):
     q = np.asarray(state["q"], float)
     z = _per_slider(state["z"], sl.S)
     phi = _per_slider(state["phi"], sl.S)
-    return (
-        0.5 * np.sum(md.M * md.omega**2 * q**2, axis=-1)
-        + np.sum(0.5 * sl.Kphi * phi**2 + 0.5 * sl.kz * z**2 + sl.sigma * sl.N0 * z, axis=-1)
+    return 0.5 * np.sum(md.M * md.omega**2 * q**2, axis=-1) + np.sum(
+        0.5 * sl.Kphi * phi**2 + 0.5 * sl.kz * z**2 + sl.sigma * sl.N0 * z, axis=-1
     )
 
 
@@ -1219,8 +1243,10 @@ def power_terms(case: Any, out: Mapping, *, mode_data: ModeData | None = None) -
     f = _per_slider(out["friction_force"], S).reshape(nt, S)
     Om = np.broadcast_to(_omega_of(case, out), (nt,))
     Omd = np.broadcast_to(np.asarray(out.get("Omega_dot", 0.0), float), (nt,))
-    res = {k: np.zeros(nt) for k in ("friction", "drive", "surface", "slider_damping",
-                                     "disc_damping", "options")}
+    res = {
+        k: np.zeros(nt)
+        for k in ("friction", "drive", "surface", "slider_damping", "disc_damping", "options")
+    }
     for i in range(nt):
         _, GP, GPP = model.shapes(phi[i])
         v = Om[i] - phid[i]
@@ -1314,8 +1340,8 @@ def sliding_equilibrium(case: Any, mode_data: ModeData | None = None) -> dict:
         p = model.partner
         for i in range(n):
             if md.l[i] >= 1:
-                K[i, p[i]] += 2.0 * model.zeta[i] * md.omega[i] * md.M[i] * model.csign[i] * (
-                    md.l[i] * Om
+                K[i, p[i]] += (
+                    2.0 * model.zeta[i] * md.omega[i] * md.M[i] * model.csign[i] * (md.l[i] * Om)
                 )
 
     def parts(phi):
@@ -1334,8 +1360,13 @@ def sliding_equilibrium(case: Any, mode_data: ModeData | None = None) -> dict:
     phi_start = sl.r * mu * sl.N0 / sl.Kphi
     if S == 1:
         phi = np.array(
-            [float(newton(lambda x: residual(np.array([x]))[0], phi_start[0], tol=1e-15,
-                          maxiter=100))]
+            [
+                float(
+                    newton(
+                        lambda x: residual(np.array([x]))[0], phi_start[0], tol=1e-15, maxiter=100
+                    )
+                )
+            ]
         )
     else:
         sol = root(residual, phi_start, method="hybr", tol=1e-15)
@@ -1344,8 +1375,13 @@ def sliding_equilibrium(case: Any, mode_data: ModeData | None = None) -> dict:
         phi = sol.x
     q, N = parts(phi)
     if S == 1:
-        return {"q": q, "q_dot": np.zeros(n), "phi": float(phi[0]), "phi_dot": 0.0,
-                "N": float(N[0])}
+        return {
+            "q": q,
+            "q_dot": np.zeros(n),
+            "phi": float(phi[0]),
+            "phi_dot": 0.0,
+            "N": float(N[0]),
+        }
     return {"q": q, "q_dot": np.zeros(n), "phi": phi, "phi_dot": np.zeros(S), "N": N}
 
 
@@ -1355,11 +1391,13 @@ def free_doublet_eigenvalues(omega: float, l: int, Omega: float, zeta: float, fr
     their conjugates.  For l = 0 the pair belongs to the real coordinate C."""
     if frame == "material":
         wd = omega * np.sqrt(1.0 - zeta**2 + 0j)
-        return np.array([1j * l * Omega - zeta * omega + 1j * wd,
-                         1j * l * Omega - zeta * omega - 1j * wd])
+        return np.array(
+            [1j * l * Omega - zeta * omega + 1j * wd, 1j * l * Omega - zeta * omega - 1j * wd]
+        )
     root_ = np.sqrt(omega**2 * (1.0 - zeta**2) + 2j * zeta * omega * l * Omega)
-    return np.array([1j * l * Omega - zeta * omega + 1j * root_,
-                     1j * l * Omega - zeta * omega - 1j * root_])
+    return np.array(
+        [1j * l * Omega - zeta * omega + 1j * root_, 1j * l * Omega - zeta * omega - 1j * root_]
+    )
 
 
 # --------------------------------------------------------------------------- driver
@@ -1422,8 +1460,7 @@ def _initial_state(case: Any, model: _Model, y0, phase0):
 class _Runner:
     """The phase machine: integrates stretches and switches the sliders' phases."""
 
-    def __init__(self, model: _Model, pieces, t_end, rtol, atol, method, max_step,
-                 max_switches):
+    def __init__(self, model: _Model, pieces, t_end, rtol, atol, method, max_step, max_switches):
         self.model = model
         self.pieces = pieces
         self.t_end = t_end
@@ -1499,6 +1536,7 @@ class _Runner:
         S = model.S
         log = self.set_phase
         if only_separations:
+
             def log(t_, y_, ph_, sg_, j_, new, new_s, recontact=False):
                 old = ph_[j_]
                 if new == SEPARATION and old != SEPARATION:
@@ -1506,6 +1544,7 @@ class _Runner:
                 ph_[j_], sg_[j_] = new, (new_s if new == SLIP else 0)
                 if new == SEPARATION and old != SEPARATION:
                     self.record(t_, j_, old, new, 0, 0)
+
         for _ in range(8 * S * S + 8):
             r = model.solve(ph, sg, t, y, piece)
             for j in range(S):
@@ -1560,20 +1599,42 @@ class _Runner:
             loss = 0.5 * sl.m[j] * (wd_j**2 - zd_minus[j] ** 2)
             landing = [j]
             released: list[int] = []
-            info = {"contacts": [j], "lam": np.zeros(1), "b": np.zeros(1), "du_W2": 0.0,
-                    "dT2": loss, "forced": [], "impact": False, "loss": loss, "surface": 0.0,
-                    "zdot_minus": float(zd_minus[j]), "zdot_plus": float(wd_j)}
+            info = {
+                "contacts": [j],
+                "lam": np.zeros(1),
+                "b": np.zeros(1),
+                "du_W2": 0.0,
+                "dT2": loss,
+                "forced": [],
+                "impact": False,
+                "loss": loss,
+                "surface": 0.0,
+                "zdot_minus": float(zd_minus[j]),
+                "zdot_plus": float(wd_j),
+                "gap_rate_minus": np.array([sl.sigma[j] * (zd_minus[j] - wd_j)]),
+                "gap_rate_plus": np.zeros(1),
+            }
         else:
             contacts = [
-                i for i in range(S)
-                if i == j or ph[i] != SEPARATION
-                or y[self.i_e + i] <= model.z_roundoff(i, z_now[i])
+                i
+                for i in range(S)
+                if i == j or ph[i] != SEPARATION or y[self.i_e + i] <= model.z_roundoff(i, z_now[i])
             ]
             cidx = np.array(contacts)
             forced: set[int] = set()
             while True:
-                imp = plastic_impact(md.M, sl.m[cidx], sl.sigma[cidx], G[cidx], GP[cidx], q, qd,
-                                     phid[cidx], zd_minus[cidx], forced=sorted(forced))
+                imp = plastic_impact(
+                    md.M,
+                    sl.m[cidx],
+                    sl.sigma[cidx],
+                    G[cidx],
+                    GP[cidx],
+                    q,
+                    qd,
+                    phid[cidx],
+                    zd_minus[cidx],
+                    forced=sorted(forced),
+                )
                 active = set(imp["active"])
                 rel = [k for k in range(len(contacts)) if k not in active]
                 # flight of each released contact: gap rate gp+ > 0, gap acceleration below
@@ -1621,12 +1682,21 @@ class _Runner:
             v = Om - phid[cidx]
             surface = float(-np.sum(lam * sl.sigma[cidx] * v * (GP[cidx] @ q)))
             k_j = contacts.index(j)
-            info = {"contacts": contacts, "lam": lam, "b": imp["b"], "du_W2": imp["du_W2"],
-                    "dT2": imp["dT2"], "forced": [contacts[k] for k in sorted(forced)],
-                    "impact": True, "loss": -0.5 * imp["du_W2"], "surface": surface,
-                    "zdot_minus": float(zd_minus[j]), "zdot_plus": float(imp["zdot"][k_j]),
-                    "gap_rate_minus": imp["gap_rate_minus"],
-                    "gap_rate_plus": imp["gap_rate_plus"]}
+            info = {
+                "contacts": contacts,
+                "lam": lam,
+                "b": imp["b"],
+                "du_W2": imp["du_W2"],
+                "dT2": imp["dT2"],
+                "forced": [contacts[k] for k in sorted(forced)],
+                "impact": True,
+                "loss": -0.5 * imp["du_W2"],
+                "surface": surface,
+                "zdot_minus": float(zd_minus[j]),
+                "zdot_plus": float(imp["zdot"][k_j]),
+                "gap_rate_minus": imp["gap_rate_minus"],
+                "gap_rate_plus": imp["gap_rate_plus"],
+            }
         # phases, in slider order: released contacts separate, landing sliders choose
         for i in range(S):
             if i in released and ph[i] != SEPARATION:
@@ -1727,8 +1797,7 @@ class _Runner:
             if t_new > t:
                 fresh = set()
             if ivp.status == 1:
-                first = names[which]
-                for j, cause in self.simultaneous(t_new, y_new, ph, sg, piece, *first):
+                for j, cause in self.simultaneous(ivp, evs, names, which, t_new, y_new):
                     self.handle(t_new, y_new, ph, sg, j, cause, new_piece, fresh)
                 self.settle(t_new, y_new, ph, sg, new_piece, fresh)
             elif t_new < self.t_end:  # a speed breakpoint: re-check with the new Omegadot
@@ -1747,32 +1816,38 @@ class _Runner:
                 self.settle(t_new, y_new, ph, sg, new_piece, fresh)
             t, y = t_new, y_new
 
-    def simultaneous(self, t, y, ph, sg, piece, j0, cause0):
-        """The event (j0, cause0) and every other slider's exit condition met at the same
-        instant (to round-off), in slider order: [(slider, cause)].
+    def simultaneous(self, ivp, evs, names, which, t, y):
+        """The event ``names[which]`` at t and every other exit of the stretch whose root lies
+        within ``t_tol = 1e-14 max(1, t)`` s after it (or that has already crossed at t, to
+        round-off), in slider order: [(slider, cause)].
 
-        Distances to each exit, relative: slip ``s v`` (tolerance ``vtol``), ``N`` and
-        ``mu_s N - |f|`` (1e-11 of N0 / of the force), the gap (round-off of z).  N = 0 takes
-        precedence over the other exit of the same slider."""
-        model = self.model
-        r = model.solve(ph, sg, t, y, piece)
+        scipy stops at the earliest root; the others are found by brentq on the dense output
+        of the same step (``ivp.sol.interpolants[-1]``, valid to the step's end).  Two exits
+        that mathematically coincide (symmetric sliders) are located ~1e-16 s apart by
+        round-off; 1e-14 s is ~20x brentq's location accuracy.  N = 0 takes precedence over
+        the other exit of the same slider."""
+        from scipy.optimize import brentq
+
+        interp = ivp.sol.interpolants[-1]
+        t_b = float(interp.t)
+        t_tol = 1e-14 * max(1.0, abs(t))
+        j0, cause0 = names[which]
         found = {j0: cause0}
-        for j in range(model.S):
-            if j == j0:
+        for k, (ev, (j, cause)) in enumerate(zip(evs, names, strict=True)):
+            if k == which:
                 continue
-            if ph[j] == SEPARATION:
-                if y[self.i_e + j] <= model.z_roundoff(j, r["z"][j]):
-                    found[j] = "gap0"
-                continue
-            if r["N"][j] <= 1e-11 * max(abs(model._N0[j]), 1.0):
-                found[j] = "N0"
-            elif ph[j] == SLIP:
-                if sg[j] * (piece.omega(t) - y[self.i_phid + j]) <= self.vtol(piece, t):
-                    found[j] = "v0"
-            else:
-                limit = model.mu_s * r["N"][j]
-                if limit - abs(r["f"][j]) <= 1e-11 * max(limit, abs(r["f"][j]), 1.0):
-                    found[j] = "friction_limit"
+            d = ev.direction
+            g_t = ev(t, y)
+            hit = d * g_t >= 0.0
+            if not hit and t_b > t:
+                g_b = ev(t_b, interp(t_b))
+                if d * g_b >= 0.0:
+                    root = brentq(
+                        lambda tt, ev=ev: ev(tt, interp(tt)), t, t_b, xtol=4 * _EPS, rtol=4 * _EPS
+                    )
+                    hit = root - t <= t_tol
+            if hit and (j not in found or cause == "N0"):
+                found[j] = cause
         return sorted(found.items())
 
     def handle(self, t, y, ph, sg, j, cause, piece, fresh):
