@@ -171,11 +171,17 @@ Phase choice and event re-arming
 * separation: exits when the gap reaches 0 from above (direction -1); the
   plastic impact is applied (unless ``simulation.impact`` is False), then the
   phase is chosen from the state.
+* Simultaneous events: scipy stops at the earliest root of all exit functions;
+  every other exit whose root lies within ``1e-14 max(1, t)`` s after it (found by
+  brentq on the same step's dense output), or that has already crossed at that
+  time, is taken at the same instant, one after the other in slider order.
+  (Mathematically coincident exits, e.g. of mirror-symmetric sliders, are located
+  ~1e-16 s apart by round-off.)
 * After any switch every slider in contact is re-checked (``N >= 0``; a sticking
   one ``|f| <= mu_s N``; a slipping one, unless it entered slip at this instant,
-  whether ``s v`` is at 0 within round-off, which then is its ``v = 0`` switch)
-  and the lowest-index violator switches first, repeatedly.  Simultaneous events
-  are so taken one after the other in slider order.
+  whether ``s v`` is at 0 within 1e-13 max(1, |Omega|), which then is its
+  ``v = 0`` switch) and the lowest-index violator switches first, repeatedly
+  (at most 8 S^2 + 8 rounds).
 * At t = 0 the phases come from the state (v = 0: stick test; else slip with the
   sign of v); a slider whose contact would need N < 0 starts separated, logged
   as a separation at t = 0.
@@ -1230,7 +1236,11 @@ def power_terms(case: Any, out: Mapping, *, mode_data: ModeData | None = None) -
     terms, printed gyroscopic sign) and their sum ``total`` = dE/dt.
     """
     md = mode_data if mode_data is not None else mode_data_from_case(case)
-    model = _Model(case, md)
+    return _power_terms(_Model(case, md), out)
+
+
+def _power_terms(model: _Model, out: Mapping) -> dict:
+    case, md = model.case, model.md
     sl = model.sl
     S = sl.S
     q = np.atleast_2d(np.asarray(out["q"], float))
@@ -1285,7 +1295,6 @@ def energy_terms(result: ReferenceResult, times=None, *, n_gauss: int = 8) -> di
     x, wts = np.polynomial.legendre.leggauss(n_gauss)
     names = ("friction", "drive", "surface", "slider_damping", "disc_damping", "options")
     # work on [0, t] per name: integrate every step panel, cut at the requested times
-    order = np.argsort(t_out)
     cum = {k: np.zeros(t_out.size) for k in names}
     for k, seg in enumerate(result.segments):
         edges = np.asarray(seg.ivp.t, float)
@@ -1295,7 +1304,7 @@ def energy_terms(result: ReferenceResult, times=None, *, n_gauss: int = 8) -> di
             if b <= a:
                 continue
             nodes = 0.5 * (a + b) + 0.5 * (b - a) * x
-            p = power_terms(case, result.evaluate_segment(k, nodes), mode_data=md)
+            p = _power_terms(result._model, result.evaluate_segment(k, nodes))
             for name in names:
                 w = 0.5 * (b - a) * float(np.sum(wts * p[name]))
                 cum[name][t_out >= b] += w
@@ -1310,7 +1319,6 @@ def energy_terms(result: ReferenceResult, times=None, *, n_gauss: int = 8) -> di
     out = {"t": t_out, "energy": e, **cum, "impact_loss": loss, "impact_surface": surf}
     out["work"] = sum(cum[k] for k in names) + loss + surf
     out["residual"] = e - e0 - out["work"]
-    del order
     return out
 
 
@@ -1584,6 +1592,9 @@ class _Runner:
     def recontact(self, t, y, ph, sg, j, piece, fresh):
         model = self.model
         md, sl, n, S = model.md, model.sl, model.n, model.S
+        for i in range(S):  # a sticking slider moves with the disc exactly
+            if ph[i] == STICK:
+                y[self.i_phid + i] = piece.omega(t)
         y_minus = y.copy()
         q, qd = y[:n], y[n : 2 * n]
         phi, phid = y[self.i_phi : self.i_phi + S], y[self.i_phid : self.i_phid + S]
