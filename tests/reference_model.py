@@ -124,8 +124,12 @@ sigma N zdot - c_z zdot^2``.  In contact ``zdot = wdot``, so with
                     - sigma_j N_j v_j (g'_j.q) ]                  (surface: moment, slope)
             - sum_j (r_j^2 c_phij phidot_j^2 + c_zj zdot_j^2)     (slider dampers)
             - a . D_damp                                          (disc damping)
-            + a . (rhs used - rhs of the stated model)            (options: no Omegadot
+            + a . F_options                                       (options: no Omegadot
                                                                    terms, printed sign)
+
+with ``F_options = +/- l M Omegadot q[partner]`` (the missing Omegadot terms, sign
+of the C / D equation moved to the right) and ``-4 l M Omega Cdot`` in each D
+equation (printed gyroscopic sign), written out from the option flags.
 
 The "surface" term is the work of the moving, sloped disc surface on the slider
 (the model's phi equation has no component of N along the slope; see below).
@@ -602,6 +606,7 @@ class _Model:
         # ... except the D equations' gyroscopic term with the printed paper's sign
         # (+2 l M Omega Cdot on the left: not skew), an option for comparison only
         printed = bool(getattr(sim, "printed_gyroscopic_sign", False))
+        self.printed = printed
         self.gsign = np.where(md.is_sine, -1.0 if printed else 1.0, -1.0)
         self.lf = md.l.astype(float)
         for name in ("r", "m", "kz", "cz", "Kphi", "Cphi", "N0", "I", "hk"):
@@ -670,16 +675,19 @@ class _Model:
             b -= self._c2zwM * vel
         return b
 
-    def disc_free_stated(self, q, qd, Om, Omd):
-        """disc_free of the stated model (Omegadot terms on, correct gyroscopic sign)."""
+    def option_forces(self, q, qd, Om, Omd):
+        """Generalised forces by which the options leave the stated model (written out from
+        the option flags, not as a difference of implementations): without the Omegadot
+        terms ``-(-/+) l M Omegadot q[partner]`` is missing; with the printed gyroscopic sign
+        the D equations carry ``-4 l M Omega Cdot`` more on the right."""
         md, p = self.md, self.partner
         lM = self.lf * md.M
-        b = self.dsign * 2.0 * lM * Om * qd[p] + self.dsign * lM * Omd * q[p]
-        b -= md.M * (md.omega**2 - self.lf**2 * Om**2) * q
-        if np.any(self.zeta):
-            vel = self.material_velocity(q, qd, Om) if self.material else qd
-            b -= 2.0 * self.zeta * md.omega * md.M * vel
-        return b
+        extra = np.zeros(self.n)
+        if not self.omega_dot_terms:
+            extra -= self.dsign * lM * Omd * q[p]
+        if self.printed:
+            extra -= np.where(md.is_sine, 4.0 * lM * Om * qd[p], 0.0)
+        return extra
 
     def stick_force(self, j, t, phi_j, piece):
         """Friction needed to hold slider j at phidot = Omega (its phi equation)."""
@@ -1271,10 +1279,7 @@ def _power_terms(model: _Model, out: Mapping) -> dict:
         if np.any(model.zeta):
             vel = a if model.material else qd[i]
             res["disc_damping"][i] = -np.sum(2.0 * model.zeta * md.omega * md.M * vel * a)
-        extra = model.disc_free(q[i], qd[i], Om[i], Omd[i]) - model.disc_free_stated(
-            q[i], qd[i], Om[i], Omd[i]
-        )
-        res["options"][i] = a @ extra
+        res["options"][i] = a @ model.option_forces(q[i], qd[i], Om[i], Omd[i])
     res["total"] = sum(res[k] for k in list(res))
     return res
 
