@@ -1601,7 +1601,7 @@ class _Runner:
             if ph[i] == STICK:
                 y[self.i_phid + i] = piece.omega(t)
         y_minus = y.copy()
-        q, qd = y[:n], y[n : 2 * n]
+        q, qd = y[:n].copy(), y[n : 2 * n].copy()
         phi, phid = y[self.i_phi : self.i_phi + S], y[self.i_phid : self.i_phid + S]
         G, GP, _ = model.shapes(phi)
         r_minus = model.solve(ph, sg, t, y, piece)
@@ -1684,6 +1684,11 @@ class _Runner:
                 forced |= newly
             qd_new = imp["qdot"]
             y[n : 2 * n] = qd_new
+            # a slider in flight is not struck: its zdot stays, so its gap rate (relative to
+            # the disc, whose velocity jumps) changes by -sigma G (qdot+ - qdot-)
+            for i in range(S):
+                if i not in contacts and ph[i] == SEPARATION:
+                    y[self.i_ed + i] -= sl.sigma[i] * (G[i] @ (qd_new - qd))
             landing, released = [], []
             for k, i in enumerate(contacts):
                 y[self.i_e + i] = 0.0
