@@ -26,6 +26,23 @@ Case attributes read
   initial_state, perturbation, max_step, max_switches, duration`` and
   ``min_flight_time`` (default 1e-11 s).
 
+Public API
+----------
+* ``reference_simulate(case, t_end=None, *, rtol=1e-12, atol=1e-14, method="DOP853",
+  y0=None, phase0=None, mode_data=None, max_step=None, max_switches=None)`` ->
+  :class:`ReferenceResult` with ``events`` (tuples ``(t, from_phase, to_phase, kind,
+  slider)``), ``segments``, ``impacts``, ``evaluate(times)`` (dict: ``q``, ``q_dot``
+  (n_t, n); per slider (n_t, S): ``phi, phi_dot, z, z_dot, gap, normal_force,
+  friction_force, phase, slip_sign``; ``disc_speed`` = ``Omega``, ``Omega_dot``, ``t``
+  (n_t,)) and ``state(t)``.
+* ``energy_terms(result, times)``, ``mechanical_energy(case, state)``,
+  ``power_terms(case, out)``: the energy balance (below); ``jacobi_integral``,
+  ``kinetic_energy_t2`` (T2 - T0 + V and T2, as before, summed over sliders).
+* ``sliding_equilibrium(case)``, ``free_doublet_eigenvalues(omega, l, Omega, zeta,
+  frame)``, ``plastic_impact(...)``, ``solve_impact_lcp(G, gap_rate_minus, forced)``,
+  ``impact_map(...)`` (paper Eqs. 54-56), ``FrictionLaw(case.friction)``,
+  ``mode_data_from_case(case)``, ``speed_at(speed, t)``, ``slider_list(case)``.
+
 How it differs from the fast code, on purpose
 ---------------------------------------------
 * At every right-hand-side evaluation the FULL linear system of the unknown
@@ -147,8 +164,9 @@ With the impact off, ``Delta E = 1/2 m_j (wdot_j^2 - zdot_j-^2)``.
 Re-contact with several sliders (equations.md): Moreau's plastic impact on
 ``A = {j} + {sliders in contact} + {separated sliders whose gap is closed to
 round-off}``; the LCP is solved exactly by enumerating the active sets
-(:func:`solve_impact_lcp`).  Impact cascades: a slider that the impact releases
-(lambda = 0, gammadot+ > 0) flies ballistically, ``e(t) ~ gammadot+ t + 1/2
+(:func:`solve_impact_lcp`).  A slider in flight is not struck: its zdot is kept
+(its stored gap rate follows the disc's velocity jump).  Impact cascades: a
+slider that the impact releases (lambda = 0, gammadot+ > 0) flies ballistically, ``e(t) ~ gammadot+ t + 1/2
 eddot t^2``; if that flight ``2 gammadot+ / |eddot|`` is shorter than
 ``simulation.min_flight_time`` or its peak gap ``gammadot+^2 / (2 |eddot|)`` is
 below the round-off of z (``8 eps max(|z|, N0/k_z)``), the slider is kept in
