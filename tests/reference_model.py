@@ -166,8 +166,8 @@ Re-contact with several sliders (equations.md): Moreau's plastic impact on
 round-off}``; the LCP is solved exactly by enumerating the active sets
 (:func:`solve_impact_lcp`).  A slider in flight is not struck: its zdot is kept
 (its stored gap rate follows the disc's velocity jump).  Impact cascades: a
-slider that the impact releases (lambda = 0, gammadot+ > 0) flies ballistically, ``e(t) ~ gammadot+ t + 1/2
-eddot t^2``; if that flight ``2 gammadot+ / |eddot|`` is shorter than
+slider that the impact releases (lambda = 0, gammadot+ > 0) flies ballistically,
+``e(t) ~ gammadot+ t + 1/2 eddot t^2``; if that flight ``2 gammadot+ / |eddot|`` is shorter than
 ``simulation.min_flight_time`` or its peak gap ``gammadot+^2 / (2 |eddot|)`` is
 below the round-off of z (``8 eps max(|z|, N0/k_z)``), the slider is kept in
 contact: the impact is solved again with that contact as an equality
