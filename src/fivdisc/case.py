@@ -34,6 +34,7 @@ from pydantic import (
     ConfigDict,
     Discriminator,
     Field,
+    PlainSerializer,
     PlainValidator,
     Strict,
     Tag,
@@ -235,7 +236,12 @@ class Disc(_Table):
     modes: Annotated[tuple[Mode, ...], AfterValidator(_distinct_modes)] = _field(
         ((0, 0), (0, 1), (0, 2), (0, 3))
     )
-    damping_ratio: Annotated[float | tuple[float, ...], PlainValidator(_damping_ratios)] = 0.0
+    damping_ratio: Annotated[
+        float | tuple[float, ...],
+        PlainValidator(_damping_ratios),
+        # The union confuses pydantic's serializer for the tuple form; the value is plain.
+        PlainSerializer(lambda value: list(value) if isinstance(value, tuple) else value),
+    ] = 0.0
     damping_frame: Literal["material", "space"] = "material"
 
     @model_validator(mode="after")

@@ -62,7 +62,7 @@ from fivdisc._kernels.layout import (
 )
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def speed_at(t, knots, coef, right):
     """Disc speed and acceleration at ``t`` from the piecewise-cubic profile.
 
@@ -86,7 +86,7 @@ def speed_at(t, knots, coef, right):
     return om, omd
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def kinetic_friction(mdl, r, s, v):
     """Kinetic friction coefficient at relative speed ``v`` [rad/s] in slip with sign ``s``.
 
@@ -134,7 +134,7 @@ def new_work(mdl, like):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _disc_forces(t, y, om, omd, mdl, fq, dy):
     """Disc forces that do not depend on the contacts: stiffness, spin, damping."""
     n, _, half = sizes(mdl)
@@ -155,7 +155,7 @@ def _disc_forces(t, y, om, omd, mdl, fq, dy):
         dy[i] = y[half + i]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _slider_sums(j, y, ph, om, mdl, wk):
     """Mode shapes at slider j (rows j of g, g') and the sums over the modal coordinates
     that its contact needs (rows of ``aux``)."""
@@ -222,7 +222,7 @@ def _slider_sums(j, y, ph, om, mdl, wk):
     aux[A_F, j] = zero
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def solve_small(a, b, m):
     """Solve the leading ``m x m`` block of ``a x = b`` in place (``b`` becomes x) by
     Gaussian elimination with partial pivoting on the real parts. For m = 1 it is one
@@ -372,7 +372,7 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
         _powers(y, ph, om, omd, mdl, wk, dy)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _powers(y, ph, om, omd, mdl, wk, dy):
     """Rates of the energy accumulators (``layout.E_*``) [W]."""
     gp = wk[1]
@@ -421,7 +421,7 @@ def _powers(y, ph, om, omd, mdl, wk, dy):
         dy[e0 + c] = zero
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def event_values(ph, sg, y, mdl, wk, out):
     """Event functions of every slider's phase, positive while it holds (3 per slider;
     unused slots +inf). Needs ``wk`` filled by ``evaluate`` at ``y``."""

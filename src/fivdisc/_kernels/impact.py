@@ -22,7 +22,7 @@ from fivdisc._kernels.dynamics import solve_small
 from fivdisc._kernels.layout import E_IMPACT, E_SURFACE, n_dynamic, sizes
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def contact_velocity(j, y, mdl, wk):
     """Normal velocity of the disc's surface under slider j [m/s]; rows j of g, g' in
     ``wk`` must hold the mode shapes at ``y``."""

@@ -283,8 +283,10 @@ def _impact(j, t, y, ph, sg, mdl, wk, dy, fst, released):
                 continue
             flight = 2.0 * w[a] / -gdd
             peak = 0.5 * w[a] * w[a] / -gdd
-            zscale = abs(y[n + ns + k]) + abs(aux[A_WC, k])
-            if flight < min_flight or peak <= 4.0 * 2.220446049250313e-16 * zscale:
+            # Round-off of z: its size, or the preload's compression of the slider's
+            # spring where z itself is small.
+            zscale = max(abs(aux[A_WC, k]), abs(mdl.n0[k] / mdl.kz[k]))
+            if flight < min_flight or peak < 8.0 * 2.220446049250313e-16 * zscale:
                 forced[a] = True
                 again = True
             else:

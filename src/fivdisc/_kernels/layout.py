@@ -145,7 +145,7 @@ class KernelModel(NamedTuple):
     opts: np.ndarray
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def sizes(mdl):
     """``(n, S, half)``: modal coordinates, sliders, and the offset of the velocities."""
     n = mdl.l.shape[0]
@@ -153,7 +153,7 @@ def sizes(mdl):
     return n, s, n + 2 * s
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def n_dynamic(mdl):
     """Length of the state without the energy accumulators, ``2 (n + 2 S)``."""
     return 2 * (mdl.l.shape[0] + 2 * mdl.theta.shape[0])

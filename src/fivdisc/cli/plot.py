@@ -1,4 +1,5 @@
-"""``fivdisc plot RESULT.nc --kind KIND [--var NAME] [--probe I] [--window T0:T1] -o FIG.png``."""
+"""``fivdisc plot RESULT.nc --kind KIND [--var NAME] [--probe I] [--slider J] [--window T0:T1]
+-o FIG.png``."""
 
 from __future__ import annotations
 
@@ -85,6 +86,8 @@ def _check(ds, kind: str, var: str | None, probe: int | None) -> str | None:
               help="Variable for timeseries, spectrogram and spectrum [default: phi].")
 @click.option("--probe", type=int, default=None,
               help="Index along the variable's second dimension (w: probe) [default: 0].")
+@click.option("--slider", type=int, default=0, show_default=True,
+              help="Which slider's variables (phi, normal_force, ...) and events to plot.")
 @click.option("--window", "window_text", metavar="T0:T1", default=None,
               help="Time window in s; either side may be empty [default: all].")
 @click.option("--fmax", type=float, default=None,
@@ -95,12 +98,14 @@ def _check(ds, kind: str, var: str | None, probe: int | None) -> str | None:
               help="Figure file; the format follows the extension [default: RESULT-KIND.png].")
 @click.option("--dpi", type=click.IntRange(min=10), default=150, show_default=True,
               help="Resolution of raster formats.")
-def plot(result: Path, kind: str, var: str | None, probe: int | None, window_text: str | None,
-         fmax: float | None, segment: float | None, output: Path | None, dpi: int) -> None:
+def plot(result: Path, kind: str, var: str | None, probe: int | None, slider: int,
+         window_text: str | None, fmax: float | None, segment: float | None,
+         output: Path | None, dpi: int) -> None:
     """Plot a simulation RESULT (netCDF written by ``fivdisc simulate``) to a file."""
     import xarray as xr
 
     from fivdisc import plots
+    from fivdisc.result import select_slider
 
     try:
         with xr.open_dataset(result) as stored:
@@ -112,6 +117,11 @@ def plot(result: Path, kind: str, var: str | None, probe: int | None, window_tex
         raise FivdiscError(f"cannot read {result} as a netCDF result: {exc}") from None
     if "time" not in ds.coords or ds.sizes["time"] < 2:
         raise FivdiscError(f"{result} has no time coordinate: is it a fivdisc result?")
+    count = ds.sizes.get("slider", 1)
+    if not 0 <= slider < count:
+        raise FivdiscError(f"--slider {slider} is invalid: the run has {count} slider"
+                           f"{'s' if count > 1 else ''}, numbered from 0")
+    ds = select_slider(ds, slider)
     if fmax is not None and kind not in ("spectrogram", "spectrum"):
         raise FivdiscError(f"--fmax is not used by --kind {kind}: only by spectrogram and "
                            "spectrum")
