@@ -1,8 +1,8 @@
 """Slow, plain reference model of the slider on a spinning annular disc.
 
 This module is an *independent* implementation of the model stated in
-``/work/shared/design/equations.md`` (the printed paper has errors; that page
-wins).  It exists to check the package's fast (numba) simulator and to serve as
+``docs/model.md`` (the printed paper has errors; that page wins, see
+``docs/deviations.md``).  It exists to check the package's fast (numba) simulator and to serve as
 the speed baseline of the benchmarks.  It deliberately shares no code with
 ``fivdisc._kernels`` or ``fivdisc.simulate``: it only takes modal data from
 ``fivdisc.plate`` and parameters from a ``fivdisc.case.Case`` (or any object with
