@@ -1,9 +1,8 @@
 """Slow, plain reference model of sliders on a spinning annular disc (the model family).
 
 This module is an *independent* implementation of the model stated in
-``/work/shared/design/equations.md`` (the printed paper has errors; that page
-wins), including its section "Beyond the paper": S sliders on either face, disc
-damping and several friction laws.  It exists to check the package's fast
+``docs/model.md`` (the printed paper has errors; that page wins): S sliders on
+either face, disc damping and several friction laws.  It exists to check the package's fast
 (numba) simulator and to serve as the speed baseline of the benchmarks.  It
 deliberately shares no code with ``fivdisc._kernels`` or ``fivdisc.simulate``:
 it only takes modal data from ``fivdisc.plate`` and parameters from a case

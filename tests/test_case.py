@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from fivdisc import examples
 from fivdisc.case import (
     AcceleratingSpeed,
     Case,
@@ -27,7 +28,7 @@ from fivdisc.case import (
 )
 from fivdisc.errors import CaseError
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "default.toml"
+EXAMPLE = examples.path("default")
 
 SPEEDS: dict[str, dict[str, Any]] = {
     "constant": {"profile": "constant", "value": 10.0},

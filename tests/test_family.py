@@ -5,8 +5,6 @@ identities between friction laws, and the impact complementarity problem."""
 from __future__ import annotations
 
 import itertools
-from pathlib import Path
-
 import numpy as np
 import pytest
 from scipy.interpolate import PchipInterpolator
@@ -16,10 +14,10 @@ from fivdisc._kernels import dynamics as dyn
 from fivdisc._kernels import layout as lay
 from fivdisc._kernels.impact import solve_lcp
 from fivdisc.case import Case, load_case
+from fivdisc.examples import DIRECTORY as EXAMPLES
 from fivdisc.model import build_model
 from fivdisc.simulate import simulate
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 TIGHT = {"rtol": 1e-10, "atol": 1e-13}
 
 

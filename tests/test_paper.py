@@ -9,14 +9,13 @@ docs/deviations.md.
 from __future__ import annotations
 
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
 import xarray as xr
 from click.testing import CliRunner
 
-from fivdisc import linear_stability, load_case, simulate, stability_map
+from fivdisc import examples, linear_stability, load_case, simulate, stability_map
 from fivdisc.cli.reproduce import reproduce as reproduce_command
 from fivdisc.errors import FivdiscError
 from fivdisc.model import build_model
@@ -45,7 +44,7 @@ from fivdisc.paper import measure as ms
 from fivdisc.paper.cases import FIG10
 from fivdisc.paper.figures import separation_grid
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = examples.DIRECTORY
 
 
 def _short(case, duration, rate=5000.0):
@@ -61,7 +60,7 @@ def test_every_figure_3_to_28_has_its_case():
 
 
 def test_example_files_equal_the_code_cases():
-    """examples/figNN.toml are written from fivdisc.paper.cases (write_examples)."""
+    """The packaged examples figNN.toml are written from fivdisc.paper.cases (write_examples)."""
     expected = cases()
     on_disk = {p.stem for p in EXAMPLES.glob("fig[0-9][0-9]*.toml")} - {"fig27_base"}
     assert on_disk == set(expected)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 
@@ -209,3 +210,18 @@ def test_simulated_result_end_to_end(tmp_path):
     # limit the refined estimate; 1 Hz allows for the paper quoting it to 0.5 Hz.
     with xr.open_dataset(path) as stored:
         assert dominant_frequency(stored, "phi", t0=0.05) == pytest.approx(181.0, abs=1.0)
+
+
+def test_backend_chosen_by_mplbackend_is_kept():
+    """Headless, fivdisc picks Agg unless MPLBACKEND chose a backend (Jupyter's inline one)."""
+    code = ("import matplotlib; from fivdisc import plots; import numpy as np; "
+            "import xarray as xr; t = np.linspace(0, 1, 11); "
+            "ds = xr.Dataset({'phi': ('time', t)}, coords={'time': t}); "
+            "plots.plot_timeseries(ds, 'phi'); print(matplotlib.get_backend())")
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("DISPLAY", "WAYLAND_DISPLAY", "MPLBACKEND")}
+    chosen = {**env, "MPLBACKEND": "svg"}
+    for environment, backend in ((env, "agg"), (chosen, "svg")):
+        out = subprocess.run([sys.executable, "-c", code], env=environment, check=True,
+                             capture_output=True, text=True)
+        assert out.stdout.strip().lower() == backend

@@ -17,6 +17,7 @@ import pytest
 import xarray as xr
 from click.testing import CliRunner
 
+from fivdisc import examples
 from fivdisc.case import Case
 from fivdisc.cli.sweep import separation_map, sweep
 from fivdisc.errors import CaseError, FivdiscError
@@ -34,8 +35,6 @@ from fivdisc.sweep import (
 )
 from fivdisc.sweep.reductions import evaluate, resolve, stop_events
 from fivdisc.sweep.run import run_point
-
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 # A user reduction, importable by the workers through PYTHONPATH / sys.path.
 HELPER = '''
@@ -196,7 +195,7 @@ def test_base_file_is_relative_to_the_sweep_file(tmp_path) -> None:
 def test_fig27_example_is_the_separation_map_default() -> None:
     from fivdisc.sweep import separation_sweep
 
-    example = load_sweep(EXAMPLES / "sweep_fig27.toml")
+    example = load_sweep(examples.path("sweep_fig27"))
     assert example.shape == (40, 40)
     assert example.stop_on == ("separation",)
     assert example.digest == separation_sweep().digest

@@ -3,12 +3,13 @@
 The public API::
 
     import fivdisc
-    case = fivdisc.load_case("examples/fig10.toml")     # or fivdisc.Case(...)
+    case = fivdisc.load_case("mycase.toml")             # or fivdisc.Case(...)
     result = fivdisc.simulate(case)                     # result.dataset is an xarray.Dataset
     fivdisc.linear_stability(case).max_growth_rate      # constant-speed cases
 
 Plotting lives in :mod:`fivdisc.plots`, parameter sweeps in :mod:`fivdisc.sweep` and the
-paper's cases in :mod:`fivdisc.paper`; they import matplotlib or dask only when used.
+paper's cases in :mod:`fivdisc.paper`; they import matplotlib or dask only when used. The
+example cases that ship with fivdisc are in :mod:`fivdisc.examples`.
 """
 
 from importlib.metadata import version as _version

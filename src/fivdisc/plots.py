@@ -56,8 +56,9 @@ def _axes(ax: Axes | None) -> tuple[Figure, Axes]:
     headless = sys.platform.startswith("linux") and not (
         os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
     )
-    if headless and "matplotlib.pyplot" not in sys.modules:
-        # An interactive backend chosen by the user's config would fail without a display.
+    if headless and not os.environ.get("MPLBACKEND") and "matplotlib.pyplot" not in sys.modules:
+        # An interactive backend chosen by the user's config would fail without a display;
+        # one chosen for this process (MPLBACKEND, e.g. Jupyter's inline backend) stays.
         matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 

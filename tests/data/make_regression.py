@@ -16,10 +16,10 @@ from pathlib import Path
 import numpy as np
 
 from fivdisc.case import Case, load_case
+from fivdisc.examples import DIRECTORY as EXAMPLES
 from fivdisc.simulate import simulate
 
 HERE = Path(__file__).parent
-EXAMPLES = HERE.parents[1] / "examples"
 
 
 def _kick(case: Case) -> np.ndarray:

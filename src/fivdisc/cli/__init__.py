@@ -33,7 +33,7 @@ def cli() -> None:
 
 
 def _register() -> None:
-    from fivdisc.cli import modes, plot, reproduce, simulate, stability, sweep
+    from fivdisc.cli import examples, modes, plot, reproduce, simulate, stability, sweep
 
     cli.add_command(modes.modes)
     cli.add_command(simulate.simulate)
@@ -42,6 +42,7 @@ def _register() -> None:
     cli.add_command(sweep.sweep)
     cli.add_command(sweep.separation_map)
     cli.add_command(reproduce.reproduce)
+    cli.add_command(examples.examples)
 
 
 _register()

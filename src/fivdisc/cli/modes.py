@@ -7,11 +7,11 @@ from pathlib import Path
 
 import click
 
+from fivdisc.cli._case import CASE
+
 
 @click.command("modes")
-@click.argument(
-    "case", required=False, type=click.Path(exists=True, dir_okay=False, path_type=Path)
-)
+@click.argument("case", required=False, type=CASE)
 @click.option(
     "--json",
     "as_json",
@@ -21,10 +21,11 @@ import click
 def modes(case: Path | None, as_json: bool) -> None:
     """Natural frequencies and modal masses of the disc modes of CASE.
 
-    CASE is a TOML case file; without it the paper's Table 1 disc is used. One line per
-    (k, l) of the case's mode list (k nodal circles, l nodal diameters; every l >= 1 mode is a
-    doublet). omega is in rad/s, the frequency in Hz and the modal mass in kg, for the mode
-    shape scaled to max |R| = 1.
+    CASE is a TOML case file or the name of a packaged example (``fivdisc examples``);
+    without it the paper's Table 1 disc is used. One line per (k, l) of the case's mode
+    list (k nodal circles, l nodal diameters; every l >= 1 mode is a doublet). omega is in
+    rad/s, the frequency in Hz and the modal mass in kg, for the mode shape scaled to
+    max |R| = 1.
     """
     # Imported here so that `fivdisc --help` does not pay for scipy and pydantic.
     from fivdisc.case import Case, load_case

@@ -7,15 +7,21 @@ from pathlib import Path
 
 import click
 
+from fivdisc.cli._case import CASE, default_output
+
 
 @click.command()
-@click.argument("case_file", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("case_file", type=CASE)
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
-              help="netCDF file for the result (default: CASE with .nc).")
+              help="netCDF file for the result [default: CASE_FILE with .nc; for an example, "
+              "NAME.nc in the working directory].")
 @click.option("--progress/--no-progress", default=True, show_default=True,
               help="Show a progress bar in simulated time.")
 def simulate(case_file: Path, output: Path | None, progress: bool) -> None:
     """Simulate CASE_FILE and write the time histories and events as netCDF.
+
+    CASE_FILE is a TOML case file or the name of a packaged example (``fivdisc examples``),
+    e.g. ``fivdisc simulate fig10 -o fig10.nc``.
 
     A failed run (non-finite state, step-size underflow, endless switching) still
     writes what was computed, marked as failed, and exits with status 1.
@@ -24,7 +30,7 @@ def simulate(case_file: Path, output: Path | None, progress: bool) -> None:
     from fivdisc.simulate import simulate as run
 
     case = load_case(case_file)
-    out = output or case_file.with_suffix(".nc")
+    out = output or default_output(case_file, ".nc")
     result = run(case, progress=progress)
     result.to_netcdf(out)
     s = result.summary()

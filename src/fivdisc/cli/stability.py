@@ -7,11 +7,12 @@ from pathlib import Path
 import click
 import numpy as np
 
+from fivdisc.cli._case import CASE
 from fivdisc.errors import FivdiscError
 
 
 @click.command()
-@click.argument("case_file", required=False, type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("case_file", required=False, type=CASE)
 @click.option("--x", "x_spec", metavar="KEY=START:STOP:N",
               help="Horizontal axis, e.g. normal_damping=0:12:200 (with --y: a map).")
 @click.option("--y", "y_spec", metavar="KEY=START:STOP:N", help="Vertical axis.")
@@ -27,6 +28,7 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
               progress: bool) -> None:
     """Stability of the sliding equilibrium of CASE_FILE (default: Table 1 at 2 pi rad/s).
 
+    CASE_FILE is a TOML case file or the name of a packaged example (``fivdisc examples``).
     Without --x/--y: prints the equilibrium and the eigenvalues of the linearised slip
     equations. With both: computes the largest growth rate over the grid and the
     stability boundary, and writes it with -o.

@@ -8,6 +8,8 @@ from typing import TYPE_CHECKING
 
 import click
 
+from fivdisc.cli._case import CASE, default_output
+
 if TYPE_CHECKING:
     from fivdisc.sweep import Sweep, SweepReport
 
@@ -64,13 +66,13 @@ def _run(
 
 
 @click.command()
-@click.argument("sweep_file", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("sweep_file", type=CASE)
 @click.option(
     "-o",
     "--output",
     type=click.Path(path_type=Path),
-    help="Zarr store for the results [default: SWEEP_FILE with .zarr]. An existing store "
-    "of the same sweep is resumed.",
+    help="Zarr store for the results [default: SWEEP_FILE with .zarr; for an example, "
+    "NAME.zarr in the working directory]. An existing store of the same sweep is resumed.",
 )
 @_scheduler_option
 @_workers_option
@@ -84,6 +86,9 @@ def sweep(
 ) -> None:
     """Run the sweep of SWEEP_FILE and store one value per point and reduction.
 
+    SWEEP_FILE is a TOML sweep file or the name of a packaged example, e.g.
+    ``fivdisc sweep sweep_fig27 -o fig27.zarr``.
+
     Results are written as points finish, so an interrupted sweep (Ctrl-C, a killed
     process) continues where it stopped when the same command is run again. A
     point whose run fails is stored with its error message, and the sweep goes on.
@@ -91,7 +96,7 @@ def sweep(
     from fivdisc.sweep import load_sweep
 
     spec = load_sweep(sweep_file)
-    _run(spec, output or sweep_file.with_suffix(".zarr"), scheduler, workers, progress)
+    _run(spec, output or default_output(sweep_file, ".zarr"), scheduler, workers, progress)
 
 
 @click.command("separation-map")
@@ -117,9 +122,9 @@ def sweep(
 )
 @click.option(
     "--base",
-    type=click.Path(dir_okay=False, path_type=Path),
-    help="Case file the points start from [default: the paper's Fig. 27 case]; its speed "
-    "table is replaced.",
+    type=CASE,
+    help="Case file or packaged example the points start from [default: the paper's "
+    "Fig. 27 case]; its speed table is replaced.",
 )
 @click.option(
     "--duration",

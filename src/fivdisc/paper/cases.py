@@ -670,7 +670,8 @@ def write_examples(directory: str | PathLike[str]) -> list[Path]:
     Parameters
     ----------
     directory
-        Where to write (the repository's ``examples``).
+        Where to write (the repository's ``src/fivdisc/examples``, which ships them as
+        package data: :mod:`fivdisc.examples`).
 
     Returns
     -------

@@ -1,7 +1,9 @@
 """Parameter sweeps: many simulations, reduced to a few numbers each, stored resumably.
 
+>>> from fivdisc import examples
 >>> from fivdisc.sweep import load_sweep, run_sweep, open_sweep
->>> report = run_sweep(load_sweep("examples/sweep_fig27.toml"), "fig27.zarr")  # doctest: +SKIP
+>>> spec = load_sweep(examples.path("sweep_fig27"))
+>>> report = run_sweep(spec, "fig27.zarr")  # doctest: +SKIP
 >>> open_sweep("fig27.zarr")["separated"]  # doctest: +SKIP
 
 See :mod:`fivdisc.sweep.spec` for the sweep file format, :mod:`fivdisc.sweep.store`

@@ -1,0 +1,112 @@
+"""The packaged examples, the CASE resolver and ``fivdisc examples``.
+
+These run against the installed package; ``.ci/check-package`` repeats the commands from a
+wheel installed into a fresh virtual environment, away from the source tree.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import xarray as xr
+from click.testing import CliRunner
+
+from fivdisc import examples, load_case
+from fivdisc.cli import cli
+from fivdisc.errors import FivdiscError
+from fivdisc.sweep import load_sweep
+
+
+def _run(*argv: str):
+    return CliRunner().invoke(cli, list(argv))
+
+
+def test_every_example_loads_and_has_a_one_line_description():
+    listing = examples.available()
+    assert set(listing) == {p.stem for p in examples.DIRECTORY.glob("*.toml")}
+    assert {"default", "fig10", "fig27_base", "sweep_fig27"} <= set(listing)
+    for name, description in listing.items():
+        assert description.endswith(".") and "\n" not in description, name
+        assert len(description) <= 120, (name, description)
+        if name.startswith("sweep_"):
+            load_sweep(examples.path(name))
+        else:
+            load_case(examples.path(name))
+
+
+def test_resolve_prefers_an_existing_file(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "fig10").write_text("[slider]\nmass = 0.2\n")
+    assert examples.resolve("fig10") == Path("fig10")
+    assert examples.resolve("fig10.toml") == examples.DIRECTORY / "fig10.toml"
+    assert examples.resolve("fig04") == examples.path("fig04.toml")
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("fig1", r"^'fig1' is neither a file nor a packaged example: nearest: fig10, fig11"),
+        ("zzz", r"must be one of default, fig03a, .*sweep_fig27 \(`fivdisc examples`"),
+        ("nowhere/fig10.toml", r"^file not found: nowhere/fig10.toml$"),
+    ],
+)
+def test_resolve_errors(text, message, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(FivdiscError, match=message):
+        examples.resolve(text)
+
+
+def test_resolve_refuses_a_directory(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "fig10").mkdir()
+    with pytest.raises(FivdiscError, match=r"'fig10' is a directory: must be a TOML file"):
+        examples.resolve("fig10")
+
+
+def test_examples_command_lists_and_prints():
+    listed = _run("examples")
+    assert listed.exit_code == 0, listed.output
+    lines = listed.output.splitlines()
+    assert [line.split()[0] for line in lines] == list(examples.available())
+    assert any(line.startswith("fig10 ") and "decelerating disc" in line for line in lines)
+    shown = _run("examples", "fig10")
+    assert shown.exit_code == 0
+    assert shown.output == examples.path("fig10").read_text()
+    unknown = _run("examples", "fig99")
+    assert unknown.exit_code == 2
+    assert unknown.output.startswith("error: 'fig99' is not a packaged example: nearest:")
+    assert unknown.output.count("\n") == 1
+
+
+def test_every_case_command_takes_an_example_name(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    modes = _run("modes", "fig10", "--json")
+    assert modes.exit_code == 0 and '"frequency_hz"' in modes.output
+    stability = _run("stability", "fig08")
+    assert stability.exit_code == 0 and "unstable" in stability.output
+    # Without -o, an example's result goes to the working directory, not the package.
+    simulated = _run("simulate", "default", "--no-progress")
+    assert simulated.exit_code == 0, simulated.output
+    assert (tmp_path / "default.nc").exists()
+    with xr.open_dataset(tmp_path / "default.nc") as ds:
+        assert ds.attrs["status"] == "success"
+    assert not (examples.DIRECTORY / "default.nc").exists()
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ("simulate", "fig1"),
+        ("modes", "fig1"),
+        ("stability", "fig1"),
+        ("sweep", "fig1"),
+        ("separation-map", "--base", "fig1"),
+    ],
+)
+def test_unknown_example_is_one_line(argv, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    result = _run(*argv)
+    assert result.exit_code == 2
+    assert result.output.startswith("error: 'fig1' is neither a file nor a packaged example")
+    assert result.output.count("\n") == 1 and "Traceback" not in result.output
