@@ -25,7 +25,6 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np
 
 from bench_simulate import against_baseline
-from fivdisc import Case, simulate
 from previous import BEFORE_FAMILY, run_previous
 
 # Cases written with keys the pre-family code knows too.

@@ -5,6 +5,7 @@ identities between friction laws, and the impact complementarity problem."""
 from __future__ import annotations
 
 import itertools
+
 import numpy as np
 import pytest
 from scipy.interpolate import PchipInterpolator
