@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
@@ -12,9 +13,13 @@ from fivdisc._kernels import dynamics as dyn
 from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium
 from fivdisc.case import Case
 from fivdisc.errors import CaseError, SimulationError
+from fivdisc.limits import check_memory
 from fivdisc.model import Model, build_model
 from fivdisc.speed import SpeedProfile
 
+# Bytes per grid point of a stability map: growth rate and stability flag, and the
+# dataset's and the netCDF writer's copies of them.
+_GRID_BYTES = 3 * (8 + 1)
 # Case keys that enter the model only through its parameter vector: a map over them
 # patches that vector instead of rebuilding the model (and the plate modes) per point.
 _PAR_KEYS = {
@@ -261,6 +266,13 @@ def stability_map(
     axes = [(xkey, xs), (ykey, ys)]
     if curves:
         axes.append((curves[0], np.asarray(curves[1], dtype=float)))
+    size = math.prod(len(values) for _, values in axes)
+    n = 2 * sum(1 if l == 0 else 2 for _, l in case.disc.modes) + 2
+    check_memory(
+        _GRID_BYTES * size + 16.0 * xs.size * n * n,
+        f"a stability map of {' x '.join(str(len(v)) for _, v in axes)} points",
+        "use fewer points per axis",
+    )
     _validate_grid(case, axes)
     cs = axes[2][1] if curves else [None]
     base = build_model(case)
@@ -354,7 +366,9 @@ def parse_range(text: str, option: str) -> tuple[str, np.ndarray]:
     try:
         if ":" in spec:
             start, stop, num = spec.split(":")
-            values = np.linspace(float(start), float(stop), int(num))
+            count = int(num)
+            check_memory(8.0 * count, f"{option} with N = {count} values", "lower N")
+            values = np.linspace(float(start), float(stop), count)
         else:
             values = np.array([float(v) for v in spec.split(",")])
     except ValueError:
