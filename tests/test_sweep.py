@@ -348,8 +348,6 @@ def test_separation_reductions_stop_at_the_first_separation() -> None:
 
 
 def test_analysis_reductions() -> None:
-    pytest.importorskip("fivdisc.analysis.spectra")
-    pytest.importorskip("fivdisc.analysis.stability")
     values = evaluate(
         Case().replace({"simulation.duration": 0.2, "simulation.output_rate": 2000.0}),
         ["dominant_frequency", "max_growth_rate"],
@@ -358,7 +356,6 @@ def test_analysis_reductions() -> None:
 
 
 def test_max_growth_rate_needs_constant_speed() -> None:
-    pytest.importorskip("fivdisc.analysis.stability")
     with pytest.raises(SweepError, match="'max_growth_rate' needs a constant disc speed"):
         Sweep(base=_short(), axes={"speed.initial": [1.0]}, keep=["max_growth_rate"])
 
