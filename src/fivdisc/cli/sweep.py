@@ -46,9 +46,7 @@ def _run(
     from fivdisc.sweep import read_mask, run_sweep
 
     if scheduler is not None:
-        # A lost scheduler is reported in one line (SweepError); the client's own log of
-        # it comes with tracebacks.
-        logging.getLogger("distributed").setLevel(logging.CRITICAL)
+        _quiet_dask()
     try:
         report = run_sweep(spec, output, scheduler=scheduler, workers=workers, progress=progress)
     except KeyboardInterrupt:
@@ -74,6 +72,18 @@ def _run(
             err=True,
         )
     return report
+
+
+def _quiet_dask() -> None:
+    """Silence dask.distributed's logs: a lost scheduler is reported in one line (a
+    SweepError), and the client's own log of it comes with tracebacks."""
+    try:
+        import distributed  # noqa: F401  (it sets its loggers' levels when imported)
+    except ImportError:
+        return  # run_sweep says how to install it
+    for name in list(logging.root.manager.loggerDict):
+        if name.split(".")[0] == "distributed":
+            logging.getLogger(name).setLevel(logging.CRITICAL)
 
 
 def _verify(store: Path) -> None:

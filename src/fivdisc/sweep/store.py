@@ -580,14 +580,15 @@ def _repair(path: Path, sweep: Sweep, broken: Sequence[str]) -> None:
 def open_sweep(path: str | PathLike[str]) -> xr.Dataset:
     """Load a sweep store into memory, one entry per point.
 
-    ``done`` is True only for verified points (see :func:`read_mask`); the values of
-    other points are not to be trusted.
+    ``done`` is True only for verified points (see :func:`read_mask`); unreadable chunks
+    read as their variable's fill value, and the values of points that are not done are
+    not to be trusted.
 
     Raises
     ------
     SweepError
-        `path` is not a sweep store, a variable is missing or damaged, or some chunk
-        cannot be read (rerun the sweep to repair the store and recompute them).
+        `path` is not a sweep store, or a variable is missing or has damaged metadata
+        (rerun the sweep to rebuild it and recompute its points).
     """
     path = Path(path)
     attrs = _read_attrs(path)
@@ -597,11 +598,18 @@ def open_sweep(path: str | PathLike[str]) -> xr.Dataset:
             f"{path} is damaged: variable(s) {', '.join(broken)} are missing or unreadable; "
             "rerun the sweep to rebuild them and recompute their points"
         )
+    data = xr.open_zarr(path, consolidated=False)
+    for name in list(data.data_vars):
+        try:
+            data[name].load()
+        except Exception:  # damaged chunks: the codec's error type varies
+            values, _ = _readable(_arrays(path, [name], complete.size)[0][name])
+            data[name] = data[name].copy(data=values)
     try:
-        data = xr.open_zarr(path, consolidated=False).load()
-    except Exception as exc:  # damaged chunks: the codec's error type varies
+        data = data.load()
+    except Exception as exc:  # a damaged coordinate chunk
         raise SweepError(
-            f"{path} has unreadable chunks ({_brief(exc)}); rerun the sweep to recompute them"
+            f"{path} has unreadable coordinates ({_brief(exc)}); rerun the sweep to rebuild them"
         ) from None
     data["done"] = data["done"].copy(data=complete)
     return data
