@@ -56,12 +56,12 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
     axes = {"--x": parse_range(x_spec, "--x"), "--y": parse_range(y_spec, "--y")}
     if curve_spec is not None:
         axes["--curves"] = parse_range(curve_spec, "--curves")
-    keys = [key for key, _ in axes.values()]
+    varied: dict[str, str] = {}  # case key -> option
     for option, (key, _) in axes.items():
-        if keys.count(key) > 1:
-            others = [o for o, (k, _) in axes.items() if k == key and o != option]
-            raise FivdiscError(f"{option} {key} is invalid: {' and '.join(others)} varies the "
-                               "same key; give each axis its own key")
+        if key in varied:
+            raise FivdiscError(f"{option} {key} is invalid: {varied[key]} varies the same key; "
+                               "give each axis its own key")
+        varied[key] = option
     ds = stability_map(case, axes["--x"], axes["--y"], axes.get("--curves"), progress=progress)
     if out.suffix == ".nc":
         write_atomic(out, ds.to_netcdf)

@@ -296,13 +296,19 @@ class StoreHealth:
         return not self.damaged.any() and not self.broken
 
 
+def _layout(attrs: dict[str, Any]) -> tuple[list[str], list[str], int]:
+    """(checksummed variables: reductions then "error"; every variable; number of points)."""
+    variables = json.loads(attrs["sweep_variables"])
+    coords = [DIM, *json.loads(attrs["sweep_axes"])]
+    return variables, [*variables, "checksum", "done", *coords], \
+        math.prod(json.loads(attrs["sweep_shape"]))
+
+
 def _inspect(path: Path, attrs: dict[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray,
                                                           list[str]]:
     """(complete, damaged, failed, broken variables) of a store; see :class:`StoreHealth`."""
-    variables = json.loads(attrs["sweep_variables"])  # reductions, then "error"
-    n = math.prod(json.loads(attrs["sweep_shape"]))
-    coords = [DIM, *json.loads(attrs["sweep_axes"])]
-    arrays, broken = _arrays(path, [*variables, "checksum", "done", *coords], n)
+    variables, names, n = _layout(attrs)
+    arrays, broken = _arrays(path, names, n)
     if "done" in arrays:
         done, done_readable = _readable(arrays["done"])
         done = np.asarray(done, dtype=bool)
@@ -321,7 +327,7 @@ def _inspect(path: Path, attrs: dict[str, Any]) -> tuple[np.ndarray, np.ndarray,
         row = [columns[name][i] for name in variables]
         complete[i] = int(columns["checksum"][i]) == _checksum(attrs["sweep_hash"], int(i), row)
     damaged = ~complete & (done | ~done_readable)
-    failed = complete & (columns["error"] != "") if "error" in columns else complete & False
+    failed = complete & (columns["error"] != "") if "error" in columns else np.zeros(n, bool)
     return complete, damaged, failed, broken
 
 
@@ -481,7 +487,8 @@ class SweepStore:
                     f"{path} holds a different sweep (its definition differs in: {fields}); "
                     "write to a new store, or delete this one to start over"
                 )
-            _repair(path, sweep, _inspect(path, attrs)[3])
+            _, names, n = _layout(attrs)
+            _repair(path, sweep, _arrays(path, names, n)[1])
         else:
             _create(path, sweep)
         return cls(path, sweep)
