@@ -184,7 +184,8 @@ class _DaskPool:
             )
         self.address = address
         try:
-            self._client = Client(address, timeout=_CONNECT_TIMEOUT)
+            # Not the default scheduler of this process: the coordinator only submits.
+            self._client = Client(address, timeout=_CONNECT_TIMEOUT, set_as_default=False)
         except ValueError as exc:  # malformed: no port, unknown scheme, ...
             raise SweepError(
                 f"scheduler = {address!r} is invalid ({exc}): must be an address like "
@@ -211,7 +212,9 @@ class _DaskPool:
         from distributed import wait
 
         try:
-            return set(wait(list(futures), timeout=timeout, return_when="FIRST_COMPLETED").done)
+            with self._client.as_current():  # wait() looks for a current client
+                done = wait(list(futures), timeout=timeout, return_when="FIRST_COMPLETED").done
+            return set(done)
         except TimeoutError:
             return set()
         except CancelledError as exc:  # FuturesCancelledError: the scheduler went away

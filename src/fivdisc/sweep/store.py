@@ -605,7 +605,9 @@ def open_sweep(path: str | PathLike[str]) -> xr.Dataset:
             f"{path} is damaged: variable(s) {', '.join(broken)} are missing or unreadable; "
             "rerun the sweep to rebuild them and recompute their points"
         )
-    data = xr.open_zarr(path, consolidated=False)
+    # chunks=None: lazily indexed arrays read by Zarr itself, not dask (whose default
+    # scheduler may be a cluster client of this process).
+    data = xr.open_zarr(path, consolidated=False, chunks=None)
     for name in list(data.data_vars):
         try:
             data[name].load()
