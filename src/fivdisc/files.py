@@ -131,6 +131,13 @@ def write_atomic(path: str | PathLike[str], write: Callable[[Path], Any]) -> Non
     The temporary file lies in the same directory and keeps the suffix (matplotlib picks
     the format from it); it is removed if `write` fails or is interrupted, so `path` is
     either the complete new file or what it was before.
+
+    Parameters
+    ----------
+    path
+        The file to write.
+    write
+        Writes the content to the path it is given, e.g. ``dataset.to_netcdf``.
     """
     path = Path(path)
     tmp = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")

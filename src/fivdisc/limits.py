@@ -162,6 +162,15 @@ def check_simulation(case: Any) -> None:
 def check_raster(figure: Figure, dpi: float, option: str = "--dpi") -> None:
     """Refuse a resolution at which `figure` cannot be drawn as a raster image.
 
+    Parameters
+    ----------
+    figure
+        The figure, whose size [in] is set.
+    dpi
+        Resolution [pixels/in].
+    option
+        The option that gave `dpi`, named in the message.
+
     Raises
     ------
     FivdiscError

@@ -359,6 +359,16 @@ def read_mask(path: str | PathLike[str]) -> np.ndarray:
 def verify_store(path: str | PathLike[str]) -> StoreHealth:
     """Check every point and variable of a sweep store, without changing it.
 
+    Parameters
+    ----------
+    path
+        The store.
+
+    Returns
+    -------
+    StoreHealth
+        Complete, damaged and failed points, broken variables and the lock's holder.
+
     Raises
     ------
     SweepError
