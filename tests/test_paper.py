@@ -229,12 +229,18 @@ def test_fig8_stationary_only_at_first_and_separates(runs):
     quasi-periodic with f1 = 181 Hz, f2 = 290.5 Hz, and (Fig. 24) that it does not
     separate. fivdisc: quasi-periodic (131.3 and 180.9 Hz) over 1-11 s, but the unstable
     disc modes C02, C03 (growth 0.27 and 0.39 1/s) grow, the strongest line moves to
-    ~189 Hz after 10 s and the slider separates from ~26.6 s (docs/deviations.md)."""
+    ~189 Hz after 10 s and the slider separates late in the run (docs/deviations.md).
+
+    The response is chaotic by then: the first separation moves between 23.9 and 26.6 s
+    with the tolerance (tests/data/separation_tolerance_study.py, rtol 1e-5 to 1e-8) and
+    was seen at 24.3 s on another machine. So only its occurrence is asserted, in a
+    window twice that spread wide on each side, after the quasi-periodic stage."""
     ds = runs.get(FIG8.case)
     assert ms.periodicity(ds, "phi", None, 1.0, 11.0).kind == "quasi-periodic"
     assert ms.dominant(ds, "phi", None, 1.0, 6.0) == pytest.approx(180.9, abs=0.2)
     assert ms.dominant(ds, "phi", None, 10.0, 15.0) == pytest.approx(188.8, abs=1.0)
-    assert ms.separation(ds)["first"] == pytest.approx(26.6, abs=1.0)
+    separation = ms.separation(ds)
+    assert separation["count"] > 0 and 18.0 < separation["first"] < 33.0
 
 
 @pytest.mark.slow
@@ -268,8 +274,11 @@ def test_fig19_separation_throughout_a_and_not_late_b(runs):
 def test_fig24_separation_accelerating_and_constant(runs):
     """Fig. 24: separation as the disc speeds up, none at constant speed. fivdisc: b
     separates from 14.3 s (Omega = 9.1 rad/s) and not at constant 2 pi; a separates
-    from 26.5 s, but so does its constant-speed counterpart (26.6 s), which the paper
-    says does not separate (docs/deviations.md)."""
+    from 26.5 s, but so does its constant-speed counterpart (Fig. 8, late in the run),
+    which the paper says does not separate (docs/deviations.md). Unlike Fig. 8's, these
+    onsets hardly move with the tolerance (a: 26.50-26.51 s, b: 14.27-14.41 s for rtol
+    1e-5 to 1e-8, tests/data/separation_tolerance_study.py), so they are checked to
+    several times that spread."""
     a, b = (ms.separation(runs.get(c)) for c in FIG24.runs.values())
     assert b["first"] == pytest.approx(14.3, abs=0.5)
     assert a["first"] == pytest.approx(26.5, abs=1.0)

@@ -470,11 +470,12 @@ def test_cli_errors_are_one_line(stub_case: types.ModuleType, tmp_path) -> None:
 
 
 def test_cli_with_the_real_case_module() -> None:
-    case = pytest.importorskip("fivdisc.case")
+    from fivdisc.case import Case
+
     result = _run(["modes", "--json"])
     assert result.exit_code == 0, result.output
     rows = json.loads(result.output)
-    assert [(row["k"], row["l"]) for row in rows] == [tuple(m) for m in case.Case().disc.modes]
+    assert [(row["k"], row["l"]) for row in rows] == [tuple(m) for m in Case().disc.modes]
 
 
 @pytest.mark.parametrize(

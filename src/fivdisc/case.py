@@ -45,6 +45,8 @@ from pydantic.fields import FieldInfo
 from pydantic_core import ErrorDetails, PydanticCustomError
 
 from fivdisc.errors import CaseError
+from fivdisc.files import read_text
+from fivdisc.limits import disc_problem
 
 __all__ = [
     "AcceleratingSpeed",
@@ -195,6 +197,14 @@ class _Table(BaseModel):
     # here would be wrapped (and its location lost) in the parent's error.
     __init__.__pydantic_base_init__ = True  # type: ignore[attr-defined]
 
+    @classmethod
+    def model_validate(cls, obj: Any, *args: Any, **kwargs: Any) -> Any:
+        """pydantic's ``model_validate``, raising CaseError (one line) on invalid input."""
+        try:
+            return super().model_validate(obj, *args, **kwargs)
+        except ValidationError as exc:
+            raise CaseError(_describe(exc, cls, obj)) from None
+
 
 class Disc(_Table):
     """Annular Kirchhoff plate, clamped at the inner and free at the outer edge.
@@ -258,6 +268,15 @@ class Disc(_Table):
                 "damping_ratio",
                 self.damping_ratio,
             )
+        return self
+
+    @model_validator(mode="after")
+    def _check_limits(self) -> Disc:
+        # Bounded work: see fivdisc.limits.
+        problem = disc_problem(self.inner_radius, self.outer_radius, self.modes)
+        if problem is not None:
+            key, value, rule = problem
+            raise _rule(rule, key, value)
         return self
 
     def mode_damping(self) -> tuple[float, ...]:
@@ -936,11 +955,12 @@ def load_case(path: str | PathLike[str]) -> Case:
     ------
     CaseError
         Invalid TOML or an invalid case; the message starts with the file's path.
+    FivdiscError
+        The path is a directory, cannot be read, or is not UTF-8 text.
     FileNotFoundError
         The file does not exist.
     """
-    path = Path(path)
-    return _parse(path.read_text(encoding="utf-8"), source=str(path))
+    return _parse(read_text(path), source=str(path))
 
 
 def _parse(text: str, source: str | None) -> Case:
@@ -954,12 +974,13 @@ def _parse(text: str, source: str | None) -> Case:
 
 
 def _validate(data: Any, source: str | None) -> Case:
-    """Validate a dict as a case, turning pydantic's errors into a CaseError."""
+    """Validate a dict as a case; `source` (a path) prefixes error messages."""
     try:
         return Case.model_validate(data)
-    except ValidationError as exc:
-        message = _describe(exc, Case, data)
-        raise CaseError(f"{source}: {message}" if source else message) from None
+    except CaseError as exc:
+        if source is None:
+            raise
+        raise CaseError(f"{source}: {exc}") from None
 
 
 # --- keys ------------------------------------------------------------------------------------

@@ -227,7 +227,9 @@ def _radial_values(
 
 @lru_cache(maxsize=64)
 def _leggauss(n: int) -> tuple[np.ndarray, np.ndarray]:
-    return np.polynomial.legendre.leggauss(n)
+    # scipy's asymptotic nodes and weights cost O(n); numpy's leggauss solves an n x n
+    # eigenproblem, which took seconds for n ~ 400 on a machine with busy cores.
+    return special.roots_legendre(n)
 
 
 def _gauss_legendre(a: float, b: float, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -284,9 +286,10 @@ def _radial_mode(
 
 
 def clear_cache() -> None:
-    """Forget every cached root list and mode (for timing a cold start)."""
+    """Forget every cached root list, mode and quadrature rule (for timing a cold start)."""
     _roots.cache_clear()
     _radial_mode.cache_clear()
+    _leggauss.cache_clear()
 
 
 def _check_positive(name: str, value: Any) -> float:

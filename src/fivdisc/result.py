@@ -226,9 +226,6 @@ class Result:
 
     def to_netcdf(self, path: str | PathLike[str]) -> None:
         """Write the dataset to a netCDF file atomically (a temporary file is renamed)."""
-        from pathlib import Path
+        from fivdisc.files import write_atomic
 
-        path = Path(path)
-        tmp = path.with_name(path.name + ".part")
-        self.dataset.to_netcdf(tmp)
-        tmp.replace(path)
+        write_atomic(path, self.dataset.to_netcdf)

@@ -12,6 +12,7 @@ from fivdisc._kernels import integrate as kern
 from fivdisc._kernels import layout as lay
 from fivdisc.case import Case
 from fivdisc.errors import SimulationError
+from fivdisc.limits import check_simulation
 from fivdisc.model import Model, build_model
 from fivdisc.result import EVENT_KINDS, PHASE_NAMES, Result, build_dataset
 from fivdisc.speed import SpeedProfile
@@ -129,10 +130,17 @@ def simulate(
     Result
         Its ``dataset`` holds the sampled histories and the event table; a failed
         run keeps what was computed, with ``status`` and ``message`` saying why.
+
+    Raises
+    ------
+    FivdiscError
+        The recorded output would not fit in memory (see :mod:`fivdisc.limits`).
+    CaseError
+        `speed` is not a profile or a pair of callables, or cannot be represented.
     """
     sim = case.simulation
-    if isinstance(speed, tuple):
-        speed = SpeedProfile.from_callables(*speed, t_end=sim.duration)
+    check_simulation(case)
+    speed = SpeedProfile.from_override(speed, sim.duration)
     for kind in stop_on:
         if kind not in EVENT_KINDS:
             raise SimulationError(

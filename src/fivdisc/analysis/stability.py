@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
@@ -13,9 +14,13 @@ from fivdisc._kernels import layout as lay
 from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium, slip_phases
 from fivdisc.case import Case, is_case_key
 from fivdisc.errors import CaseError, SimulationError
+from fivdisc.limits import check_memory
 from fivdisc.model import Model, build_model
 from fivdisc.speed import SpeedProfile
 
+# Bytes per grid point of a stability map: growth rate and stability flag, and the
+# dataset's and the netCDF writer's copies of them.
+_GRID_BYTES = 3 * (8 + 1)
 # Per-slider case keys that enter the model only through a kernel array, and friction
 # keys that enter only through its friction slots: a map over them patches those arrays
 # instead of rebuilding the model (and the plate modes) per point.
@@ -317,6 +322,13 @@ def stability_map(
     axes = [(xkey, xs), (ykey, ys)]
     if curves:
         axes.append((curves[0], np.asarray(curves[1], dtype=float)))
+    size = math.prod(len(values) for _, values in axes)
+    n = 2 * sum(1 if l == 0 else 2 for _, l in case.disc.modes) + 2
+    check_memory(
+        _GRID_BYTES * size + 16.0 * xs.size * n * n,
+        f"a stability map of {' x '.join(str(len(v)) for _, v in axes)} points",
+        "use fewer points per axis",
+    )
     _validate_grid(case, axes)
     cs = axes[2][1] if curves else [None]
     base = build_model(case)
@@ -410,7 +422,9 @@ def parse_range(text: str, option: str) -> tuple[str, np.ndarray]:
     try:
         if ":" in spec:
             start, stop, num = spec.split(":")
-            values = np.linspace(float(start), float(stop), int(num))
+            count = int(num)
+            check_memory(8.0 * count, f"{option} with N = {count} values", "lower N")
+            values = np.linspace(float(start), float(stop), count)
         else:
             values = np.array([float(v) for v in spec.split(",")])
     except ValueError:

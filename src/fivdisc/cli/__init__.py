@@ -1,8 +1,9 @@
 """The ``fivdisc`` command line.
 
 Each sub-command lives in its own module of this package and is registered here; a
-:class:`~fivdisc.errors.FivdiscError` raised by any of them ends the program with a
-one-line message and exit status 2 instead of a traceback.
+:class:`~fivdisc.errors.FivdiscError` raised by any of them, an operating-system error
+(a full disk) or running out of memory ends the program with a one-line message and
+exit status 2 instead of a traceback.
 """
 
 from __future__ import annotations
@@ -14,16 +15,25 @@ import click
 from fivdisc.errors import FivdiscError
 
 
+def _fail(message: str) -> None:
+    """End the program with `message` on one line of stderr and exit status 2."""
+    click.echo(f"error: {' '.join(message.split())}", err=True)
+    sys.exit(2)
+
+
 class _Group(click.Group):
     def invoke(self, ctx: click.Context):
         try:
             return super().invoke(ctx)
         except FivdiscError as exc:
-            click.echo(f"error: {exc}", err=True)
-            sys.exit(2)
+            _fail(str(exc))
         except FileNotFoundError as exc:
-            click.echo(f"error: file not found: {exc.filename}", err=True)
-            sys.exit(2)
+            _fail(f"file not found: {exc.filename}")
+        except OSError as exc:  # e.g. a full disk while writing an output
+            _fail(f"{exc.filename}: {exc.strerror}" if exc.filename else str(exc))
+        except MemoryError as exc:  # an estimate in fivdisc.limits fell short
+            _fail(f"out of memory ({exc or 'no details'}); ask for less (shorter runs, "
+                  "lower output rates, smaller grids)")
 
 
 @click.group(cls=_Group)

@@ -61,7 +61,7 @@ def _check(ds, kind: str, var: str | None, probe: int | None) -> str | None:
             raise FivdiscError(f"--kind {kind} needs {', '.join(missing)}, which the file "
                                "lacks: is it a fivdisc result?")
         return None
-    name = var or "phi"
+    name = "phi" if var is None else var
     allowed = sorted(str(v) for v, da in ds.data_vars.items() if "time" in da.dims)
     if name not in allowed:
         raise FivdiscError(f"--var {name!r} is not a time series of the file: must be one of "
@@ -105,8 +105,12 @@ def plot(result: Path, kind: str, var: str | None, probe: int | None, slider: in
     import xarray as xr
 
     from fivdisc import plots
+    from fivdisc.files import check_output, figure_suffixes, write_atomic
+    from fivdisc.limits import check_raster
     from fivdisc.result import select_slider
 
+    out = check_output(output or result.with_name(f"{result.stem}-{kind}.png"), "-o",
+                       figure_suffixes(), inputs=[result])
     try:
         with xr.open_dataset(result) as stored:
             ds = stored.load()
@@ -146,13 +150,11 @@ def plot(result: Path, kind: str, var: str | None, probe: int | None, slider: in
     else:
         fig = plots.plot_normal_force(ds, window)
 
-    out = output or result.with_name(f"{result.stem}-{kind}.png")
     import matplotlib.pyplot as plt
 
     try:
-        fig.savefig(out, dpi=dpi)
-    except ValueError as exc:
-        raise FivdiscError(f"-o {out} cannot be written: {exc}") from None
+        check_raster(fig, dpi)
+        write_atomic(out, lambda path: fig.savefig(path, dpi=dpi))
     finally:
         plt.close(fig)
     click.echo(f"wrote {out}")

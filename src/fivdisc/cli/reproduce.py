@@ -30,9 +30,11 @@ def reproduce(figures: str | None, all_figures: bool, outdir: Path, force: bool,
     (same parameters) are reused unless --force is given, so an interrupted run
     resumes where it stopped.
     """
+    from fivdisc.files import check_output
     from fivdisc.paper.reproduce import parse_figures
     from fivdisc.paper.reproduce import reproduce as run
 
+    check_output(outdir, "-o", (), kind="directory")
     if all_figures == (figures is not None):
         raise FivdiscError("give either --figures LIST (e.g. --figures 3,8,27) or --all")
     numbers = None if all_figures else parse_figures(figures, "--figures")

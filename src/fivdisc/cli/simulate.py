@@ -27,10 +27,12 @@ def simulate(case_file: Path, output: Path | None, progress: bool) -> None:
     writes what was computed, marked as failed, and exits with status 1.
     """
     from fivdisc.case import load_case
+    from fivdisc.files import NETCDF, check_output
     from fivdisc.simulate import simulate as run
 
     case = load_case(case_file)
-    out = output or default_output(case_file, ".nc")
+    out = check_output(output or default_output(case_file, ".nc"), "-o", NETCDF,
+                       inputs=[case_file])
     result = run(case, progress=progress)
     result.to_netcdf(out)
     s = result.summary()

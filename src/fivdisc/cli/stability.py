@@ -35,9 +35,14 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
     """
     from fivdisc.analysis.stability import linear_stability, parse_range, stability_map
     from fivdisc.case import Case, load_case
+    from fivdisc.files import check_output, write_atomic
 
     case = load_case(case_file) if case_file else Case()
     if x_spec is None and y_spec is None:
+        for option, given in (("--curves", curve_spec), ("-o", output)):
+            if given is not None:
+                raise FivdiscError(f"{option} is used only by a stability map: give --x and --y "
+                                   "too (KEY=START:STOP:N)")
         res = linear_stability(case)
         if as_json:
             import json
@@ -61,20 +66,25 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
         raise FivdiscError("a stability map needs both --x and --y (KEY=START:STOP:N)")
     if as_json:
         raise FivdiscError("--json prints the equilibrium and eigenvalues: leave out --x/--y")
-    if output is not None and output.suffix not in (".nc", ".png"):
-        raise FivdiscError(f"-o {output}: the file must end in .nc or .png")
-    x = parse_range(x_spec, "--x")
-    y = parse_range(y_spec, "--y")
-    curves = parse_range(curve_spec, "--curves") if curve_spec else None
-    ds = stability_map(case, x, y, curves, progress=progress)
-    if output is None or output.suffix == ".nc":
-        out = output or Path("stability.nc")
-        ds.to_netcdf(out)
+    out = check_output(output or Path("stability.nc"), "-o", (".nc", ".png"),
+                       inputs=[case_file])
+    axes = {"--x": parse_range(x_spec, "--x"), "--y": parse_range(y_spec, "--y")}
+    if curve_spec is not None:
+        axes["--curves"] = parse_range(curve_spec, "--curves")
+    varied: dict[str, str] = {}  # case key -> option
+    for option, (key, _) in axes.items():
+        if key in varied:
+            raise FivdiscError(f"{option} {key} is invalid: {varied[key]} varies the same key; "
+                               "give each axis its own key")
+        varied[key] = option
+    ds = stability_map(case, axes["--x"], axes["--y"], axes.get("--curves"), progress=progress)
+    if out.suffix == ".nc":
+        write_atomic(out, ds.to_netcdf)
     else:
         from fivdisc.plots import plot_stability_map
 
-        out = output
-        plot_stability_map(ds).savefig(out, dpi=150)
+        figure = plot_stability_map(ds)
+        write_atomic(out, lambda path: figure.savefig(path, dpi=150))
     click.echo(f"wrote {out}")
     for i, c in enumerate(ds["curve"].values):
         b = ds["boundary"].values[i]

@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+import logging
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import click
+import numpy as np
+
+from fivdisc.errors import FivdiscError
 
 from fivdisc.cli._case import CASE, default_output
 
@@ -15,6 +19,8 @@ if TYPE_CHECKING:
 
 # Shell convention for a command ended by SIGINT (128 + 2).
 _EXIT_INTERRUPTED = 130
+# Damaged points listed by --verify.
+_SHOWN_POINTS = 20
 
 _scheduler_option = click.option(
     "--scheduler",
@@ -41,10 +47,15 @@ def _run(
     """Run a sweep into `output`, print what happened; exit 130 on Ctrl-C."""
     from fivdisc.sweep import read_mask, run_sweep
 
+    if scheduler is not None:
+        _quiet_dask()
     try:
         report = run_sweep(spec, output, scheduler=scheduler, workers=workers, progress=progress)
     except KeyboardInterrupt:
-        done = int(read_mask(output).sum()) if output.exists() else 0
+        try:
+            done = int(read_mask(output).sum())
+        except FivdiscError:  # interrupted before the store was created
+            done = 0
         click.echo(
             f"interrupted: {done} of {spec.n_points} points are stored in {output}; "
             "rerun the same command to compute the rest",
@@ -65,8 +76,49 @@ def _run(
     return report
 
 
+def _quiet_dask() -> None:
+    """Silence dask.distributed's logs: a lost scheduler is reported in one line (a
+    SweepError), and the client's own log of it comes with tracebacks."""
+    try:
+        import distributed  # noqa: F401  (it sets its loggers' levels when imported)
+    except ImportError:
+        return  # run_sweep says how to install it
+    for name in list(logging.root.manager.loggerDict):
+        if name.split(".")[0] == "distributed":
+            logging.getLogger(name).setLevel(logging.CRITICAL)
+
+
+def _verify(store: Path) -> None:
+    """Report the health of a sweep store; exit 1 if it is damaged."""
+    from fivdisc.sweep import verify_store
+
+    health = verify_store(store)
+    n = health.complete.size
+    incomplete = n - int(health.complete.sum()) - int(health.damaged.sum())
+    click.echo(
+        f"{store}: {n} points: {int(health.complete.sum())} complete and verified "
+        f"({int(health.failed.sum())} of them failed runs), {incomplete} not computed, "
+        f"{int(health.damaged.sum())} damaged"
+    )
+    if health.holder is not None:
+        click.echo(f"being written by {health.holder}")
+    if health.broken:
+        click.echo(f"variables with missing or damaged metadata: {', '.join(health.broken)}")
+    if health.damaged.any():
+        shown = ", ".join(map(str, np.flatnonzero(health.damaged)[:_SHOWN_POINTS]))
+        more = " ..." if health.damaged.sum() > _SHOWN_POINTS else ""
+        click.echo(f"damaged points (values lost or not matching their checksums): {shown}{more}")
+    if not health.healthy:
+        click.echo(
+            f"error: {store} is damaged; rerun the sweep that wrote it to rebuild and "
+            "recompute what is damaged",
+            err=True,
+        )
+        sys.exit(1)
+
+
 @click.command()
-@click.argument("sweep_file", type=CASE)
+@click.argument("sweep_file", required=False, type=CASE)
 @click.option(
     "-o",
     "--output",
@@ -74,12 +126,21 @@ def _run(
     help="Zarr store for the results [default: SWEEP_FILE with .zarr; for an example, "
     "NAME.zarr in the working directory]. An existing store of the same sweep is resumed.",
 )
+@click.option(
+    "--verify",
+    "verify_store",
+    metavar="STORE",
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Check every point of STORE against its checksum and report the store's health, "
+    "instead of running a sweep; exits with 1 if the store is damaged.",
+)
 @_scheduler_option
 @_workers_option
 @_progress_option
 def sweep(
-    sweep_file: Path,
+    sweep_file: Path | None,
     output: Path | None,
+    verify_store: Path | None,
     scheduler: str | None,
     workers: int | None,
     progress: bool,
@@ -90,13 +151,25 @@ def sweep(
     ``fivdisc sweep sweep_fig27 -o fig27.zarr``.
 
     Results are written as points finish, so an interrupted sweep (Ctrl-C, a killed
-    process) continues where it stopped when the same command is run again. A
-    point whose run fails is stored with its error message, and the sweep goes on.
+    process, a lost cluster) continues where it stopped when the same command is run
+    again; points whose stored values no longer match their checksums are recomputed.
+    A point whose run fails is stored with its error message, and the sweep goes on.
+    One sweep at a time may write a store.
     """
+    from fivdisc.files import ZARR, check_output
     from fivdisc.sweep import load_sweep
 
+    if verify_store is not None:
+        if sweep_file is not None or output is not None or scheduler or workers:
+            raise click.UsageError("--verify STORE takes no sweep file and no other option")
+        _verify(verify_store)
+        return
+    if sweep_file is None:
+        raise click.UsageError("missing SWEEP_FILE (or --verify STORE)")
     spec = load_sweep(sweep_file)
-    _run(spec, output or default_output(sweep_file, ".zarr"), scheduler, workers, progress)
+    store = check_output(output or default_output(sweep_file, ".zarr"), "-o", ZARR,
+                         inputs=[sweep_file], kind="directory")
+    _run(spec, store, scheduler, workers, progress)
 
 
 @click.command("separation-map")
@@ -165,6 +238,7 @@ def separation_map(
     separation, and draws the separation region.
     """
     from fivdisc.case import load_case
+    from fivdisc.files import ZARR, check_output, figure_suffixes
     from fivdisc.sweep import plot_separation_map, separation_sweep
 
     spec = separation_sweep(
@@ -174,8 +248,10 @@ def separation_map(
         base=load_case(base) if base is not None else None,
         duration=duration,
     )
-    output = output or Path(f"separation-{profile}.zarr")
-    report = _run(spec, output, scheduler, workers, progress)
-    figure = figure or output.with_suffix(".png")
+    store = check_output(output or Path(f"separation-{profile}.zarr"), "-o", ZARR,
+                         inputs=[base], kind="directory")
+    figure = check_output(figure or store.with_suffix(".png"), "--figure", figure_suffixes(),
+                          inputs=[base])
+    report = _run(spec, store, scheduler, workers, progress)
     plot_separation_map(report.store, figure)
     click.echo(f"wrote {figure}")

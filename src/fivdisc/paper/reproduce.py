@@ -29,6 +29,7 @@ import numpy as np
 import xarray as xr
 
 from fivdisc.errors import FivdiscError
+from fivdisc.files import write_atomic
 from fivdisc.paper.cases import CITATION, FIGURES
 from fivdisc.paper.figures import RECIPE, Row, Runs, compute, plot, rows
 from fivdisc.paper.report import figure_blocks, render_html, render_markdown, summary_blocks
@@ -197,22 +198,12 @@ def _make(numbers: list[int], outdir: str, runs: Runs | None = None) -> dict[int
         figure = plot(data)
         stem = FIGURES[number].stem
         # The PNG goes first: a netCDF file on disk means its figure is complete.
-        _atomic(out / f"{stem}.png", lambda p, f=figure: f.savefig(p, dpi=110, format="png"))
+        write_atomic(out / f"{stem}.png", lambda p, f=figure: f.savefig(p, dpi=110, format="png"))
         seconds[number] = time.perf_counter() - start
         data.attrs["seconds"] = seconds[number]
         data.attrs["fivdisc_version"] = version("fivdisc")
-        _atomic(out / f"{stem}.nc", lambda p, d=data: d.to_netcdf(p, encoding=_encoding(d)))
+        write_atomic(out / f"{stem}.nc", lambda p, d=data: d.to_netcdf(p, encoding=_encoding(d)))
     return seconds
-
-
-def _atomic(path: Path, write) -> None:
-    """Call ``write(tmp)`` and rename tmp to `path`, so `path` is whole or absent."""
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.part")
-    try:
-        write(tmp)
-        tmp.replace(path)
-    finally:
-        tmp.unlink(missing_ok=True)
 
 
 def _encoding(data: xr.Dataset) -> dict:
@@ -275,7 +266,7 @@ def _write_report(out: Path, computed: tuple[int, ...], reused: tuple[int, ...],
         blocks += figure_blocks(n, str(attrs["title"]), str(attrs["caption"]),
                                 str(attrs["choices"]), f"{FIGURES[n].stem}.png", table[n],
                                 float(attrs.get("seconds", np.nan)))
-    _atomic(out / "REPORT.md",
+    write_atomic(out / "REPORT.md",
             lambda p: p.write_text(render_markdown(blocks), encoding="utf-8"))
-    _atomic(out / "REPORT.html",
+    write_atomic(out / "REPORT.html",
             lambda p: p.write_text(render_html(blocks, out), encoding="utf-8"))

@@ -15,12 +15,21 @@ from fivdisc.sweep.reductions import BUILTIN, Reduction, RunFailed, SweepError
 from fivdisc.sweep.run import SweepReport, run_sweep, warm_kernel
 from fivdisc.sweep.separation import plot_separation_map, separation_sweep
 from fivdisc.sweep.spec import Sweep, load_sweep, parse_range
-from fivdisc.sweep.store import SweepStore, as_grid, open_sweep, read_mask
+from fivdisc.sweep.store import (
+    StoreHealth,
+    SweepStore,
+    as_grid,
+    open_sweep,
+    read_mask,
+    store_lock,
+    verify_store,
+)
 
 __all__ = [
     "BUILTIN",
     "Reduction",
     "RunFailed",
+    "StoreHealth",
     "Sweep",
     "SweepError",
     "SweepReport",
@@ -33,5 +42,7 @@ __all__ = [
     "read_mask",
     "run_sweep",
     "separation_sweep",
+    "store_lock",
+    "verify_store",
     "warm_kernel",
 ]

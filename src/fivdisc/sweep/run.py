@@ -28,7 +28,7 @@ from fivdisc.case import Case
 from fivdisc.errors import FivdiscError
 from fivdisc.sweep.reductions import SweepError, evaluate
 from fivdisc.sweep.spec import Sweep
-from fivdisc.sweep.store import PointOutcome, SweepStore
+from fivdisc.sweep.store import PointOutcome, SweepStore, store_lock
 
 __all__ = ["SweepReport", "run_sweep", "warm_kernel"]
 
@@ -163,6 +163,10 @@ def _warm_plugin() -> Any:
     return WarmKernel()
 
 
+class ClusterLost(SweepError):
+    """The Dask cluster went away while the sweep was running on it."""
+
+
 class _DaskPool:
     """The workers of an existing Dask distributed cluster."""
 
@@ -174,27 +178,53 @@ class _DaskPool:
                 f"--scheduler needs dask.distributed ({exc}); install it with "
                 "`pip install fivdisc[distributed]`"
             ) from None
+        if not address.strip():
+            raise SweepError(
+                f"scheduler = {address!r} is invalid: must be an address like tcp://host:8786"
+            )
+        self.address = address
         try:
-            self._client = Client(address, timeout=_CONNECT_TIMEOUT)
-        except OSError as exc:
+            # Not the default scheduler of this process: the coordinator only submits.
+            self._client = Client(address, timeout=_CONNECT_TIMEOUT, set_as_default=False)
+        except ValueError as exc:  # malformed: no port, unknown scheme, ...
+            raise SweepError(
+                f"scheduler = {address!r} is invalid ({exc}): must be an address like "
+                "tcp://host:8786"
+            ) from None
+        except (OSError, TimeoutError) as exc:
             raise SweepError(f"scheduler = {address!r}: cannot connect ({exc})") from None
         self._client.register_plugin(_warm_plugin())
         self.workers = max(1, sum(self._client.nthreads().values()))
 
+    def _lost(self, exc: BaseException) -> ClusterLost:
+        reason = " ".join(str(exc).split()[:12]) or type(exc).__name__
+        return ClusterLost(f"lost the Dask cluster at {self.address} ({reason})")
+
     def submit(self, index: int, case: Case, keep: tuple[str, ...]) -> Any:
-        return self._client.submit(run_point, index, case, keep, pure=False)
+        try:
+            return self._client.submit(run_point, index, case, keep, pure=False)
+        except Exception as exc:  # a closed client raises several types
+            raise self._lost(exc) from None
 
     def wait(self, futures: Iterable[Any], timeout: float | None) -> set[Any]:
+        from concurrent.futures import CancelledError
+
         from distributed import wait
 
         try:
-            return set(wait(list(futures), timeout=timeout, return_when="FIRST_COMPLETED").done)
+            with self._client.as_current():  # wait() looks for a current client
+                done = wait(list(futures), timeout=timeout, return_when="FIRST_COMPLETED").done
+            return set(done)
         except TimeoutError:
             return set()
+        except CancelledError as exc:  # FuturesCancelledError: the scheduler went away
+            raise self._lost(exc) from None
 
     def outcome(self, future: Any, index: int) -> PointOutcome:
         if future.status == "finished":
             return future.result()
+        if future.status != "error":  # cancelled or lost with the scheduler
+            raise self._lost(RuntimeError(f"point {index} was {future.status}"))
         # run_point catches everything, so this is the cluster's failure, e.g. a worker
         # killed repeatedly while running the point: record it as the point's error.
         exc = future.exception()
@@ -245,7 +275,9 @@ def run_sweep(
     Raises
     ------
     SweepError
-        Bad `workers`, a store holding another sweep, or no connection to `scheduler`.
+        Bad `workers`; a store holding another sweep or in use by another coordinator;
+        no connection to `scheduler`, or the cluster lost during the sweep (finished
+        points stay stored; rerunning resumes).
     KeyboardInterrupt
         On Ctrl-C, after the workers are stopped; complete points stay stored.
     """
@@ -259,19 +291,30 @@ def run_sweep(
             f"workers = {workers} is invalid with a scheduler: the cluster's size is set "
             "where the cluster is started"
         )
-    target = SweepStore.open(store, spec)
-    done = target.completed()
-    todo = deque(int(i) for i in range(spec.n_points) if not done[i])
-    already = spec.n_points - len(todo)
-    failed = target.errors(done)
-
-    if todo:
-        pool = _DaskPool(scheduler) if scheduler else _LocalPool(workers or os.cpu_count() or 1)
-        try:
-            _drive(pool, spec, target, todo, already, failed, progress)
-        except BaseException:
+    # A cluster is reached before the store is touched, so that a bad address changes nothing.
+    pool = _DaskPool(scheduler) if scheduler is not None else None
+    try:
+        with store_lock(store):
+            target = SweepStore.open(store, spec)
+            done = target.completed()
+            todo = deque(int(i) for i in range(spec.n_points) if not done[i])
+            already = spec.n_points - len(todo)
+            failed = target.errors(done)
+            if todo:
+                pool = pool or _LocalPool(workers or os.cpu_count() or 1)
+                try:
+                    _drive(pool, spec, target, todo, already, failed, progress)
+                except ClusterLost as exc:
+                    stored = int(target.completed().sum())
+                    raise SweepError(
+                        f"{exc}; {stored} of {spec.n_points} points are stored in {store}: "
+                        "restart the cluster and rerun the same command to compute the rest"
+                    ) from None
+    except BaseException:
+        if pool is not None:
             pool.abort()
-            raise
+        raise
+    if pool is not None:
         pool.close()
     return SweepReport(
         store=target.path,

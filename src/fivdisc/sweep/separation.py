@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import json
 from os import PathLike
-from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 import xarray as xr
 
 from fivdisc.case import Case
+from fivdisc.files import write_atomic
 from fivdisc.sweep.reductions import SweepError
 from fivdisc.sweep.spec import Sweep
 from fivdisc.sweep.store import as_grid
@@ -47,6 +47,7 @@ DEFAULT_ACCELERATING_DURATION = 20.0  # [s]
 # base case samples sparsely to keep long runs light.
 _SPARSE_OUTPUT_RATE = 100.0  # [Hz]
 
+_DPI = 150
 _Y_KEY = {"decelerating": "speed.duration", "accelerating": "speed.rate"}
 _LABELS = {
     ("decelerating", "speed.initial"): r"initial disc speed $\Omega_0$ [rad/s]",
@@ -201,5 +202,5 @@ def plot_separation_map(
     # Outside the axes, so that it hides no point.
     fig.legend(loc="outside upper center", ncol=3, fontsize="small", frameon=False)
     if path is not None:
-        fig.savefig(Path(path), dpi=150)
+        write_atomic(path, lambda p: fig.savefig(p, dpi=_DPI))
     return fig

@@ -34,6 +34,8 @@ import numpy as np
 
 from fivdisc.case import Case, is_case_key, load_case
 from fivdisc.errors import CaseError
+from fivdisc.files import read_text
+from fivdisc.limits import check_memory, check_simulation, simulation_bytes
 from fivdisc.sweep.reductions import Reduction, SweepError, nearest, resolve, stop_events
 
 __all__ = ["Sweep", "SweepError", "load_sweep", "parse_range"]
@@ -44,6 +46,11 @@ _FILE_KEYS = ("base", "mode", "axes", "link", "reduce")
 _REDUCE_KEYS = ("keep",)
 _RANGE = re.compile(r"^\s*([^:]+):([^:]+):([^:]+)\s*$")
 _INTEGER = re.compile(r"^\s*[+-]?\d+\s*$")
+# Memory per axis value while parsing (the values, as floats and as Python objects), and
+# per point of a sweep: its validated case (measured: 6.3 kB) and its share of the store
+# template and the coordinator's bookkeeping.
+_VALUE_BYTES = 64
+_POINT_BYTES = 10_000
 
 
 def parse_range(text: str, where: str = "range") -> list[float] | list[int]:
@@ -77,6 +84,7 @@ def parse_range(text: str, where: str = "range") -> list[float] | list[int]:
         raise SweepError(f"{where} = {text!r} is invalid: n must be >= 1")
     if n == 1 and start != stop:
         raise SweepError(f"{where} = {text!r} is invalid: n = 1 needs start == stop")
+    check_memory(_VALUE_BYTES * n, f"{where} = {text!r} ({n} values)", "lower n")
     values = np.linspace(start, stop, n)
     if (
         _INTEGER.match(start_text)
@@ -207,7 +215,13 @@ class Sweep:
             )
         set_(self, "keep", tuple(self.keep))
         set_(self, "reductions", resolve(self.keep))
+        check_memory(
+            _POINT_BYTES * self.n_points,
+            f"a sweep of {self.n_points} points ({' x '.join(map(str, self.shape))})",
+            "use fewer values per axis, or split the sweep",
+        )
         set_(self, "cases", tuple(self._point_case(i) for i in range(self.n_points)))
+        check_simulation(max(self.cases, key=simulation_bytes))
         # Keep the values as validated (e.g. 6 -> 6.0) so that equal sweeps have equal
         # definitions however their values were spelt.
         strides = strides_of(self.shape) if self.mode == "grid" else (1,) * len(axes)
@@ -370,8 +384,11 @@ def load_sweep(path: str | PathLike[str]) -> Sweep:
     ------
     SweepError, CaseError
         Invalid sweep or case; the message starts with the file's path.
+    FivdiscError
+        The file is a directory, unreadable or not UTF-8 text; a point would not fit in
+        memory (see :mod:`fivdisc.limits`).
     FileNotFoundError
         The sweep file does not exist.
     """
     path = Path(path)
-    return Sweep.from_toml(path.read_text(encoding="utf-8"), root=path.parent, source=str(path))
+    return Sweep.from_toml(read_text(path), root=path.parent, source=str(path))

@@ -1,4 +1,4 @@
-"""Sweep results in a Zarr store, written point by point and safe to resume.
+"""Sweep results in a Zarr store, written point by point, verified and safe to resume.
 
 Layout (one Zarr v3 group, written through xarray)::
 
@@ -8,23 +8,40 @@ Layout (one Zarr v3 group, written through xarray)::
                                                the values are not numbers, booleans or text)
     data vars   <reduction name>               one per kept reduction (bool or float64)
                 error                          "" or why the point failed
+                checksum                       hash of the sweep, the point's index, values
+                                               and error (0: nothing written)
                 done                           the point's values are written
     attrs       sweep_definition, sweep_hash   canonical JSON of the sweep and its SHA-256
-                sweep_mode, sweep_axes, sweep_shape, sweep_variables, fivdisc_version
+                sweep_mode, sweep_axes, sweep_shape, sweep_variables, fivdisc_version,
+                store_format
 
 Every data variable has chunks of one point, so writing a point touches only its
-own chunk files (each replaced atomically by Zarr's local store). Values and
-``error`` are written before ``done``; a point counts as complete only if its
-``done`` chunk says so and every one of its chunks can be read. A store is created
-complete (metadata and coordinates) under a temporary name and renamed into place.
+own chunk files (each replaced atomically by Zarr's local store). Values, ``error`` and
+``checksum`` are written before ``done``. A point is complete only if its ``done``
+chunk says so and its values read back to its checksum: Zarr reads a lost chunk file
+as the fill value, so without the checksum a deleted chunk would pass for data.
+
+One coordinator writes a store at a time: :func:`store_lock` holds a lock file next
+to the store (``STORE.lock``, through ``filelock``) and records its holder in
+``STORE.lock.owner``. A store is created complete (metadata and coordinates) under a
+temporary name and renamed into place; temporary stores left by a killed coordinator
+are removed by the next. A variable whose metadata is lost or damaged is rebuilt empty
+when the sweep is resumed, and its points recomputed.
 """
 
 from __future__ import annotations
 
+import datetime
+import hashlib
 import json
+import math
 import os
 import shutil
-from collections.abc import Sequence
+import socket
+import struct
+import sys
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from importlib.metadata import version
 from os import PathLike
@@ -35,13 +52,26 @@ import numpy as np
 import xarray as xr
 
 from fivdisc.case import unit_of
+from fivdisc.files import write_atomic
 from fivdisc.sweep.reductions import SweepError
 from fivdisc.sweep.spec import Sweep, strides_of
 
-__all__ = ["PointOutcome", "SweepStore", "as_grid", "open_sweep", "read_mask"]
+__all__ = [
+    "PointOutcome",
+    "StoreHealth",
+    "SweepStore",
+    "as_grid",
+    "open_sweep",
+    "read_mask",
+    "store_lock",
+    "verify_store",
+]
 
 DIM = "point"
+#: Version of the layout above; stores of another version are refused.
+STORE_FORMAT = 2
 _STRING = np.dtypes.StringDType()
+_BRIEF_CHARS = 160
 
 
 @dataclass(frozen=True)
@@ -104,6 +134,11 @@ def _template(sweep: Sweep) -> xr.Dataset:
         da.from_array(np.full(n, "", dtype=_STRING), chunks=1),
         {"long_name": 'why the point failed ("" if it did not)'},
     )
+    data["checksum"] = (
+        DIM,
+        da.zeros(n, dtype=np.uint64, chunks=1),
+        {"long_name": "hash of the sweep, the point's index, values and error (0: none)"},
+    )
     data["done"] = (
         DIM,
         da.zeros(n, dtype=bool, chunks=1),
@@ -125,19 +160,61 @@ def _template(sweep: Sweep) -> xr.Dataset:
         "sweep_shape": json.dumps(list(sweep.shape)),
         "sweep_variables": json.dumps([*(r.name for r in sweep.reductions), "error"]),
         "fivdisc_version": version("fivdisc"),
+        "store_format": STORE_FORMAT,
     }
-    return xr.Dataset(data, coords=coords, attrs=attrs)
+    dataset = xr.Dataset(data, coords=coords, attrs=attrs)
+    # Name the axis coordinates on every data variable, so that a variable rebuilt
+    # alone (see _repair) still carries them.
+    for var in dataset.data_vars.values():
+        var.encoding["coordinates"] = " ".join(sweep.axes)
+    return dataset
+
+
+def _brief(exc: BaseException) -> str:
+    """An exception as one short line."""
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text if len(text) <= _BRIEF_CHARS else text[: _BRIEF_CHARS - 3] + "..."
+
+
+def _checksum(digest: str, index: int, row: Sequence[Any]) -> int:
+    """Checksum of one point: the sweep's digest, the index and the stored values, in order.
+
+    Never 0, the fill value of the ``checksum`` variable (nothing written).
+    """
+    h = hashlib.blake2b(f"{digest}:{index}".encode(), digest_size=8)
+    for value in row:
+        if isinstance(value, bool | np.bool_):
+            token = b"T" if value else b"F"
+        elif isinstance(value, float | np.floating):
+            token = b"nan" if math.isnan(value) else struct.pack("<d", float(value))
+        else:
+            token = str(value).encode()
+        h.update(len(token).to_bytes(4, "little") + token)
+    return int.from_bytes(h.digest(), "little") or 1
 
 
 def _read_attrs(path: Path) -> dict[str, Any]:
     """The group attributes of a sweep store; SweepError if `path` is not one."""
     zarr = _require_zarr()
+    if not path.is_dir():
+        raise SweepError(f"{path} is not a sweep store: no such directory")
+    if not (path / "zarr.json").is_file():
+        raise SweepError(f"{path} exists and is not a Zarr store (it has no zarr.json)")
     try:
         attrs = dict(zarr.open_group(path, mode="r").attrs)
-    except Exception as exc:  # zarr raises several types for "not a group here"
-        raise SweepError(f"{path} exists and is not a Zarr store ({exc})") from None
+    except Exception as exc:  # zarr raises several types for damaged metadata
+        raise SweepError(
+            f"{path} has damaged metadata ({path / 'zarr.json'}: {_brief(exc)}); delete the "
+            "store to start over"
+        ) from None
     if "sweep_hash" not in attrs:
         raise SweepError(f"{path} exists and is not a fivdisc sweep store")
+    if attrs.get("store_format") != STORE_FORMAT:
+        raise SweepError(
+            f"{path} was written by another version of fivdisc (store format "
+            f"{attrs.get('store_format', 1)}, this version writes {STORE_FORMAT}); write to "
+            "a new store, or delete this one to start over"
+        )
     return attrs
 
 
@@ -167,11 +244,98 @@ def _readable(array: Any) -> tuple[np.ndarray, np.ndarray]:
         return values, ok
 
 
+def _arrays(path: Path, names: Sequence[str], n: int) -> tuple[dict[str, Any], list[str]]:
+    """The store's arrays by name, and the names whose metadata is missing or damaged."""
+    zarr = _require_zarr()
+    group = zarr.open_group(path, mode="r")
+    arrays: dict[str, Any] = {}
+    broken: list[str] = []
+    for name in names:
+        try:
+            array = group[name]
+            ok = array.shape == (n,)
+        except Exception:  # missing directory (KeyError), damaged JSON, bad metadata
+            ok = False
+        if ok:
+            arrays[name] = array
+        else:
+            broken.append(name)
+    return arrays, broken
+
+
+@dataclass(frozen=True)
+class StoreHealth:
+    """What :func:`verify_store` found.
+
+    Attributes
+    ----------
+    path
+        The store.
+    complete
+        Per point: its ``done`` flag is set and its values read back to its checksum.
+    damaged
+        Per point: marked done (or its ``done`` chunk is unreadable), but not complete.
+    failed
+        Complete points whose run failed (a non-empty ``error``).
+    broken
+        Variables whose metadata is missing or damaged.
+    holder
+        Who holds the store's lock (a sweep writing it), or None.
+    """
+
+    path: Path
+    complete: np.ndarray
+    damaged: np.ndarray
+    failed: np.ndarray
+    broken: tuple[str, ...]
+    holder: str | None
+
+    @property
+    def healthy(self) -> bool:
+        """No damaged point and no broken variable (points may still be missing)."""
+        return not self.damaged.any() and not self.broken
+
+
+def _layout(attrs: dict[str, Any]) -> tuple[list[str], list[str], int]:
+    """(checksummed variables: reductions then "error"; every variable; number of points)."""
+    variables = json.loads(attrs["sweep_variables"])
+    coords = [DIM, *json.loads(attrs["sweep_axes"])]
+    return variables, [*variables, "checksum", "done", *coords], \
+        math.prod(json.loads(attrs["sweep_shape"]))
+
+
+def _inspect(path: Path, attrs: dict[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                          list[str]]:
+    """(complete, damaged, failed, broken variables) of a store; see :class:`StoreHealth`."""
+    variables, names, n = _layout(attrs)
+    arrays, broken = _arrays(path, names, n)
+    if "done" in arrays:
+        done, done_readable = _readable(arrays["done"])
+        done = np.asarray(done, dtype=bool)
+    else:
+        done, done_readable = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+    readable = np.ones(n, dtype=bool)
+    columns = {}
+    for name in [*variables, "checksum"]:
+        if name in arrays:
+            columns[name], ok = _readable(arrays[name])
+            readable &= ok
+        else:
+            readable[:] = False
+    complete = done & done_readable & readable
+    for i in np.flatnonzero(complete):
+        row = [columns[name][i] for name in variables]
+        complete[i] = int(columns["checksum"][i]) == _checksum(attrs["sweep_hash"], int(i), row)
+    damaged = ~complete & (done | ~done_readable)
+    failed = complete & (columns["error"] != "") if "error" in columns else np.zeros(n, bool)
+    return complete, damaged, failed, broken
+
+
 def read_mask(path: str | PathLike[str]) -> np.ndarray:
     """Which points of a sweep store are complete.
 
-    A point is complete when its ``done`` chunk reads True and every chunk of its
-    values and error can be read; damaged chunks count as not done.
+    A point is complete when its ``done`` chunk reads True and its values and error
+    read back to its checksum; damaged or lost chunks count as not done.
 
     Parameters
     ----------
@@ -182,15 +346,112 @@ def read_mask(path: str | PathLike[str]) -> np.ndarray:
     -------
     ndarray of bool
         One entry per point.
+
+    Raises
+    ------
+    SweepError
+        `path` is not a sweep store of this version.
     """
     path = Path(path)
-    attrs = _read_attrs(path)
-    group = _require_zarr().open_group(path, mode="r")
-    done, readable = _readable(group["done"])
-    mask = np.asarray(done, dtype=bool) & readable
-    for name in json.loads(attrs["sweep_variables"]):
-        mask &= _readable(group[name])[1]
-    return mask
+    return _inspect(path, _read_attrs(path))[0]
+
+
+def verify_store(path: str | PathLike[str]) -> StoreHealth:
+    """Check every point and variable of a sweep store, without changing it.
+
+    Parameters
+    ----------
+    path
+        The store.
+
+    Returns
+    -------
+    StoreHealth
+        Complete, damaged and failed points, broken variables and the lock's holder.
+
+    Raises
+    ------
+    SweepError
+        `path` is not a sweep store of this version, or its group metadata is damaged.
+    """
+    path = Path(path)
+    complete, damaged, failed, broken = _inspect(path, _read_attrs(path))
+    return StoreHealth(path, complete, damaged, failed, tuple(broken), _holder(path))
+
+
+# --- the lock --------------------------------------------------------------------------------
+
+
+def _lock_path(path: Path) -> Path:
+    return path.with_name(path.name + ".lock")
+
+
+def _owner_path(path: Path) -> Path:
+    return path.with_name(path.name + ".lock.owner")
+
+
+def _describe_owner(path: Path) -> str:
+    """The lock holder recorded next to the store, as text."""
+    try:
+        owner = json.loads(_owner_path(path).read_text(encoding="utf-8"))
+        return (f"process {owner['pid']} on host {owner['host']} (running since "
+                f"{owner['since']}: {owner['command']})")
+    except (OSError, ValueError, KeyError, TypeError):
+        return "another process (it recorded no details)"
+
+
+def _holder(path: Path) -> str | None:
+    """Who holds the store's lock now, or None."""
+    from filelock import FileLock, Timeout
+
+    if not _lock_path(path).exists():
+        return None
+    lock = FileLock(_lock_path(path), timeout=0)
+    try:
+        lock.acquire()
+    except Timeout:
+        return _describe_owner(path)
+    lock.release()
+    return None
+
+
+@contextmanager
+def store_lock(path: str | PathLike[str]) -> Iterator[None]:
+    """Hold the lock of a sweep store: one coordinator writes a store at a time.
+
+    The lock is a file next to the store (``STORE.lock``, held through ``filelock``; the
+    operating system releases it when its process dies, however it dies), and the holder's
+    process id, host, start time and command are written to ``STORE.lock.owner``.
+
+    Raises
+    ------
+    SweepError
+        Another process holds the lock; the message names it.
+    """
+    from filelock import FileLock, Timeout
+
+    path = Path(path)
+    lock = FileLock(_lock_path(path), timeout=0)
+    try:
+        lock.acquire()
+    except Timeout:
+        raise SweepError(
+            f"{path} is in use by {_describe_owner(path)}: wait for that sweep to end or "
+            "stop it, then rerun"
+        ) from None
+    try:
+        owner = {
+            "pid": os.getpid(),
+            "host": socket.gethostname(),
+            "since": datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M:%S UTC"),
+            "command": " ".join(sys.argv),
+        }
+        write_atomic(_owner_path(path), lambda p: p.write_text(json.dumps(owner),
+                                                               encoding="utf-8"))
+        yield
+    finally:
+        _owner_path(path).unlink(missing_ok=True)
+        lock.release()
 
 
 class SweepStore:
@@ -213,7 +474,11 @@ class SweepStore:
 
     @classmethod
     def open(cls, path: str | PathLike[str], sweep: Sweep) -> SweepStore:
-        """Create the store for `sweep`, or reopen it to resume.
+        """Create the store for `sweep`, or reopen it to resume; hold :func:`store_lock`.
+
+        Temporary stores left next to `path` by a killed coordinator are removed, and
+        variables whose metadata is lost or damaged are rebuilt empty (their points are
+        then incomplete and get recomputed).
 
         Raises
         ------
@@ -222,6 +487,8 @@ class SweepStore:
         """
         path = Path(path)
         _require_zarr()
+        for stale in path.parent.glob(f"{path.name}.tmp-*"):
+            shutil.rmtree(stale, ignore_errors=True)
         if path.exists():
             attrs = _read_attrs(path)
             if attrs["sweep_hash"] != sweep.digest:
@@ -230,6 +497,8 @@ class SweepStore:
                     f"{path} holds a different sweep (its definition differs in: {fields}); "
                     "write to a new store, or delete this one to start over"
                 )
+            _, names, n = _layout(attrs)
+            _repair(path, sweep, _arrays(path, names, n)[1])
         else:
             _create(path, sweep)
         return cls(path, sweep)
@@ -268,6 +537,13 @@ class SweepStore:
                 for r in self.sweep.reductions
             }
             data["error"] = (DIM, np.array([o.error for o in run], dtype=_STRING))
+            columns = [data[name][1] for name in (*(r.name for r in self.sweep.reductions),
+                                                  "error")]
+            checksums = [
+                _checksum(self.sweep.digest, o.index, [column[j] for column in columns])
+                for j, o in enumerate(run)
+            ]
+            data["checksum"] = (DIM, np.array(checksums, dtype=np.uint64))
             self._write_region(xr.Dataset(data), run)
         for run in runs:
             self._write_region(xr.Dataset({"done": (DIM, np.ones(len(run), dtype=bool))}), run)
@@ -277,15 +553,18 @@ class SweepStore:
         data.to_zarr(self.path, region=region, mode="r+", consolidated=False)
 
 
+def _encoding(names: Sequence[str]) -> dict[str, dict[str, Any]]:
+    return {name: {"chunks": (1,)} for name in names}
+
+
 def _create(path: Path, sweep: Sweep) -> None:
     """Write the empty store under a temporary name and rename it into place."""
     tmp = path.with_name(f"{path.name}.tmp-{os.getpid()}")
-    encoding = {
-        name: {"chunks": (1,)} for name in (*(r.name for r in sweep.reductions), "error", "done")
-    }
+    template = _template(sweep)
     try:
-        _template(sweep).to_zarr(
-            tmp, mode="w-", compute=False, consolidated=False, zarr_format=3, encoding=encoding
+        template.to_zarr(
+            tmp, mode="w-", compute=False, consolidated=False, zarr_format=3,
+            encoding=_encoding(list(template.data_vars)),
         )
         tmp.rename(path)
     except BaseException:
@@ -293,23 +572,66 @@ def _create(path: Path, sweep: Sweep) -> None:
         raise
 
 
+def _repair(path: Path, sweep: Sweep, broken: Sequence[str]) -> None:
+    """Rebuild variables whose metadata is missing or damaged: coordinates from the sweep,
+    data variables empty."""
+    if not broken:
+        return
+    template = _template(sweep)
+    for name in broken:
+        shutil.rmtree(path / name, ignore_errors=True)
+    rebuilt = template[[n for n in broken if n in template.data_vars]]
+    rebuilt = rebuilt.drop_vars([c for c in rebuilt.coords if c not in broken])
+    for name in broken:
+        if name in template.coords and name not in rebuilt:
+            rebuilt[name] = template[name].variable
+    rebuilt.attrs = template.attrs  # the group's, rewritten unchanged (same sweep)
+    # Data variables are lazy, so only their metadata is written; coordinates are numpy
+    # arrays, whose values compute=False writes too.
+    rebuilt.to_zarr(
+        path, mode="a", compute=False, consolidated=False, zarr_format=3,
+        encoding=_encoding([n for n in broken if n in template.data_vars]),
+    )
+
+
 def open_sweep(path: str | PathLike[str]) -> xr.Dataset:
     """Load a sweep store into memory, one entry per point.
+
+    ``done`` is True only for verified points (see :func:`read_mask`); unreadable chunks
+    read as their variable's fill value, and the values of points that are not done are
+    not to be trusted.
 
     Raises
     ------
     SweepError
-        `path` is not a sweep store, or some chunk cannot be read (rerun the sweep
-        to recompute the damaged points).
+        `path` is not a sweep store, or a variable is missing or has damaged metadata
+        (rerun the sweep to rebuild it and recompute its points).
     """
     path = Path(path)
-    _read_attrs(path)
-    try:
-        return xr.open_zarr(path, consolidated=False).load()
-    except Exception as exc:  # damaged chunks: the codec's error type varies
+    attrs = _read_attrs(path)
+    complete, _, _, broken = _inspect(path, attrs)
+    if broken:
         raise SweepError(
-            f"{path} has unreadable chunks ({exc}); rerun the sweep to recompute them"
+            f"{path} is damaged: variable(s) {', '.join(broken)} are missing or unreadable; "
+            "rerun the sweep to rebuild them and recompute their points"
+        )
+    # chunks=None: lazily indexed arrays read by Zarr itself, not dask (whose default
+    # scheduler may be a cluster client of this process).
+    data = xr.open_zarr(path, consolidated=False, chunks=None)
+    for name in list(data.data_vars):
+        try:
+            data[name].load()
+        except Exception:  # damaged chunks: the codec's error type varies
+            values, _ = _readable(_arrays(path, [name], complete.size)[0][name])
+            data[name] = data[name].copy(data=values)
+    try:
+        data = data.load()
+    except Exception as exc:  # a damaged coordinate chunk
+        raise SweepError(
+            f"{path} has unreadable coordinates ({_brief(exc)}); rerun the sweep to rebuild them"
         ) from None
+    data["done"] = data["done"].copy(data=complete)
+    return data
 
 
 def as_grid(data: xr.Dataset) -> xr.Dataset:

@@ -1,0 +1,268 @@
+"""Sweep stores are safe: one writer at a time, every point verified by its checksum,
+damaged metadata rebuilt, ``fivdisc sweep --verify`` (issue 14, item 2).
+
+The stores here are filled with made-up outcomes through :class:`SweepStore`, without
+running simulations; ``test_sweep.py`` and ``test_sweep_dask.py`` run real sweeps.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+from click.testing import CliRunner
+
+from fivdisc.case import Case
+from fivdisc.cli import cli
+from fivdisc.sweep import (
+    Sweep,
+    SweepError,
+    SweepStore,
+    open_sweep,
+    read_mask,
+    run_sweep,
+    store_lock,
+    verify_store,
+)
+from fivdisc.sweep.store import PointOutcome
+
+N = 6
+FAILED = 3  # the point whose run failed
+SPEC = Sweep(
+    base=Case(simulation={"duration": 0.01, "output_rate": 1000.0}),
+    axes={"slider.normal_damping": [0.1 * (i + 1) for i in range(N)]},
+    keep=["separated", "max_normal_force"],
+)
+
+
+def _outcome(i: int) -> PointOutcome:
+    """Even points separate; every point has a force; point FAILED failed."""
+    if i == FAILED:
+        return PointOutcome(i, None, "RuntimeError: boom")
+    return PointOutcome(i, {"separated": i % 2 == 0, "max_normal_force": 100.0 + i})
+
+
+def _store(path: Path, points=range(N)) -> Path:
+    with store_lock(path):
+        SweepStore.open(path, SPEC).write([_outcome(i) for i in points])
+    return path
+
+
+@pytest.fixture
+def store(tmp_path: Path) -> Path:
+    return _store(tmp_path / "s.zarr")
+
+
+def _mask(*indices: int) -> np.ndarray:
+    mask = np.zeros(N, dtype=bool)
+    mask[list(indices)] = True
+    return mask
+
+
+def _chunk(store: Path, name: str, i: int) -> Path:
+    return store / name / "c" / str(i)
+
+
+# --- checksums -------------------------------------------------------------------------------
+
+
+def test_a_complete_store_verifies(store: Path) -> None:
+    health = verify_store(store)
+    assert health.healthy and health.complete.all() and not health.damaged.any()
+    np.testing.assert_array_equal(health.failed, _mask(FAILED))
+    assert health.broken == () and health.holder is None
+    data = open_sweep(store)
+    assert data["done"].all()
+    np.testing.assert_array_equal(data["max_normal_force"].values[[0, 5]], [100.0, 105.0])
+
+
+def test_lost_and_damaged_chunks_fail_their_checksum(store: Path) -> None:
+    # Zarr reads a missing chunk as the fill value, so without checksums point 1 would
+    # pass for done with max_normal_force = NaN.
+    _chunk(store, "max_normal_force", 1).unlink()
+    _chunk(store, "checksum", 2).unlink()
+    _chunk(store, "separated", 4).unlink()  # True, read back as the fill value False
+    _chunk(store, "error", FAILED).write_bytes(b"garbage")
+    _chunk(store, "done", 5).unlink()  # values written, flag not yet: incomplete, not damaged
+    health = verify_store(store)
+    np.testing.assert_array_equal(health.complete, _mask(0))
+    np.testing.assert_array_equal(health.damaged, _mask(1, 2, FAILED, 4))
+    assert not health.healthy
+    np.testing.assert_array_equal(read_mask(store), _mask(0))
+    np.testing.assert_array_equal(open_sweep(store)["done"].values, _mask(0))
+
+
+def test_a_lost_chunk_equal_to_the_fill_value_loses_nothing(store: Path) -> None:
+    # Point 1 did not separate (False, the fill value): Zarr may not even write that chunk.
+    _chunk(store, "separated", 1).unlink(missing_ok=True)
+    assert verify_store(store).complete.all()
+
+
+def test_a_chunk_copied_from_another_point_fails(store: Path) -> None:
+    for name in ("max_normal_force", "separated", "checksum"):
+        _chunk(store, name, 2).write_bytes(_chunk(store, name, 0).read_bytes())
+    np.testing.assert_array_equal(verify_store(store).damaged, _mask(2))
+
+
+# --- damaged metadata ------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("damage", "name"),
+    [
+        ("delete", "max_normal_force"),
+        ("truncate", "max_normal_force"),
+        ("delete", "checksum"),
+        ("truncate", "done"),
+        ("delete", "slider.normal_damping"),  # a coordinate
+        ("truncate", "point"),
+    ],
+)
+def test_damaged_variables_are_reported_and_rebuilt(store: Path, damage: str, name: str) -> None:
+    reference = open_sweep(store)
+    if damage == "delete":
+        for path in sorted((store / name).rglob("*"), reverse=True):
+            path.unlink() if path.is_file() else path.rmdir()
+        (store / name).rmdir()
+    else:
+        meta = store / name / "zarr.json"
+        meta.write_bytes(meta.read_bytes()[:40])
+    health = verify_store(store)
+    assert health.broken == (name,) and not health.healthy
+    with pytest.raises(SweepError, match=f"variable\\(s\\) {name} are missing or unreadable"):
+        open_sweep(store)
+    result = CliRunner().invoke(cli, ["sweep", "--verify", str(store)])
+    assert result.exit_code == 1 and name in result.stdout
+
+    # Resuming rebuilds the variable; only the points whose values it held are lost.
+    with store_lock(store):
+        SweepStore.open(store, SPEC)
+    health = verify_store(store)
+    assert health.broken == ()
+    lost = {"max_normal_force": _mask(*range(N)) & ~_mask(FAILED),  # NaN is the fill value
+            "checksum": _mask(*range(N)), "done": _mask(*range(N))}.get(name, _mask())
+    np.testing.assert_array_equal(health.complete, ~lost)
+    _store(store, np.flatnonzero(lost))
+    xr.testing.assert_identical(open_sweep(store), reference)
+
+
+def test_damaged_group_metadata_is_one_line(store: Path) -> None:
+    meta = store / "zarr.json"
+    meta.write_bytes(meta.read_bytes()[:100])
+    for call in (verify_store, open_sweep, read_mask,
+                 lambda p: run_sweep(SPEC, p, workers=1, progress=False)):
+        with pytest.raises(SweepError, match=r"s.zarr has damaged metadata \(.*zarr.json: .*\); "
+                                             r"delete the store to start over$") as info:
+            call(store)
+        assert "\n" not in str(info.value)
+
+
+def test_a_store_of_an_older_format_is_refused(store: Path) -> None:
+    meta = store / "zarr.json"
+    data = json.loads(meta.read_text())
+    del data["attributes"]["store_format"]
+    meta.write_text(json.dumps(data))
+    with pytest.raises(SweepError, match="store format 1, this version writes 2"):
+        verify_store(store)
+
+
+# --- one coordinator per store ---------------------------------------------------------------
+
+
+def test_a_second_coordinator_is_refused_and_told_who_holds_the_store(tmp_path: Path) -> None:
+    path = tmp_path / "s.zarr"
+    with store_lock(path):
+        owner = json.loads((tmp_path / "s.zarr.lock.owner").read_text())
+        assert owner["pid"] == os.getpid() and owner["host"] == socket.gethostname()
+        with pytest.raises(SweepError) as info:
+            run_sweep(SPEC, path, workers=1, progress=False)
+        message = str(info.value)
+        assert message.startswith(f"{path} is in use by process {os.getpid()} on host "
+                                  f"{socket.gethostname()} (running since ")
+        assert message.endswith("wait for that sweep to end or stop it, then rerun")
+        assert not path.exists()  # the new store was not started
+    assert not (tmp_path / "s.zarr.lock.owner").exists()
+    _store(path)  # free again
+
+
+def test_the_lock_holds_across_processes_and_ends_with_its_holder(tmp_path: Path) -> None:
+    path = _store(tmp_path / "s.zarr")
+    holder = subprocess.Popen(
+        [sys.executable, "-c",
+         "import sys, time\nfrom fivdisc.sweep.store import store_lock\n"
+         f"with store_lock({str(path)!r}):\n    print('held', flush=True)\n    time.sleep(60)"],
+        stdout=subprocess.PIPE, text=True,
+    )
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        result = CliRunner().invoke(cli, ["sweep", "--verify", str(path)])
+        assert result.exit_code == 0 and f"being written by process {holder.pid}" in result.stdout
+        with pytest.raises(SweepError, match=f"in use by process {holder.pid} on host"):
+            with store_lock(path):
+                pass
+    finally:
+        holder.kill()  # SIGKILL: no cleanup; the operating system drops the lock
+        holder.wait()
+    assert (tmp_path / "s.zarr.lock.owner").exists()  # stale record of the dead holder
+    with store_lock(path):
+        assert json.loads((tmp_path / "s.zarr.lock.owner").read_text())["pid"] == os.getpid()
+
+
+def test_stale_temporary_stores_are_removed(tmp_path: Path) -> None:
+    stale = tmp_path / "s.zarr.tmp-999999"
+    (stale / "done").mkdir(parents=True)
+    (stale / "zarr.json").write_text("{")
+    _store(tmp_path / "s.zarr")
+    assert sorted(p.name for p in tmp_path.iterdir() if "tmp" in p.name) == []
+    assert verify_store(tmp_path / "s.zarr").complete.all()
+
+
+# --- fivdisc sweep --verify ------------------------------------------------------------------
+
+
+def test_verify_command(store: Path) -> None:
+    result = CliRunner().invoke(cli, ["sweep", "--verify", str(store)])
+    assert result.exit_code == 0, result.output
+    assert result.stdout == (f"{store}: 6 points: 6 complete and verified (1 of them failed "
+                             "runs), 0 not computed, 0 damaged\n")
+    _chunk(store, "max_normal_force", 4).unlink()
+    _chunk(store, "done", 5).unlink()
+    result = CliRunner().invoke(cli, ["sweep", "--verify", str(store)])
+    assert result.exit_code == 1
+    assert "4 complete and verified (1 of them failed runs), 1 not computed, 1 damaged" in \
+        result.stdout
+    assert "damaged points (values lost or not matching their checksums): 4\n" in result.stdout
+    assert result.stderr.startswith("error: ") and result.stderr.count("\n") == 1
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["sweep", "--verify", "{store}", "s.toml"], ["takes no sweep file"]),
+        (["sweep", "--verify", "{store}", "--workers", "2"], ["takes no sweep file"]),
+        (["sweep"], ["missing SWEEP_FILE"]),
+    ],
+)
+def test_verify_usage(store: Path, args, words) -> None:
+    result = CliRunner().invoke(cli, [a.format(store=store) for a in args])
+    assert result.exit_code == 2 and "Usage:" in result.stderr
+    for word in words:
+        assert word in result.stderr
+
+
+def test_verify_of_something_else_is_one_line(tmp_path: Path) -> None:
+    (tmp_path / "empty.zarr").mkdir()
+    for target, words in ((tmp_path / "empty.zarr", "has no zarr.json"),
+                          (tmp_path / "none.zarr", "no such directory")):
+        start = time.perf_counter()
+        result = CliRunner().invoke(cli, ["sweep", "--verify", str(target)])
+        assert result.exit_code == 2 and time.perf_counter() - start < 5.0
+        assert result.stderr.count("\n") == 1 and words in result.stderr
