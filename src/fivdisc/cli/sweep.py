@@ -10,9 +10,8 @@ from typing import TYPE_CHECKING
 import click
 import numpy as np
 
-from fivdisc.errors import FivdiscError
-
 from fivdisc.cli._case import CASE, default_output
+from fivdisc.errors import FivdiscError
 
 if TYPE_CHECKING:
     from fivdisc.sweep import Sweep, SweepReport
