@@ -47,7 +47,8 @@ def test_resolve_prefers_an_existing_file(tmp_path, monkeypatch):
     ("text", "message"),
     [
         ("fig1", r"^'fig1' is neither a file nor a packaged example: nearest: fig10, fig11"),
-        ("zzz", r"must be one of default, fig03a, .*sweep_fig27 \(`fivdisc examples`"),
+        ("zzz", r"must be one of damped-disc, default, fig03a, .*sweep_fig27, two-pads "
+                r"\(`fivdisc examples`"),
         ("nowhere/fig10.toml", r"^file not found: nowhere/fig10.toml$"),
     ],
 )

@@ -246,13 +246,15 @@ def test_verify_command(store: Path) -> None:
 @pytest.mark.parametrize(
     ("args", "words"),
     [
-        (["sweep", "--verify", "{store}", "s.toml"], ["takes no sweep file"]),
+        (["sweep", "--verify", "{store}", "{sweep}"], ["takes no sweep file"]),
         (["sweep", "--verify", "{store}", "--workers", "2"], ["takes no sweep file"]),
         (["sweep"], ["missing SWEEP_FILE"]),
     ],
 )
-def test_verify_usage(store: Path, args, words) -> None:
-    result = CliRunner().invoke(cli, [a.format(store=store) for a in args])
+def test_verify_usage(store: Path, tmp_path: Path, args, words) -> None:
+    sweep = tmp_path / "s.toml"
+    sweep.write_text("", encoding="utf-8")
+    result = CliRunner().invoke(cli, [a.format(store=store, sweep=sweep) for a in args])
     assert result.exit_code == 2 and "Usage:" in result.stderr
     for word in words:
         assert word in result.stderr

@@ -227,9 +227,9 @@ def _radial_values(
 
 @lru_cache(maxsize=64)
 def _leggauss(n: int) -> tuple[np.ndarray, np.ndarray]:
-    # scipy's asymptotic nodes and weights cost O(n); numpy's leggauss solves an n x n
-    # eigenproblem, which took seconds for n ~ 400 on a machine with busy cores.
-    return special.roots_legendre(n)
+    # numpy's rule, cached: scipy's roots_legendre is cheaper but differs in the last bits,
+    # which changes every modal mass and so breaks bit-for-bit reproducibility of runs.
+    return np.polynomial.legendre.leggauss(n)
 
 
 def _gauss_legendre(a: float, b: float, n: int) -> tuple[np.ndarray, np.ndarray]:
