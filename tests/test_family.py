@@ -230,7 +230,7 @@ def test_kernel_friction_law_matches_its_formula(law):
     mdl = build_model(case).kernel_args
     u = np.linspace(0.0, 1.5, 301)
     r = 0.1
-    got = np.array([dyn.kinetic_friction(mdl, r, 1, ui / r) for ui in u])
+    got = np.array([dyn.kinetic_friction(mdl.opts, mdl.table, r, 1, ui / r) for ui in u])
     if law["law"] == "stribeck":
         want = 0.35 + 0.25 * np.exp(-(u / 0.3) ** 2.0) + 0.1 * u
     else:

@@ -85,9 +85,9 @@ def _energy(model, y, omega):
     qp = np.where(partner >= 0, q[np.maximum(partner, 0)], 0.0)
     kinetic = 0.5 * np.sum(M * (qd + sgn * l * omega * qp) ** 2)
     kern = model.kernel
-    kinetic += 0.5 * kern.mass[0] * zd**2 + 0.5 * kern.inertia[0] * phid**2
-    potential = 0.5 * np.sum(M * md.omega**2 * q**2) + 0.5 * kern.kphi[0] * phi**2
-    potential += 0.5 * kern.kz[0] * z**2 + kern.n0[0] * z
+    kinetic += 0.5 * kern.row("mass")[0] * zd**2 + 0.5 * kern.row("inertia")[0] * phid**2
+    potential = 0.5 * np.sum(M * md.omega**2 * q**2) + 0.5 * kern.row("kphi")[0] * phi**2
+    potential += 0.5 * kern.row("kz")[0] * z**2 + kern.row("n0")[0] * z
     return kinetic + potential
 
 
@@ -107,19 +107,20 @@ def test_impact_map_equal_velocities_and_energy_loss():
         # Half the trials with the slider moving with the disc (v = 0).
         y[2 * n + 2] = omega if trial % 2 else rng.uniform(0, 2 * omega)
         work = dyn.new_work(mdl, y)
+        aux = lay.work_rows(1)[3]
         dyn.evaluate(0.0, y, flying, sign, True, mdl, work, dy)
-        y[n + 1] = work[5][lay.A_WC, 0]
+        y[n + 1] = work[aux + lay.A_WC, 0]
         # Slider approaching the disc surface.
-        y[-1] = work[5][lay.A_WCD, 0] - abs(rng.normal(0, 0.5))
+        y[-1] = work[aux + lay.A_WCD, 0] - abs(rng.normal(0, 0.5))
         before = y.copy()
         single_impact(0, y, mdl, work)
         dyn.evaluate(0.0, y, flying, sign, True, mdl, work, dy)
-        assert y[-1] == pytest.approx(work[5][lay.A_WCD, 0], abs=1e-12 * abs(before[-1]))
+        assert y[-1] == pytest.approx(work[aux + lay.A_WCD, 0], abs=1e-12 * abs(before[-1]))
         # Classical plastic-impact loss: u^2 / (2 K), K = 1/m + sum g^2/M, with u the
         # approach velocity; the normal impulse p on a surface sloped by g'.q that slides
         # at v = Omega - phidot under the slider also does work -p v (g'.q).
-        g, gp = work[0][0], work[1][0]
-        m = mdl.mass[0]
+        g, gp = work[0, :n], work[1, :n]
+        m = mdl.slider[lay.S_MASS, 0]
         kk = 1 / m + np.sum(g**2 / model.modal_mass)
         u = before[-1] - (g @ before[n + 2 : 2 * n + 2] + before[2 * n + 2] * (gp @ before[:n]))
         p = -u / kk

@@ -73,7 +73,7 @@ class Model:
     @property
     def n_sliders(self) -> int:
         """Number of sliders S."""
-        return int(self.kernel.theta.size)
+        return int(self.kernel.slider.shape[1])
 
     @property
     def state_size(self) -> int:
@@ -83,19 +83,31 @@ class Model:
     @cached_property
     def kernel_args(self) -> lay.KernelModel:
         """The model tuple the numba kernels take, with the speed profile of this model."""
-        return self.kernel._replace(knots=self.speed.knots, coef=self.speed.coefficients)
+        return self.kernel._replace(speed=self.speed.pieces())
 
     def with_speed(self, speed: SpeedProfile) -> Model:
         """The same model at another disc speed profile."""
         return replace(self, speed=speed)
 
-    def with_sliders(self, **arrays: np.ndarray) -> Model:
-        """The same model with per-slider kernel arrays replaced (``cz=...``, ``n0=...``).
+    def with_sliders(self, **rows: np.ndarray) -> Model:
+        """The same model with per-slider quantities replaced (``cz=...``, ``n0=...``;
+        names of ``layout.SLIDER_ROWS``).
 
-        The face-signed products (``smass``, ``skz``, ...) follow their plain values.
+        The face-signed products follow their plain values.
         """
-        kern = self.kernel._replace(**arrays)
-        return replace(self, kernel=kern._replace(**_signed(kern._asdict())))
+        slider = self.kernel.slider.copy()
+        for name, values in rows.items():
+            slider[lay.SLIDER_ROWS[name]] = values
+        _sign(slider)
+        return replace(self, kernel=self.kernel._replace(slider=slider))
+
+    def with_friction(self, **values: float) -> Model:
+        """The same model with friction parameters replaced (``decay=...``; keys of the
+        case's ``[friction]`` table in ``layout.FRICTION_SLOTS``)."""
+        opts = self.kernel.opts.copy()
+        for name, value in values.items():
+            opts[lay.FRICTION_SLOTS[name]] = value
+        return replace(self, kernel=self.kernel._replace(opts=opts))
 
     def index(self, what: str, j: int = 0) -> int:
         """Position of slider j's ``"phi"``, ``"z"``, ``"phi_dot"`` or ``"z_dot"`` in the
@@ -122,53 +134,46 @@ def shape_matrix(modes, r, theta) -> np.ndarray:
     return np.stack(cols, axis=1) if cols else np.empty((r.size, 0))
 
 
-def _signed(arrays) -> dict[str, np.ndarray]:
-    """The face-signed products of the per-slider arrays (a mapping of kernel fields)."""
-    sig = arrays["sigma"]
-    return {
-        "smass": sig * arrays["mass"],
-        "skz": sig * arrays["kz"],
-        "scz": sig * arrays["cz"],
-        "sn0": sig * arrays["n0"],
-        "shh": sig * arrays["hh"],
-    }
+def _sign(slider: np.ndarray) -> None:
+    """Fill the face-signed rows of a ``(N_SLIDER, S)`` slider array from the plain ones."""
+    for signed, plain in lay.SIGNED_ROWS:
+        slider[signed] = slider[lay.S_SIGMA] * slider[plain]
 
 
-def friction_arrays(friction) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(fric, ftab_x, ftab_c)`` kernel arrays of a case's ``[friction]`` table.
+def friction_arrays(friction, opts: np.ndarray) -> np.ndarray:
+    """Write a case's ``[friction]`` table into ``opts`` (law and parameters) and return
+    the kernel's table of a tabulated law.
 
-    A tabulated law becomes its PCHIP pieces in powers of ``u - x_k``, with a constant
-    last piece beyond the last point.
+    A tabulated law becomes its PCHIP pieces in powers of ``u - x_k`` (rows: start,
+    then the four coefficients), with a constant last piece beyond the last point.
     """
-    fric = np.zeros(lay.N_FRIC)
-    fric[lay.F_MUS] = friction.static
-    tab_x = np.zeros(1)
-    tab_c = np.zeros((1, 4))
+    opts[lay.O_MUS] = friction.static
+    table = np.zeros((1, 5))
     if friction.law == "exponential":
-        fric[lay.F_LAW] = lay.LAW_EXPONENTIAL
-        fric[lay.F_MU0] = friction.kinetic_max
-        fric[lay.F_MU1] = friction.kinetic_min
-        fric[lay.F_ALPHA] = friction.decay
+        opts[lay.O_LAW] = lay.LAW_EXPONENTIAL
+        opts[lay.O_MU0] = friction.kinetic_max
+        opts[lay.O_MU1] = friction.kinetic_min
+        opts[lay.O_ALPHA] = friction.decay
     elif friction.law == "stribeck":
-        fric[lay.F_LAW] = lay.LAW_STRIBECK
-        fric[lay.F_MU0] = friction.kinetic_max
-        fric[lay.F_MU1] = friction.kinetic_min
-        fric[lay.F_VS] = friction.stribeck_velocity
-        fric[lay.F_DELTA] = friction.stribeck_exponent
-        fric[lay.F_MUV] = friction.viscous
+        opts[lay.O_LAW] = lay.LAW_STRIBECK
+        opts[lay.O_MU0] = friction.kinetic_max
+        opts[lay.O_MU1] = friction.kinetic_min
+        opts[lay.O_VS] = friction.stribeck_velocity
+        opts[lay.O_DELTA] = friction.stribeck_exponent
+        opts[lay.O_MUV] = friction.viscous
     else:
         from scipy.interpolate import PchipInterpolator
 
         x = np.asarray(friction.speeds, dtype=float)
         v = np.asarray(friction.values, dtype=float)
         pchip = PchipInterpolator(x, v)
-        fric[lay.F_LAW] = lay.LAW_TABLE
-        tab_x = x.copy()
-        tab_c = np.zeros((x.size, 4))
+        opts[lay.O_LAW] = lay.LAW_TABLE
+        table = np.zeros((x.size, 5))
+        table[:, 0] = x
         # scipy stores the highest power first.
-        tab_c[:-1] = pchip.c[::-1].T
-        tab_c[-1, 0] = v[-1]
-    return fric, tab_x, tab_c
+        table[:-1, 1:] = pchip.c[::-1].T
+        table[-1, 1] = v[-1]
+    return table
 
 
 def build_model(case: Case, speed: SpeedProfile | None = None) -> Model:
@@ -210,51 +215,47 @@ def build_model(case: Case, speed: SpeedProfile | None = None) -> Model:
     # The printed paper flips the sign of 2 l M Omega dC/dt in the D equations only; the
     # l M dOmega/dt C term keeps its sign, so its factor undoes the flip there.
     gyro_sign = np.ones(n) if printed else sgn_a
-    omd_fix = sgn_a * gyro_sign
     cdamp = 2.0 * zeta_a * omega_a * mass_a
-    material = disc.damping_frame == "material"
+    disc_rows = np.zeros((lay.N_DISC, n))
+    disc_rows[lay.D_SGN] = sgn_a
+    disc_rows[lay.D_L] = l_a
+    disc_rows[lay.D_PARTNER] = partner
+    disc_rows[lay.D_MINV] = 1.0 / mass_a
+    disc_rows[lay.D_KD] = mass_a * omega_a**2
+    disc_rows[lay.D_ML2] = mass_a * l_a**2
+    disc_rows[lay.D_GYR] = gyro_sign * l_a * mass_a
+    disc_rows[lay.D_OMD_FIX] = sgn_a * gyro_sign
+    disc_rows[lay.D_CDAMP] = cdamp
+    if disc.damping_frame == "material":
+        disc_rows[lay.D_CDAMP_OM] = sgn_a * l_a * cdamp
     shape = np.array(cols).T.copy() if n else np.zeros((len(sliders), 0))
-    sigma = np.array([s.sigma for s in sliders])
+    slider_rows = np.zeros((lay.N_SLIDER, len(sliders)))
     slider_mass = np.array([s.mass for s in sliders])
-    fric, tab_x, tab_c = friction_arrays(case.friction)
+    for row, values in (
+        (lay.S_THETA, [s.angle for s in sliders]),
+        (lay.S_SIGMA, [s.sigma for s in sliders]),
+        (lay.S_MASS, slider_mass),
+        (lay.S_INERTIA, slider_mass * radii**2),
+        (lay.S_KZ, [s.normal_stiffness for s in sliders]),
+        (lay.S_CZ, [s.normal_damping for s in sliders]),
+        (lay.S_KPHI, [s.rotational_stiffness for s in sliders]),
+        (lay.S_CPHI, [s.rotational_damping for s in sliders]),
+        (lay.S_N0, [s.preload for s in sliders]),
+        (lay.S_RADIUS, radii),
+        (lay.S_HH, disc.thickness / (2.0 * radii)),
+    ):
+        slider_rows[row] = values
+    _sign(slider_rows)
     opts = np.zeros(lay.N_OPTS)
+    table = friction_arrays(case.friction, opts)
     opts[lay.O_OMDOT] = 1.0 if sim.omega_dot_terms else 0.0
     opts[lay.O_IMPACT] = 1.0 if sim.impact else 0.0
     opts[lay.O_LMAX] = max(ls, default=0)
     opts[lay.O_DAMPED] = 1.0 if np.any(zeta_a > 0.0) else 0.0
     opts[lay.O_MIN_FLIGHT] = sim.min_flight_time
     speed = speed if speed is not None else SpeedProfile.from_case(case.speed)
-    fields = dict(
-        l=l_a,
-        sgn=sgn_a,
-        partner=np.array(partner, dtype=np.int64),
-        minv=1.0 / mass_a,
-        kd=mass_a * omega_a**2,
-        ml2=mass_a * l_a**2,
-        gyr=gyro_sign * l_a * mass_a,
-        omd_fix=omd_fix,
-        cdamp=cdamp,
-        cdamp_om=sgn_a * l_a * cdamp if material else np.zeros(n),
-        shape=shape,
-        theta=np.array([s.angle for s in sliders]),
-        sigma=sigma,
-        mass=slider_mass,
-        inertia=slider_mass * radii**2,
-        kz=np.array([s.normal_stiffness for s in sliders]),
-        cz=np.array([s.normal_damping for s in sliders]),
-        kphi=np.array([s.rotational_stiffness for s in sliders]),
-        cphi=np.array([s.rotational_damping for s in sliders]),
-        n0=np.array([s.preload for s in sliders]),
-        radius=radii,
-        hh=disc.thickness / (2.0 * radii),
-        fric=fric,
-        ftab_x=tab_x,
-        ftab_c=tab_c,
-        knots=speed.knots,
-        coef=speed.coefficients,
-        opts=opts,
-    )
-    kern = lay.KernelModel(**fields, **_signed(fields))
+    kern = lay.KernelModel(disc=disc_rows, slider=slider_rows, shape=shape, table=table,
+                           speed=speed.pieces(), opts=opts)
 
     probes = np.asarray(sim.probes, dtype=float).reshape(-1, 2)
     return Model(

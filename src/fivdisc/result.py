@@ -69,7 +69,7 @@ def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarr
         "z_dot": _var(per, block("z_dot"), "m/s", "slider normal velocity"),
         "gap": _var(
             per,
-            model.kernel.sigma * (block("z") - w_under),
+            model.kernel.row("sigma") * (block("z") - w_under),
             "m",
             "gap between slider and disc surface (positive when apart)",
         ),

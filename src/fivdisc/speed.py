@@ -299,6 +299,11 @@ class SpeedProfile:
         k = self._locate(t)
         return _cubic_slope(np.moveaxis(self.coefficients[k], -1, 0), t - self.knots[k])
 
+    def pieces(self) -> np.ndarray:
+        """``(len(knots), 5)``: each piece's start [s] and its four coefficients, the form
+        the compiled kernels read."""
+        return np.column_stack([self.knots, self.coefficients])
+
     def is_constant(self) -> bool:
         """Whether Omega never changes."""
         coef = self.coefficients

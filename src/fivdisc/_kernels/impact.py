@@ -19,19 +19,26 @@ import numpy as np
 from numba import njit
 
 from fivdisc._kernels.dynamics import solve_small
-from fivdisc._kernels.layout import E_IMPACT, E_SURFACE, n_dynamic, sizes
+from fivdisc._kernels.layout import (
+    D_MINV,
+    E_IMPACT,
+    E_SURFACE,
+    S_MASS,
+    S_SIGMA,
+    n_dynamic,
+    sizes,
+)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def contact_velocity(j, y, mdl, wk):
-    """Normal velocity of the disc's surface under slider j [m/s]; rows j of g, g' in
-    ``wk`` must hold the mode shapes at ``y``."""
-    g, gp = wk[0], wk[1]
-    n, _, half = sizes(mdl)
+    """Normal velocity of the disc's surface under slider j [m/s]; the work array ``wk``
+    must hold the mode shapes at ``y`` (rows j and S + j)."""
+    n, ns, half = sizes(mdl)
     phid = y[half + n + j]
     acc = 0.0
     for i in range(n):
-        acc += g[j, i] * y[half + i] + phid * gp[j, i] * y[i]
+        acc += wk[j, i] * y[half + i] + phid * wk[ns + j, i] * y[i]
     return acc
 
 
@@ -41,11 +48,11 @@ def _kinetic(y, mdl, members, count):
     n, ns, half = sizes(mdl)
     acc = 0.0
     for i in range(n):
-        acc += 0.5 * y[half + i] * y[half + i] / mdl.minv[i]
+        acc += 0.5 * y[half + i] * y[half + i] / mdl.disc[D_MINV, i]
     for a in range(count):
         j = members[a]
         zd = y[half + n + ns + j]
-        acc += 0.5 * mdl.mass[j] * zd * zd
+        acc += 0.5 * mdl.slider[S_MASS, j] * zd * zd
     return acc
 
 
@@ -63,11 +70,11 @@ def _book(y, mdl, before, u_minus, members, count):
     loss = 0.0
     for i in range(n):
         du = y[half + i] - u_minus[half + i]
-        loss += 0.5 * du * du / mdl.minv[i]
+        loss += 0.5 * du * du / mdl.disc[D_MINV, i]
     for a in range(count):
         j = members[a]
         du = y[half + n + ns + j] - u_minus[half + n + ns + j]
-        loss += 0.5 * mdl.mass[j] * du * du
+        loss += 0.5 * mdl.slider[S_MASS, j] * du * du
     change = _kinetic(y, mdl, members, count) - before
     y[e0 + E_IMPACT] -= loss
     y[e0 + E_SURFACE] += change + loss
@@ -76,23 +83,23 @@ def _book(y, mdl, before, u_minus, members, count):
 @njit(cache=True)
 def single_impact(j, y, mdl, wk):
     """Plastic impact of slider j alone (paper Eqs. 47-56): slider and disc leave with one
-    normal velocity. Rows j of g, g' in ``wk`` must hold the mode shapes at ``y``."""
-    g, gp = wk[0], wk[1]
+    normal velocity. The work array ``wk`` must hold the mode shapes at ``y``."""
     n, ns, half = sizes(mdl)
+    minv = mdl.disc[D_MINV]
     members = np.array([j])
     u_minus = y.copy()
     before = _kinetic(y, mdl, members, 1)
-    m = mdl.mass[j]
+    m = mdl.slider[S_MASS, j]
     zd_minus = y[half + n + ns + j]
     phid = y[half + n + j]
     ratio = 0.0
     disc = 0.0
     for i in range(n):
-        ratio += m * g[j, i] * g[j, i] * mdl.minv[i]
-        disc += g[j, i] * y[half + i] + phid * gp[j, i] * y[i]
+        ratio += m * wk[j, i] * wk[j, i] * minv[i]
+        disc += wk[j, i] * y[half + i] + phid * wk[ns + j, i] * y[i]
     zd_plus = (disc + ratio * zd_minus) / (1.0 + ratio)
     for i in range(n):
-        y[half + i] -= m * g[j, i] * mdl.minv[i] * (zd_plus - zd_minus)
+        y[half + i] -= m * wk[j, i] * minv[i] * (zd_plus - zd_minus)
     y[half + n + ns + j] = zd_plus
     _book(y, mdl, before, u_minus, members, 1)
 
@@ -166,13 +173,16 @@ def solve_lcp(dmat, gam, forced, lam, m):
 def contact_impact(members, count, y, mdl, wk, forced, w_out):
     """Plastic impact on the contacts ``members[:count]`` (the landing slider and those
     in contact), by the complementarity problem. Rows of g, g' in ``wk`` must hold the
-    mode shapes at ``y``; the contacts' ``zdot`` must hold their contact velocities.
+    mode shapes at ``y`` (work array ``wk``); the contacts' ``zdot`` must hold their contact
+    velocities.
 
     ``forced`` marks contacts that must stay closed. On return ``w_out[a]`` is the gap
     velocity of member a after the impact (> 0: it leaves the disc).
     """
-    g = wk[0]
     n, ns, half = sizes(mdl)
+    minv = mdl.disc[D_MINV]
+    sigma = mdl.slider[S_SIGMA]
+    mass = mdl.slider[S_MASS]
     u_minus = y.copy()
     before = _kinetic(y, mdl, members, count)
     dmat = np.zeros((count, count))
@@ -184,17 +194,17 @@ def contact_impact(members, count, y, mdl, wk, forced, w_out):
             jb = members[b]
             acc = 0.0
             for i in range(n):
-                acc += g[ja, i] * g[jb, i] * mdl.minv[i]
+                acc += wk[ja, i] * wk[jb, i] * minv[i]
             if ja == jb:
-                acc += 1.0 / mdl.mass[ja]
-            dmat[a, b] = mdl.sigma[ja] * mdl.sigma[jb] * acc
-        gam[a] = mdl.sigma[ja] * (y[half + n + ns + ja] - contact_velocity(ja, y, mdl, wk))
+                acc += 1.0 / mass[ja]
+            dmat[a, b] = sigma[ja] * sigma[jb] * acc
+        gam[a] = sigma[ja] * (y[half + n + ns + ja] - contact_velocity(ja, y, mdl, wk))
     w = solve_lcp(dmat, gam, forced, lam, count)
     for a in range(count):
         ja = members[a]
-        sl = lam[a] * mdl.sigma[ja]
+        sl = lam[a] * sigma[ja]
         for i in range(n):
-            y[half + i] -= sl * g[ja, i] * mdl.minv[i]
-        y[half + n + ns + ja] += sl / mdl.mass[ja]
+            y[half + i] -= sl * wk[ja, i] * minv[i]
+        y[half + n + ns + ja] += sl / mass[ja]
         w_out[a] = w[a]
     _book(y, mdl, before, u_minus, members, count)

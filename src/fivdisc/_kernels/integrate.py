@@ -34,14 +34,19 @@ from fivdisc._kernels.layout import (
     EV_SEPARATION,
     EV_SLIP,
     EV_STICK,
-    F_MUS,
     O_IMPACT,
     O_MIN_FLIGHT,
+    O_MUS,
+    S_KZ,
+    S_MASS,
+    S_N0,
+    S_SIGMA,
     SEPARATION,
     SLIP,
     STICK,
     n_dynamic,
     sizes,
+    work_rows,
 )
 
 # Status codes (``ist[I_STATUS]``).
@@ -101,10 +106,16 @@ N_EVI = 4
 
 
 @njit(cache=True)
+def _aux(mdl, wk):
+    """The per-slider block of the work array: row ``A_*``, column j."""
+    return wk[work_rows(mdl.slider.shape[1])[3]:]
+
+
+@njit(cache=True)
 def _separate(j, y, ph, mdl, wk):
     """Slider j leaves the disc: its own z, zdot start from the contact kinematics that
     the last ``evaluate`` left in ``wk``."""
-    aux = wk[5]
+    aux = _aux(mdl, wk)
     n, ns, half = sizes(mdl)
     y[n + ns + j] = aux[A_WC, j]
     y[half + n + ns + j] = aux[A_WCD, j]
@@ -115,9 +126,9 @@ def _separate(j, y, ph, mdl, wk):
 def choose_phase(j, t, y, ph, sg, mdl, wk, dy):
     """Phase of slider j in contact at state ``y``, the others' phases held: stick, slip
     (with its sign) or, where contact would need a pulling normal force, separation."""
-    aux = wk[5]
+    aux = _aux(mdl, wk)
     n, _, half = sizes(mdl)
-    om, _ = speed_at(t, mdl.knots, mdl.coef, True)
+    om, _ = speed_at(t, mdl.speed, True)
     v = om - y[half + n + j]
     s = sg[j]
     if v == 0.0:
@@ -125,7 +136,7 @@ def choose_phase(j, t, y, ph, sg, mdl, wk, dy):
         evaluate(t, y, ph, sg, True, mdl, wk, dy)
         nf = aux[A_N, j]
         f = aux[A_F, j]
-        if nf > 0.0 and abs(f) < mdl.fric[F_MUS] * nf:
+        if nf > 0.0 and abs(f) < mdl.opts[O_MUS] * nf:
             return
         if f > 0.0:
             s = 1
@@ -176,11 +187,11 @@ def settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist):
     """After a switch, re-check every slider in contact (several sliders only): one that
     would need N < 0 separates, a sticking one beyond the static limit slips; violators
     switch one at a time, lowest index first, until none is left."""
-    aux = wk[5]
+    aux = _aux(mdl, wk)
     n, ns, half = sizes(mdl)
     if ns == 1:
         return
-    om, _ = speed_at(t, mdl.knots, mdl.coef, True)
+    om, _ = speed_at(t, mdl.speed, True)
     for _ in range(4 * ns + 4):
         evaluate(t, y, ph, sg, True, mdl, wk, dy)
         changed = False
@@ -197,7 +208,7 @@ def settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist):
                 _record(t, EV_SEPARATION, old, SEPARATION, k, ev_t, ev_i, ist)
                 changed = True
                 break
-            if ph[k] == STICK and abs(f) > mdl.fric[F_MUS] * nf:
+            if ph[k] == STICK and abs(f) > mdl.opts[O_MUS] * nf:
                 ph[k] = SLIP
                 sg[k] = 1 if f > 0.0 else -1
                 _record(t, EV_SLIP, STICK, SLIP, k, ev_t, ev_i, ist)
@@ -211,8 +222,8 @@ def settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist):
 def _surface_acceleration(k, y, mdl, wk, dy):
     """Normal acceleration of the disc's surface under slider k, from ``evaluate``'s
     derivatives ``dy`` at ``y`` [m/s^2]."""
-    g = wk[0]
-    aux = wk[5]
+    g = wk
+    aux = _aux(mdl, wk)
     n, _, half = sizes(mdl)
     phid = aux[A_PHID, k]
     acc = 2.0 * phid * aux[A_GPQD, k] - phid * phid * aux[A_L2GQ, k]
@@ -243,7 +254,7 @@ def _impact(j, t, y, ph, sg, mdl, wk, dy, fst, released):
     if count == 1:
         single_impact(j, y, mdl, wk)
         return 0
-    aux = wk[5]
+    aux = _aux(mdl, wk)
     for a in range(1, count):
         k = members[a]
         y[half + n + ns + k] = contact_velocity(k, y, mdl, wk)
@@ -278,14 +289,15 @@ def _impact(j, t, y, ph, sg, mdl, wk, dy, fst, released):
             if w[a] <= 0.0:
                 continue
             k = members[a]
-            gdd = mdl.sigma[k] * (dy[half + n + ns + k] - _surface_acceleration(k, y, mdl, wk, dy))
+            gdd = mdl.slider[S_SIGMA, k] * (dy[half + n + ns + k]
+                                             - _surface_acceleration(k, y, mdl, wk, dy))
             if gdd >= 0.0:
                 continue
             flight = 2.0 * w[a] / -gdd
             peak = 0.5 * w[a] * w[a] / -gdd
             # Round-off of z: its size, or the preload's compression of the slider's
             # spring where z itself is small.
-            zscale = max(abs(aux[A_WC, k]), abs(mdl.n0[k] / mdl.kz[k]))
+            zscale = max(abs(aux[A_WC, k]), abs(mdl.slider[S_N0, k] / mdl.slider[S_KZ, k]))
             if flight < min_flight or peak < 8.0 * 2.220446049250313e-16 * zscale:
                 forced[a] = True
                 again = True
@@ -302,7 +314,7 @@ def _impact(j, t, y, ph, sg, mdl, wk, dy, fst, released):
 @njit(cache=True)
 def apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst):
     """Carry the state across the switch triggered by event ``e`` (slider e // 3)."""
-    aux = wk[5]
+    aux = _aux(mdl, wk)
     n, ns, half = sizes(mdl)
     j = e // 3
     which = e % 3
@@ -320,7 +332,8 @@ def apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst):
             y[half + n + ns + j] = zd_new
             e0 = n_dynamic(mdl)
             if y.shape[0] > e0:
-                y[e0 + E_IMPACT] += 0.5 * mdl.mass[j] * (zd_new * zd_new - zd_old * zd_old)
+                y[e0 + E_IMPACT] += 0.5 * mdl.slider[S_MASS, j] * (zd_new * zd_new
+                                                                   - zd_old * zd_old)
         # Contacts the impact released fly from where they are.
         before = ph.copy()
         landing_leaves = False
@@ -350,7 +363,7 @@ def apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst):
         evaluate(t, y, ph, sg, True, mdl, wk, dy)
         old = ph[j]
         if old == STICK:
-            om, _ = speed_at(t, mdl.knots, mdl.coef, True)
+            om, _ = speed_at(t, mdl.speed, True)
             y[half + n + j] = om
         _separate(j, y, ph, mdl, wk)
         _record(t, EV_SEPARATION, old, SEPARATION, j, ev_t, ev_i, ist)
@@ -358,7 +371,7 @@ def apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst):
         return
     # Relative velocity reached zero (slip) or the static limit was reached (stick):
     # the slider moves with the disc at this instant; decide from the forces.
-    om, _ = speed_at(t, mdl.knots, mdl.coef, True)
+    om, _ = speed_at(t, mdl.speed, True)
     y[half + n + j] = om
     old = ph[j]
     old_s = sg[j]
@@ -465,10 +478,10 @@ def _write_outputs(t0, t1, h, rc, ph, sg, mdl, wk, dy, ytmp, ctl, out_y, out_aux
 def _write_sample(i, ti, ys, ph, sg, mdl, wk, dy, out_y, out_aux):
     """One output row: the state with the contact kinematics filled in, and per slider
     N, f, phase, w under it (columns j, S + j, 2 S + j, 3 S + j), then Omega."""
-    aux = wk[5]
+    aux = _aux(mdl, wk)
     n, ns, half = sizes(mdl)
     evaluate(ti, ys, ph, sg, False, mdl, wk, dy)
-    om, _ = speed_at(ti, mdl.knots, mdl.coef, False)
+    om, _ = speed_at(ti, mdl.speed, False)
     for j in range(ns):
         if ph[j] == STICK:
             ys[half + n + j] = om
@@ -739,7 +752,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
         h = hs * fac
         if land and t < t_final:
             # Speed-profile kink: Omegadot jumps, so the stick reaction does too.
-            om, _ = speed_at(t, mdl.knots, mdl.coef, True)
+            om, _ = speed_at(t, mdl.speed, True)
             for j in range(n_sl):
                 if ph[j] == SEPARATION:
                     continue

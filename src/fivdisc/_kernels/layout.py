@@ -12,6 +12,11 @@ held). ``E`` are the optional energy accumulators (``K = N_ENERGY`` or 0): integ
 the power of each kind of force, carried along but kept out of the error norm and the
 events, so they never change the step sequence. For one slider the layout is the
 paper's ``[q, phi, z, qdot, phidot, zdot]``.
+
+The model is a tuple of a few two-dimensional arrays whose rows are named below, rather
+than one array per quantity: numba passes every array of a tuple argument as a separate
+structure on each call, and with one array per quantity the calls of the right-hand side
+cost more than its arithmetic.
 """
 
 from __future__ import annotations
@@ -32,29 +37,67 @@ EV_REVERSAL = 2
 EV_SEPARATION = 3
 EV_RECONTACT = 4
 
-# Friction laws (KernelModel.fric[F_LAW]).
+# Rows of KernelModel.disc (one column per modal coordinate).
+D_SGN = 0  # +1 for a cosine (C) coordinate, -1 for a sine (D) coordinate
+D_L = 1  # nodal diameters l
+D_PARTNER = 2  # index of the other member of a doublet, -1 for l = 0
+D_MINV = 3  # 1 / M
+D_KD = 4  # M omega^2
+D_ML2 = 5  # M l^2
+D_GYR = 6  # the 2 Omega gyroscopic factor, sgn l M (or the printed paper's sign)
+D_OMD_FIX = 7  # turns D_GYR into the dOmega/dt term's factor (1, or -1 for D when printed)
+D_CDAMP = 8  # 2 zeta omega M
+D_CDAMP_OM = 9  # its material-frame Omega q_partner coefficient, sgn l cdamp (0: space)
+N_DISC = 10
+
+# Rows of KernelModel.slider (one column per slider); "signed" rows are sigma times
+# the plain value.
+S_THETA = 0  # base angle [rad]
+S_SIGMA = 1  # face, +1 top, -1 bottom
+S_MASS = 2
+S_INERTIA = 3  # m r^2
+S_KZ = 4
+S_CZ = 5
+S_KPHI = 6  # r^2 k_phi
+S_CPHI = 7  # r^2 c_phi
+S_N0 = 8
+S_RADIUS = 9
+S_HH = 10  # h / (2 r)
+S_SMASS = 11
+S_SKZ = 12
+S_SCZ = 13
+S_SN0 = 14
+S_SHH = 15
+N_SLIDER = 16
+SLIDER_ROWS = {"theta": S_THETA, "sigma": S_SIGMA, "mass": S_MASS, "inertia": S_INERTIA,
+               "kz": S_KZ, "cz": S_CZ, "kphi": S_KPHI, "cphi": S_CPHI, "n0": S_N0,
+               "radius": S_RADIUS, "hh": S_HH}
+SIGNED_ROWS = ((S_SMASS, S_MASS), (S_SKZ, S_KZ), (S_SCZ, S_CZ), (S_SN0, S_N0),
+               (S_SHH, S_HH))
+
+# Friction laws (KernelModel.opts[O_LAW]).
 LAW_EXPONENTIAL = 0
 LAW_STRIBECK = 1
 LAW_TABLE = 2
 
-# KernelModel.fric slots.
-F_LAW = 0
-F_MUS = 1
-F_MU0 = 2
-F_MU1 = 3
-F_ALPHA = 4
-F_VS = 5
-F_DELTA = 6
-F_MUV = 7
-N_FRIC = 8
-
 # KernelModel.opts slots.
-O_OMDOT = 0
-O_IMPACT = 1
-O_LMAX = 2
-O_DAMPED = 3
-O_MIN_FLIGHT = 4
-N_OPTS = 5
+O_LAW = 0
+O_MUS = 1
+O_MU0 = 2
+O_MU1 = 3
+O_ALPHA = 4
+O_VS = 5
+O_DELTA = 6
+O_MUV = 7
+O_OMDOT = 8  # 1 keeps the dOmega/dt terms
+O_IMPACT = 9  # 1 applies the plastic impact at re-contact
+O_LMAX = 10  # largest l
+O_DAMPED = 11  # 1 if any modal damping
+O_MIN_FLIGHT = 12  # shortest flight resolved [s]
+N_OPTS = 13
+FRICTION_SLOTS = {"static": O_MUS, "kinetic_max": O_MU0, "kinetic_min": O_MU1,
+                  "decay": O_ALPHA, "stribeck_velocity": O_VS, "stribeck_exponent": O_DELTA,
+                  "viscous": O_MUV}
 
 # Energy accumulators: integrated power [W] of each kind of force, and impact jumps [J].
 E_FRICTION = 0  # friction at the contacts, f r (phidot - Omega): dissipation while slipping
@@ -69,7 +112,7 @@ N_ENERGY = 8
 ENERGY_NAMES = ("friction", "drive", "friction_moment", "normal_slope", "slider_damping",
                 "disc_damping", "impact_loss", "impact_surface")
 
-# Rows of the per-slider scratch ``aux`` (filled by ``evaluate``).
+# Per-slider rows of the work array's auxiliary block (filled by ``evaluate``).
 A_N = 0  # normal force [N]
 A_F = 1  # friction force on the slider, positive along +phi [N]
 A_WC = 2  # the disc's w under the slider [m]
@@ -91,69 +134,49 @@ N_AUX = 15
 class KernelModel(NamedTuple):
     """Arrays the kernels read, built by :func:`fivdisc.model.build_model`.
 
-    Per modal coordinate ``i`` (length n): ``l`` nodal diameters, ``sgn`` +1 for a cosine
-    (C) and -1 for a sine (D) coordinate, ``partner`` the other member of a doublet (-1
-    for l = 0), ``minv = 1/M``, ``kd = M omega^2``, ``ml2 = M l^2``, ``gyr`` the
-    gyroscopic factor ``sgn l M`` of the ``2 Omega`` term, ``omd_fix`` the factor that
-    turns ``gyr`` into the ``dOmega/dt`` term's (1, or -1 for D with the printed sign),
-    ``cdamp = 2 zeta omega M`` and ``cdamp_om`` its material-frame ``Omega q_partner``
-    coefficient (``sgn l cdamp``; 0 in the space frame).
-
-    Per slider ``j`` (length S): ``shape[j]`` the mode shapes at its track radius, base
-    angle ``theta``, face ``sigma`` (+1 top, -1 bottom), ``mass``, ``inertia = m r^2``,
-    ``kz``, ``cz``, ``kphi`` (``r^2 k_phi``), ``cphi``, ``n0``, ``radius``,
-    ``hh = h / (2 r)``, and the face-signed products ``smass``, ``skz``, ``scz``,
-    ``sn0``, ``shh`` (sigma times the plain value).
-
-    ``fric`` holds the friction law (``F_*`` slots), ``ftab_x``/``ftab_c`` the pieces of
-    a tabulated law, ``knots``/``coef`` the piecewise-cubic speed profile and ``opts``
-    the switches (``O_*`` slots).
+    ``disc`` is ``(N_DISC, n)`` with rows ``D_*``; ``slider`` is ``(N_SLIDER, S)`` with
+    rows ``S_*``; ``shape[j]`` the mode shapes at slider j's track radius; ``table`` the
+    pieces of a tabulated friction law (start, then cubic coefficients in powers of the
+    distance from it; a constant last piece); ``speed`` the pieces of the speed profile
+    (knot, cubic coefficients); ``opts`` the friction law and the switches (``O_*``).
     """
 
-    l: np.ndarray
-    sgn: np.ndarray
-    partner: np.ndarray
-    minv: np.ndarray
-    kd: np.ndarray
-    ml2: np.ndarray
-    gyr: np.ndarray
-    omd_fix: np.ndarray
-    cdamp: np.ndarray
-    cdamp_om: np.ndarray
+    disc: np.ndarray
+    slider: np.ndarray
     shape: np.ndarray
-    theta: np.ndarray
-    sigma: np.ndarray
-    mass: np.ndarray
-    inertia: np.ndarray
-    kz: np.ndarray
-    cz: np.ndarray
-    kphi: np.ndarray
-    cphi: np.ndarray
-    n0: np.ndarray
-    radius: np.ndarray
-    hh: np.ndarray
-    smass: np.ndarray
-    skz: np.ndarray
-    scz: np.ndarray
-    sn0: np.ndarray
-    shh: np.ndarray
-    fric: np.ndarray
-    ftab_x: np.ndarray
-    ftab_c: np.ndarray
-    knots: np.ndarray
-    coef: np.ndarray
+    table: np.ndarray
+    speed: np.ndarray
     opts: np.ndarray
 
+    def row(self, name: str) -> np.ndarray:
+        """A per-slider quantity by name (``"inertia"``, ``"kz"``, ... of
+        ``SLIDER_ROWS``), one value per slider."""
+        return self.slider[SLIDER_ROWS[name]]
 
-@njit(cache=True, inline="always")
+
+@njit(cache=True)
+def work_rows(n_sliders):
+    """Row offsets of the work array: g' (rows ``gp + j``; g is rows ``j``), the disc
+    forces, cos(l psi_j) (rows ``trig + j``; sin at ``trig + S + j``), the auxiliary
+    block (rows ``aux + A_*``, column j) and the normal forces' system (rows
+    ``system + a``, its right-hand side in column S)."""
+    gp = n_sliders
+    fq = 2 * n_sliders
+    trig = fq + 1
+    aux = trig + 2 * n_sliders
+    system = aux + N_AUX
+    return gp, fq, trig, aux, system
+
+
+@njit(cache=True)
 def sizes(mdl):
     """``(n, S, half)``: modal coordinates, sliders, and the offset of the velocities."""
-    n = mdl.l.shape[0]
-    s = mdl.theta.shape[0]
+    n = mdl.disc.shape[1]
+    s = mdl.slider.shape[1]
     return n, s, n + 2 * s
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def n_dynamic(mdl):
     """Length of the state without the energy accumulators, ``2 (n + 2 S)``."""
-    return 2 * (mdl.l.shape[0] + 2 * mdl.theta.shape[0])
+    return 2 * (mdl.disc.shape[1] + 2 * mdl.slider.shape[1])

@@ -46,11 +46,11 @@ def stored_energy(ds: xr.Dataset, model) -> np.ndarray:
     )
     z = ds["z"].values
     sliders = np.sum(
-        0.5 * kern.inertia * ds["phi_dot"].values ** 2
-        + 0.5 * kern.kphi * ds["phi"].values ** 2
-        + 0.5 * kern.mass * ds["z_dot"].values ** 2
-        + 0.5 * kern.kz * z**2
-        + kern.sn0 * z,
+        0.5 * kern.row("inertia") * ds["phi_dot"].values ** 2
+        + 0.5 * kern.row("kphi") * ds["phi"].values ** 2
+        + 0.5 * kern.row("mass") * ds["z_dot"].values ** 2
+        + 0.5 * kern.row("kz") * z**2
+        + kern.row("sigma") * kern.row("n0") * z,
         axis=1,
     )
     return disc + sliders

@@ -53,7 +53,8 @@ def _evaluate(model: Model, y: np.ndarray) -> tuple[np.ndarray, tuple]:
     wk = dyn.new_work(mdl, y)
     dy = np.empty(model.state_size)
     dyn.evaluate(0.0, y, ph, sg, True, mdl, wk, dy)
-    return dy, wk
+    aux = lay.work_rows(model.n_sliders)[3]
+    return dy, wk[aux : aux + lay.N_AUX, : model.n_sliders]
 
 
 def _unknowns(model: Model) -> np.ndarray:
@@ -106,17 +107,19 @@ def sliding_equilibrium(
     kern = model.kernel_args
     unknowns = _unknowns(model)
     acc_index = unknowns + n + 2 * ns
-    inertias = np.append(model.modal_mass, kern.inertia)
+    radius, n0 = kern.row("radius"), kern.row("n0")
+    inertias = np.append(model.modal_mass, kern.row("inertia"))
     # Rigid-disc guess: N = N0, friction balanced by the in-plane spring; the disc
     # deflected statically by the preloads.
-    mu = np.array([dyn.kinetic_friction(kern, kern.radius[j], 1, omega_c) for j in range(ns)])
-    phi0 = kern.radius * mu * kern.n0 / kern.kphi
+    mu = np.array([dyn.kinetic_friction(kern.opts, kern.table, radius[j], 1, omega_c)
+                   for j in range(ns)])
+    phi0 = radius * mu * n0 / kern.row("kphi")
     stiff = model.modal_mass * (model.omega**2 - model.l**2 * omega_c**2)
     q0 = np.zeros(n)
     for j in range(ns):
-        psi = kern.theta[j] + phi0[j]
+        psi = kern.row("theta")[j] + phi0[j]
         g = np.where(model.sgn > 0, np.cos(model.l * psi), np.sin(model.l * psi)) * model.shape[j]
-        q0 -= kern.sn0[j] * g / stiff
+        q0 -= kern.slider[lay.S_SN0, j] * g / stiff
     x0 = np.append(q0, phi0)
     if guess is not None and guess.q.size == n and np.size(guess.phi) == ns:
         x0 = np.append(guess.q, guess.phi)
@@ -138,14 +141,13 @@ def sliding_equilibrium(
     sol = root(residual, x0, jac=jacobian, method="hybr", options={"xtol": xtol})
     # hybr may report "no progress" once it sits at round-off: judge by the residual, in
     # generalised forces [N], against the preload.
-    scale = float(np.max(kern.n0)) + 1.0
+    scale = float(np.max(n0)) + 1.0
     if not np.max(np.abs(sol.fun)) <= 1e-9 * scale:
         raise SimulationError(
             f"no sliding equilibrium found at Omega = {omega_c} rad/s ({sol.message.strip()})"
         )
     y = state(sol.x)
-    _, wk = _evaluate(model, y)
-    aux = wk[5]
+    _, aux = _evaluate(model, y)
     nf = aux[lay.A_N].copy()
     if np.any(nf <= 0.0):
         j = int(np.argmin(nf))

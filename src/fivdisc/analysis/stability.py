@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
@@ -21,24 +21,16 @@ from fivdisc.speed import SpeedProfile
 # Bytes per grid point of a stability map: growth rate and stability flag, and the
 # dataset's and the netCDF writer's copies of them.
 _GRID_BYTES = 3 * (8 + 1)
-# Per-slider case keys that enter the model only through a kernel array, and friction
-# keys that enter only through its friction slots: a map over them patches those arrays
-# instead of rebuilding the model (and the plate modes) per point.
+# Per-slider case keys that enter the model only through a row of the kernel's slider
+# array, and friction keys that enter only through its options (layout.FRICTION_SLOTS):
+# a map over them patches those values instead of rebuilding the model (and the plate
+# modes) per point.
 _SLIDER_ARRAYS = {
     "normal_damping": "cz",
     "rotational_damping": "cphi",
     "normal_stiffness": "kz",
     "rotational_stiffness": "kphi",
     "preload": "n0",
-}
-_FRICTION_SLOTS = {
-    "static": lay.F_MUS,
-    "kinetic_max": lay.F_MU0,
-    "kinetic_min": lay.F_MU1,
-    "decay": lay.F_ALPHA,
-    "stribeck_velocity": lay.F_VS,
-    "stribeck_exponent": lay.F_DELTA,
-    "viscous": lay.F_MUV,
 }
 
 
@@ -169,7 +161,7 @@ def linear_stability(case: Case | Model) -> LinearStability:
     lam = lam[order]
     vec = vec[:, order]
     size = model.n + model.n_sliders
-    inertia = np.append(model.modal_mass, model.kernel.inertia)
+    inertia = np.append(model.modal_mass, model.kernel.row("inertia"))
     # Velocity part of an eigenvector is lambda times its displacement part.
     energy = inertia[:, None] * np.abs(vec[size:, :]) ** 2
     names = (*model.labels, *_angle_names(model))
@@ -227,8 +219,8 @@ def perturbation_test(case: Case, duration: float | None = None) -> Perturbation
     kern = model.kernel
     energy = (
         np.sum(model.modal_mass * (ds["q_dot"].values ** 2 + model.omega**2 * dq**2), axis=1)
-        + np.sum(kern.inertia * ds["phi_dot"].values ** 2, axis=1)
-        + np.sum(kern.kphi * (ds["phi"].values - eq.phi) ** 2, axis=1)
+        + np.sum(kern.row("inertia") * ds["phi_dot"].values ** 2, axis=1)
+        + np.sum(kern.row("kphi") * (ds["phi"].values - eq.phi) ** 2, axis=1)
     )
     amplitude = np.sqrt(energy)
     span = max(1, amplitude.size // 10)
@@ -250,8 +242,10 @@ def _axis(spec, name: str) -> tuple[str, np.ndarray]:
 def _equilibrium_key(model: Model) -> tuple:
     # The sliders' dampers do not enter the equilibrium: maps over c_z, c_phi reuse one
     # solve.
-    kern = model.kernel_args._replace(cz=None, scz=None, cphi=None)
-    return tuple(a.tobytes() if isinstance(a, np.ndarray) else a for a in kern)
+    slider = model.kernel_args.slider.copy()
+    slider[[lay.S_CZ, lay.S_SCZ, lay.S_CPHI]] = 0.0
+    kern = model.kernel_args._replace(slider=slider)
+    return tuple(a.tobytes() for a in kern)
 
 
 def _point_model(base: Model, case: Case, updates: dict[str, float]) -> Model:
@@ -264,13 +258,11 @@ def _point_model(base: Model, case: Case, updates: dict[str, float]) -> Model:
         elif parts[0] in ("slider", "sliders") and parts[-1] in _SLIDER_ARRAYS:
             j = 0 if parts[0] == "slider" else int(parts[1])
             name = _SLIDER_ARRAYS[parts[-1]]
-            array = getattr(model.kernel, name).copy()
-            array[j] = value
-            model = model.with_sliders(**{name: array})
-        elif parts[0] == "friction" and parts[-1] in _FRICTION_SLOTS:
-            fric = model.kernel.fric.copy()
-            fric[_FRICTION_SLOTS[parts[-1]]] = value
-            model = replace(model, kernel=model.kernel._replace(fric=fric))
+            values = model.kernel.row(name).copy()
+            values[j] = value
+            model = model.with_sliders(**{name: values})
+        elif parts[0] == "friction" and parts[-1] in lay.FRICTION_SLOTS:
+            model = model.with_friction(**{parts[-1]: value})
         else:
             return build_model(case.replace(updates))
     return model
