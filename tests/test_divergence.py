@@ -1,0 +1,46 @@
+"""Runs that leave the range of linear plate theory end as diverged, never as success."""
+
+from __future__ import annotations
+
+import numpy as np
+from click.testing import CliRunner
+
+from fivdisc.case import Case
+from fivdisc.cli import cli
+from fivdisc.simulate import Deflection, simulate
+
+
+def test_absurd_preload_diverges():
+    """1e6 N on a 2 mm disc deflects it by metres in milliseconds."""
+    res = simulate(Case(slider={"preload": 1e6}, simulation={"duration": 0.2}))
+    assert res.status == "diverged" and not res.ok
+    assert "disc.thickness" in res.message
+    # The data up to the divergence are kept; the run stopped soon after the limit.
+    w = np.abs(res.dataset["w"].values)
+    assert res.dataset.attrs["end_time"] < 0.2
+    assert np.max(w) > Deflection.DIVERGED * 0.002
+
+
+def test_printed_sign_blow_up_diverges():
+    """The printed (non-skew) gyroscopic sign acts as negative damping growing with the
+    speed: at 200 rad/s the state grows without bound."""
+    case = Case(speed={"value": 200.0},
+                simulation={"duration": 1.0, "printed_gyroscopic_sign": True})
+    res = simulate(case)
+    assert res.status == "diverged"
+
+
+def test_paper_case_stays_within_the_limit():
+    """The paper's Table 1 case deflects the disc by about two thicknesses: no verdict."""
+    res = simulate(Case(simulation={"duration": 0.3}))
+    assert res.status == "success"
+    assert 0.002 < np.max(np.abs(res.dataset["w"].values)) < Deflection.DIVERGED * 0.002
+
+
+def test_cli_reports_divergence_in_one_line(tmp_path):
+    case = tmp_path / "big.toml"
+    case.write_text("[slider]\npreload = 1e6\n[simulation]\nduration = 0.05\n")
+    out = CliRunner().invoke(cli, ["simulate", str(case), "-o", str(tmp_path / "big.nc"),
+                                  "--no-progress"])
+    assert out.exit_code == 1
+    assert "diverged" in out.stderr and out.stderr.count("\n") == 1
