@@ -15,7 +15,7 @@ import time
 import numpy as np
 from numba import njit
 
-from fivdisc._kernels.dopri5 import A, C, E
+from fivdisc._kernels.dopri5 import A, E
 from fivdisc._kernels.dynamics import complex_step_jacobian
 
 _BETA = 0.04
