@@ -265,7 +265,8 @@ def _impact(j, t, y, ph, sg, mdl, wk, dy, fst, released):
     min_flight = mdl.opts[O_MIN_FLIGHT]
     nrel = 0
     for _ in range(count + 1):
-        y[:] = y_pre
+        for i in range(y.shape[0]):
+            y[i] = y_pre[i]
         contact_impact(members[:count], count, y, mdl, wk, forced, w)
         nrel = 0
         for a in range(count):
@@ -492,7 +493,8 @@ def _write_sample(i, ti, ys, ph, sg, mdl, wk, dy, out_y, out_aux):
         out_aux[i, ns + j] = aux[A_F, j]
         out_aux[i, 2 * ns + j] = ph[j]
         out_aux[i, 3 * ns + j] = aux[A_WC, j]
-    out_y[i, :] = ys
+    for c in range(ys.shape[0]):
+        out_y[i, c] = ys[c]
     out_aux[i, 4 * ns] = om
 
 
@@ -549,6 +551,46 @@ def start(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist):
     settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
 
 
+# What _switch does.
+MODE_START = 0
+MODE_EVENT = 1
+MODE_KINK = 2
+
+
+@njit(cache=True)
+def _switch(mode, e, t, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k, ev_prev, ev_t, ev_i,
+            ist, fst):
+    """Every change of phase, in one function: the start (``MODE_START``), the switch of
+    event ``e`` with the switches at the same instant (``MODE_EVENT``; ``ph_start`` and
+    ``ev_start`` are the phases and event values at the start of the step), or a kink of
+    the speed profile (``MODE_KINK``). The right-hand side is compiled into this one
+    function only, not into each helper."""
+    n, n_sl, half = sizes(mdl)
+    if mode == MODE_START:
+        start(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
+        return
+    if mode == MODE_EVENT:
+        apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst)
+        if n_sl > 1:
+            _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
+            ist[I_RHS] += 1
+            _simultaneous(e, t, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k, ev_prev,
+                          ev_t, ev_i, ist, fst)
+        return
+    # Speed-profile kink: Omegadot jumps, so the stick reaction does too.
+    om, _ = speed_at(t, mdl.speed, True)
+    for j in range(n_sl):
+        if ph[j] == SEPARATION:
+            continue
+        old = ph[j]
+        old_s = sg[j]
+        if old == STICK:
+            y[half + n + j] = om
+        choose_phase(j, t, y, ph, sg, mdl, wk, dy)
+        _record_change(t, old, old_s, ph[j], sg[j], j, ev_t, ev_i, ist)
+    settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
+
+
 @njit(cache=True)
 def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_aux, ev_t,
         ev_i):
@@ -559,7 +601,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
     nd = n_dynamic(mdl)
     n_ev = ev_prev.shape[0]
     wk = new_work(mdl, y)
-    n, n_sl, half = sizes(mdl)
+    n_sl = sizes(mdl)[1]
     ynew = np.empty(ns)
     ytmp = np.empty(ns)
     yout = np.empty(ns)
@@ -577,12 +619,14 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
     t = fst[F_T]
     h = fst[F_H]
     if ist[I_STARTED] == 0:
-        start(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
+        _switch(MODE_START, -1, t, y, ph, sg, ph, ev_prev, mdl, wk, dy, k, ev_prev, ev_t, ev_i,
+                ist, fst)
         _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
         if h <= 0.0:
             h = _initial_step(t, y, k[0], ph, sg, mdl, wk, ctl, ytmp, dy, nd)
         if ist[I_OUT_NEXT] == 0 and out_y.shape[0] > 0:
-            yout[:] = y
+            for i in range(ns):
+                yout[i] = y[i]
             _write_sample(0, t, yout, ph, sg, mdl, wk, dy, out_y, out_aux)
             ist[I_OUT_NEXT] = 1
         ist[I_STARTED] = 1
@@ -609,16 +653,19 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
             land = True
 
         for st in range(1, 7):
-            ytmp[:] = y
+            for i in range(ns):
+                ytmp[i] = y[i]
             for j in range(st):
                 a = hs * A[st, j]
                 if a != 0.0:
                     for i in range(ns):
                         ytmp[i] += a * k[j, i]
             evaluate(t + C[st] * hs, ytmp, ph, sg, False, mdl, wk, k[st])
-        ynew[:] = ytmp
+        for i in range(ns):
+            ynew[i] = ytmp[i]
         ist[I_RHS] += 6
-        err_vec[:] = 0.0
+        for i in range(ns):
+            err_vec[i] = 0.0
         for st in range(7):
             a = hs * E[st]
             if a != 0.0:
@@ -702,13 +749,11 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
             fst[F_H_CAP] = np.inf
             ph_start = ph.copy()
             ev_start = ev_prev.copy()
-            apply_switch(which, t_e, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst)
+            _switch(MODE_EVENT, which, t_e, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k,
+                    ev_prev, ev_t, ev_i, ist, fst)
             t = t_e
             _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
             ist[I_RHS] += 1
-            if n_sl > 1:
-                _simultaneous(which, t, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k, ev_prev,
-                              ev_t, ev_i, ist, fst)
             stop_mask = int(ctl[C_STOP_MASK])
             for e in range(first_new, ist[I_EVENTS]):
                 if stop_mask & (1 << ev_i[e, EVI_KIND]):
@@ -743,7 +788,8 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
                 dense_coefficients(y, ynew, k, hs, rc)
             _write_outputs(t, t_new, hs, rc, ph, sg, mdl, wk, dy, yout, ctl, out_y, out_aux,
                            ist)
-        y[:] = ynew
+        for i in range(ns):
+            y[i] = ynew[i]
         for i in range(ns):
             k[0, i] = k[6, i]
         for i in range(n_ev):
@@ -751,18 +797,8 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
         t = t_new
         h = hs * fac
         if land and t < t_final:
-            # Speed-profile kink: Omegadot jumps, so the stick reaction does too.
-            om, _ = speed_at(t, mdl.speed, True)
-            for j in range(n_sl):
-                if ph[j] == SEPARATION:
-                    continue
-                old = ph[j]
-                old_s = sg[j]
-                if old == STICK:
-                    y[half + n + j] = om
-                choose_phase(j, t, y, ph, sg, mdl, wk, dy)
-                _record_change(t, old, old_s, ph[j], sg[j], j, ev_t, ev_i, ist)
-            settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
+            _switch(MODE_KINK, -1, t, y, ph, sg, ph, ev_prev, mdl, wk, dy, k, ev_prev, ev_t,
+                    ev_i, ist, fst)
             _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
             ist[I_RHS] += 1
 

@@ -217,17 +217,22 @@ class _DaskPool:
             return set(done)
         except TimeoutError:
             return set()
-        except CancelledError as exc:  # FuturesCancelledError: the scheduler went away
+        except (CancelledError, OSError) as exc:  # the scheduler went away
             raise self._lost(exc) from None
 
     def outcome(self, future: Any, index: int) -> PointOutcome:
-        if future.status == "finished":
-            return future.result()
-        if future.status != "error":  # cancelled or lost with the scheduler
-            raise self._lost(RuntimeError(f"point {index} was {future.status}"))
-        # run_point catches everything, so this is the cluster's failure, e.g. a worker
-        # killed repeatedly while running the point: record it as the point's error.
-        exc = future.exception()
+        from concurrent.futures import CancelledError
+
+        try:
+            if future.status == "finished":
+                return future.result()
+            if future.status != "error":  # cancelled or lost with the scheduler
+                raise self._lost(RuntimeError(f"point {index} was {future.status}"))
+            # run_point catches everything, so this is the cluster's failure, e.g. a worker
+            # killed repeatedly while running the point: record it as the point's error.
+            exc = future.exception()
+        except (CancelledError, OSError) as lost:  # fetching the result found it gone
+            raise self._lost(lost) from None
         return PointOutcome(index, None, f"{type(exc).__name__}: {exc}")
 
     def close(self) -> None:
