@@ -97,14 +97,8 @@ def speed_at(t, speed, right):
     limit (inside or at the end of a step), so a kink is seen from the side the
     step lies on.
     """
-    knots = speed[:, 0]
-    if right:
-        k = np.searchsorted(knots, t, side="right") - 1
-    else:
-        k = np.searchsorted(knots, t, side="left") - 1
-    if k < 0:
-        k = 0
-    tau = t - knots[k]
+    k = _piece(speed, t, right)
+    tau = t - speed[k, 0]
     c0 = speed[k, 1]
     c1 = speed[k, 2]
     c2 = speed[k, 3]
@@ -112,6 +106,26 @@ def speed_at(t, speed, right):
     om = c0 + tau * (c1 + tau * (c2 + tau * c3))
     omd = c1 + tau * (2.0 * c2 + 3.0 * tau * c3)
     return om, omd
+
+
+@njit(cache=True)
+def _piece(pieces, x, right):
+    """Index of the piece of ``pieces`` (starts in column 0, increasing) holding ``x``:
+    the last start below ``x``, or at or below it when ``right``; 0 before the first.
+
+    A bisection on the column itself (no array view: views cost reference counting on
+    every call of the right-hand side).
+    """
+    lo = 0
+    hi = pieces.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        start = pieces[mid, 0]
+        if start < x or (right and start == x):
+            lo = mid + 1
+        else:
+            hi = mid
+    return max(lo - 1, 0)
 
 
 @njit(cache=True)
@@ -133,9 +147,9 @@ def kinetic_friction(opts, table, r, s, v):
         else:
             e = -((-x) ** opts[O_DELTA])
         return opts[O_MU1] + (opts[O_MU0] - opts[O_MU1]) * np.exp(-e) + opts[O_MUV] * u
-    k = np.searchsorted(table[:, 0], u.real, side="right") - 1
-    if k < 0:
+    if u.real < table[0, 0]:
         return table[0, 1] + table[0, 2] * u
+    k = _piece(table, u.real, True)
     tau = u - table[k, 0]
     return table[k, 1] + tau * (table[k, 2] + tau * (table[k, 3] + tau * table[k, 4]))
 
@@ -150,35 +164,32 @@ def new_work(mdl, like):
 
 
 @njit(cache=True)
-def solve_small(a, b, m):
-    """Solve the leading ``m x m`` block of ``a x = b`` in place (``b`` becomes x) by
+def solve_small(a, r0, m):
+    """Solve the ``m x m`` system in rows ``r0 .. r0 + m`` of ``a`` (matrix in columns
+    ``0 .. m``, right-hand side in column m) in place, the solution left in column m, by
     Gaussian elimination with partial pivoting on the real parts. For m = 1 it is one
     division."""
     for c in range(m):
         piv = c
-        best = abs(a[c, c].real)
+        best = abs(a[r0 + c, c].real)
         for r in range(c + 1, m):
-            if abs(a[r, c].real) > best:
-                best = abs(a[r, c].real)
+            if abs(a[r0 + r, c].real) > best:
+                best = abs(a[r0 + r, c].real)
                 piv = r
         if piv != c:
-            for k in range(m):
-                tmp = a[c, k]
-                a[c, k] = a[piv, k]
-                a[piv, k] = tmp
-            tmp = b[c]
-            b[c] = b[piv]
-            b[piv] = tmp
+            for k in range(m + 1):
+                tmp = a[r0 + c, k]
+                a[r0 + c, k] = a[r0 + piv, k]
+                a[r0 + piv, k] = tmp
         for r in range(c + 1, m):
-            fac = a[r, c] / a[c, c]
-            for k in range(c, m):
-                a[r, k] -= fac * a[c, k]
-            b[r] -= fac * b[c]
+            fac = a[r0 + r, c] / a[r0 + c, c]
+            for k in range(c, m + 1):
+                a[r0 + r, k] -= fac * a[r0 + c, k]
     for c in range(m - 1, -1, -1):
-        acc = b[c]
+        acc = a[r0 + c, m]
         for k in range(c + 1, m):
-            acc -= a[c, k] * b[k]
-        b[c] = acc / a[c, c]
+            acc -= a[r0 + c, k] * a[r0 + k, m]
+        a[r0 + c, m] = acc / a[r0 + c, c]
 
 
 @njit(cache=True)
@@ -228,16 +239,16 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
         psi = sl[S_THETA, j] + phi
         c1 = np.cos(psi)
         s1 = np.sin(psi)
-        cl = wk[r_trig + j]
-        sn_l = wk[r_trig + ns + j]
-        cl[0] = 1.0 + zero
-        sn_l[0] = zero
+        rc = r_trig + j
+        rs = r_trig + ns + j
+        wk[rc, 0] = 1.0 + zero
+        wk[rs, 0] = zero
         if lmax >= 1:
-            cl[1] = c1
-            sn_l[1] = s1
+            wk[rc, 1] = c1
+            wk[rs, 1] = s1
         for k in range(1, lmax):
-            cl[k + 1] = 2.0 * c1 * cl[k] - cl[k - 1]
-            sn_l[k + 1] = 2.0 * c1 * sn_l[k] - sn_l[k - 1]
+            wk[rc, k + 1] = 2.0 * c1 * wk[rc, k] - wk[rc, k - 1]
+            wk[rs, k + 1] = 2.0 * c1 * wk[rs, k] - wk[rs, k - 1]
         wc = zero
         wcd = zero
         gpq = zero
@@ -253,8 +264,8 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
             # Branch-free g = R cos(l psi) (C, sgn = 1) or R sin(l psi) (D, sgn = -1).
             cs = 0.5 + 0.5 * sgn
             sn = 0.5 - 0.5 * sgn
-            gi = shape[j, i] * (cs * cl[li] + sn * sn_l[li])
-            gpi = li * shape[j, i] * (sn * cl[li] - cs * sn_l[li])
+            gi = shape[j, i] * (cs * wk[rc, li] + sn * wk[rs, li])
+            gpi = li * shape[j, i] * (sn * wk[rc, li] - cs * wk[rs, li])
             wk[j, i] = gi
             wk[r_gp + j, i] = gpi
             qi = y[i]
@@ -359,15 +370,14 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
                         * wk[aux + A_SGGP, j] + cross)
                 + sm * gpq * omd
             )
-    system = wk[r_sys : r_sys + ns]
-    solve_small(system[:, :ns], system[:, ns], ns)
+    solve_small(wk, r_sys, ns)
 
     for i in range(n):
         acc = wk[r_fq, i]
         for j in range(ns):
             if ph[j] == SEPARATION:
                 continue
-            sn = sl[S_SIGMA, j] * system[j, ns]
+            sn = sl[S_SIGMA, j] * wk[r_sys + j, ns]
             if ph[j] == SLIP:
                 acc = acc - sn * (wk[j, i] - sl[S_HH, j] * wk[aux + A_SMU, j] * wk[r_gp + j, i])
             else:
@@ -377,7 +387,7 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
     for j in range(ns):
         if ph[j] == SEPARATION:
             continue
-        nf = system[j, ns]
+        nf = wk[r_sys + j, ns]
         wk[aux + A_N, j] = nf
         if ph[j] == SLIP:
             wk[aux + A_F, j] = wk[aux + A_SMU, j] * nf

@@ -116,15 +116,14 @@ def _solve_active(a, b, x, act, m):
             k += 1
     if k == 0:
         return
-    sub = np.empty((k, k))
-    rhs = np.empty(k)
+    sub = np.empty((k, k + 1))
     for r in range(k):
-        rhs[r] = b[idx[r]]
+        sub[r, k] = b[idx[r]]
         for c in range(k):
             sub[r, c] = a[idx[r], idx[c]]
-    solve_small(sub, rhs, k)
+    solve_small(sub, 0, k)
     for r in range(k):
-        x[idx[r]] = rhs[r]
+        x[idx[r]] = sub[r, k]
 
 
 @njit(cache=True)
