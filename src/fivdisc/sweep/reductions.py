@@ -100,17 +100,12 @@ def _first_separation(result: Result | None, case: Case) -> float:
     return float(times[0]) if times.size else math.nan
 
 
-def _per_slider(value: Any) -> list:
-    """A summary entry as a list over sliders (one-slider summaries hold the item)."""
-    return value if isinstance(value, list) else [value]
-
-
 def _phase_fraction(phase: str) -> Callable[[Result | None, Case], float]:
     def fraction(result: Result | None, case: Case) -> float:
         shares = [
-            spent[phase] / sum(spent.values())
-            for spent in _per_slider(result.summary()["time_in_phase"])
-            if sum(spent.values()) > 0
+            slider.time_in_phase[phase] / sum(slider.time_in_phase.values())
+            for slider in result.summary().sliders
+            if sum(slider.time_in_phase.values()) > 0
         ]
         return sum(shares) / len(shares) if shares else math.nan
 
@@ -173,13 +168,13 @@ BUILTIN: dict[str, Reduction] = {
         ),
         _builtin(
             "max_abs_w",
-            lambda result, case: result.summary()["max_abs_w"],
+            lambda result, case: result.summary().max_abs_w,
             "m",
             "largest |w| at the probes",
         ),
         _builtin(
             "max_normal_force",
-            lambda result, case: max(_per_slider(result.summary()["peak_normal_force"])),
+            lambda result, case: result.summary().peak_normal_force,
             "N",
             "largest normal contact force of any slider",
         ),
