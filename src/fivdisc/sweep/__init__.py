@@ -18,7 +18,6 @@ from fivdisc.sweep.spec import Sweep, load_sweep, parse_range
 from fivdisc.sweep.store import (
     StoreHealth,
     SweepStore,
-    as_grid,
     open_sweep,
     read_mask,
     store_lock,
@@ -34,7 +33,6 @@ __all__ = [
     "SweepError",
     "SweepReport",
     "SweepStore",
-    "as_grid",
     "load_sweep",
     "open_sweep",
     "parse_range",
