@@ -390,12 +390,11 @@ def test_store_holds_values_failures_and_definition(reference, sweep_file) -> No
     assert np.isnan(data["fragile"].values[failed]).all()
     assert not data["separated"].values[failed].any()
     # every other point holds exactly what a run in this process gives, at its place
-    # on the axes (point 7 of the C-ordered 4 x 3 grid is the second speed, third duration)
-    for index in (0, 7):
+    # on the axes (point 7 of the C-ordered 4 x 3 grid is the third speed, second duration)
+    for index, at in ((0, {"speed.initial": 8.0, "speed.duration": 2.0}),
+                      (7, {"speed.initial": 16.0, "speed.duration": 4.0})):
+        assert spec.updates(index) == at
         expected = evaluate(spec.cases[index], spec.keep)
-        at = spec.updates(index)
-        assert at == {"speed.initial": [2.0, 12.0][index // 7],
-                      "speed.duration": [2.0, 6.0][index // 7]}
         for name, value in expected.items():
             np.testing.assert_equal(data[name].sel(at).item(), value)
 
