@@ -15,7 +15,8 @@ import pytest
 import xarray as xr
 from click.testing import CliRunner
 
-from fivdisc import examples, linear_stability, load_case, simulate, stability_map
+from fivdisc import examples, linear_stability, load_case, open_result, simulate, stability_map
+from fivdisc.cli import cli
 from fivdisc.cli.reproduce import reproduce as reproduce_command
 from fivdisc.errors import FivdiscError
 from fivdisc.model import build_model
@@ -43,6 +44,8 @@ from fivdisc.paper import (
 from fivdisc.paper import measure as ms
 from fivdisc.paper.cases import FIG10
 from fivdisc.paper.figures import separation_grid
+
+from cf_check import check_cf
 
 EXAMPLES = examples.DIRECTORY
 
@@ -209,6 +212,16 @@ def test_reproduce_one_figure_and_reuse(tmp_path):
         stored = data.load()
     assert [r.verdict for r in rows(stored)][:2] == ["agrees", "agrees"]
     assert plot(stored).axes  # drawn from the stored data alone
+    # One layout, one reader (issue 13, item 4): each run is a group in the result layout
+    check_cf(stored.to_dataset())
+    assert list(stored.children) == ["main"]
+    check_cf(stored["main"].to_dataset())
+    run = open_result(out / "fig06.nc")
+    assert run.name == "fig06" and run.dataset["phi_dot"].dims == ("time", "slider")
+    assert run.summary().status == "success"
+    drawn = CliRunner().invoke(cli, ["plot", str(out / "fig06.nc"), "--kind", "timeseries",
+                                     "--var", "phi_dot", "-o", str(tmp_path / "f.png")])
+    assert drawn.exit_code == 0, drawn.output
     stored.attrs["parameters"] = "{}"
     stored.to_netcdf(out / "fig06.nc")
     third = reproduce([6], out, progress=False, workers=1)

@@ -11,9 +11,11 @@ a figure is drawn.
 
 from __future__ import annotations
 
+import functools
 import os
 import sys
-from typing import TYPE_CHECKING
+from collections.abc import Callable
+from typing import TYPE_CHECKING, ParamSpec, TypeVar
 
 import numpy as np
 import xarray as xr
@@ -54,6 +56,8 @@ __all__ = [
 ]
 
 Window = tuple[float | None, float | None] | None
+P = ParamSpec("P")
+R = TypeVar("R")
 
 #: The kinds of figure of a simulation result (``fivdisc plot --kind``).
 KINDS = ("timeseries", "spectrogram", "spectrum", "phase", "friction", "normal-force")
@@ -65,12 +69,22 @@ _BINS_PER_RANGE = 50
 _CHAR_WIDTH = 0.6
 
 
+def _drawing(function: Callable[P, R]) -> Callable[P, R]:
+    """A function that draws: it checks for matplotlib (the plot extra) before any work."""
+
+    @functools.wraps(function)
+    def checked(*args: P.args, **kwargs: P.kwargs) -> R:
+        from fivdisc.extras import require
+
+        require("plot", "fivdisc.plots")
+        return function(*args, **kwargs)
+
+    return checked
+
+
 def _axes(ax: Axes | None) -> tuple[Figure, Axes]:
     if ax is not None:
         return ax.figure, ax
-    from fivdisc.extras import require
-
-    require("plot", "fivdisc.plots")
     import matplotlib
 
     headless = sys.platform.startswith("linux") and not (
@@ -194,6 +208,7 @@ def default_segment(duration: float, fmax: float) -> float:
     return float(f"{segment:.2g}")
 
 
+@_drawing
 def plot_timeseries(data: xr.Dataset | object, var: str, probe: int | None = None,
                     window: Window = None, ax: Axes | None = None) -> Figure:
     """Time history of one variable (paper Figs. 8a, 9a, 12).
@@ -227,6 +242,7 @@ def plot_timeseries(data: xr.Dataset | object, var: str, probe: int | None = Non
     return fig
 
 
+@_drawing
 def plot_spectrogram(data: xr.Dataset | object, var: str = "phi", probe: int | None = None,
                      window: Window = None, segment: float | None = None, overlap: float = 0.75,
                      taper: str | tuple = "hann", fmax: float | None = None,
@@ -288,6 +304,7 @@ def plot_spectrogram(data: xr.Dataset | object, var: str = "phi", probe: int | N
     return fig
 
 
+@_drawing
 def plot_spectrum(data: xr.Dataset | object, var: str = "phi", probe: int | None = None,
                   window: Window = None, taper: str | tuple = "hann", n_peaks: int = 10,
                   min_rel_height: float = 0.05, fmax: float | None = None,
@@ -358,6 +375,7 @@ def _label_peaks(ax: Axes, frequencies: np.ndarray, amplitudes: np.ndarray) -> N
             written.append(box)
 
 
+@_drawing
 def plot_phase_portrait(data: xr.Dataset | object, window: Window = None,
                         ax: Axes | None = None, slider: int = 0) -> Figure:
     """Slider angular velocity against angle (paper Fig. 17a, c, e, ...).
@@ -377,6 +395,7 @@ def plot_phase_portrait(data: xr.Dataset | object, window: Window = None,
     return _trajectory(ds, "phi", "phi_dot", "phase portrait of the slider", ax)
 
 
+@_drawing
 def plot_friction(data: xr.Dataset | object, window: Window = None,
                   ax: Axes | None = None, slider: int = 0) -> Figure:
     """Friction force against relative angular velocity (paper Fig. 17b, d, f, ...).
@@ -408,6 +427,7 @@ def _trajectory(ds: xr.Dataset, x: str, y: str, what: str, ax: Axes | None) -> F
     return fig
 
 
+@_drawing
 def plot_normal_force(data: xr.Dataset | object, window: Window = None,
                       ax: Axes | None = None, slider: int = 0) -> Figure:
     """Normal contact force with separation intervals shaded (paper Figs. 18, 19, 24).
@@ -438,6 +458,7 @@ def plot_normal_force(data: xr.Dataset | object, window: Window = None,
     return fig
 
 
+@_drawing
 def plot_kind(data: xr.Dataset | object, kind: str = "timeseries", var: str | None = None,
               probe: int | None = None, slider: int = 0, window: Window = None,
               fmax: float | None = None, segment: float | None = None,
@@ -496,6 +517,7 @@ def plot_kind(data: xr.Dataset | object, kind: str = "timeseries", var: str | No
     return plot_normal_force(ds, window, ax=ax)
 
 
+@_drawing
 def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None) -> Figure:
     """Stability map of :func:`fivdisc.analysis.stability.stability_map` (paper Fig. 3).
 

@@ -400,7 +400,7 @@ class Result:
             sliders.append(SliderSummary(
                 {name: float(np.sum(dt[phase[:-1] == i])) for i, name in enumerate(PHASE_NAMES)},
                 int(np.sum((kinds == "separation") & (owners == j))),
-                float(np.nanmax(force, initial=np.nan)),
+                float(np.nanmax(force)) if np.isfinite(force).any() else np.nan,
             ))
         impacts = int(np.sum(kinds == "recontact")) if ds.attrs.get("impact", 1) else 0
         w = np.abs(ds["w"].values) if "w" in ds else np.full(1, np.nan)

@@ -165,18 +165,20 @@ def _template(sweep: Sweep) -> xr.Dataset:
     data["checksum"] = (
         dims,
         da.zeros(shape, dtype=np.uint64, chunks=chunks),
-        {"long_name": "hash of the sweep, the point's index, values and error (0: none)"},
+        {"units": "1",
+         "long_name": "hash of the sweep, the point's index, values and error (0: none)"},
     )
     data["done"] = (
         dims,
         da.zeros(shape, dtype=bool, chunks=chunks),
-        {"long_name": "the point's values are written"},
+        {"units": "1", "long_name": "the point's values are written"},
     )
     if sweep.mode == "grid":
         coords = {key: (key, _coordinate(values), key_attrs(key))
                   for key, values in sweep.axes.items()}
     else:
-        coords = {DIM: (DIM, np.arange(sweep.n_points), {"long_name": "sweep point"})}
+        coords = {DIM: (DIM, np.arange(sweep.n_points), {"units": "1",
+                                                           "long_name": "sweep point"})}
         coords |= {key: (DIM, _coordinate(values), key_attrs(key))
                    for key, values in sweep.axes.items()}
     keys = " and ".join(sweep.axes)
