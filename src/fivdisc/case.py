@@ -14,7 +14,6 @@ is done elsewhere.
 
 from __future__ import annotations
 
-import difflib
 import itertools
 import json
 import math
@@ -44,7 +43,7 @@ from pydantic import (
 from pydantic.fields import FieldInfo
 from pydantic_core import ErrorDetails, PydanticCustomError
 
-from fivdisc.errors import CaseError
+from fivdisc.errors import CaseError, nearest
 from fivdisc.files import read_text
 from fivdisc.limits import disc_problem
 
@@ -66,6 +65,7 @@ __all__ = [
     "TableSpeed",
     "describe_key",
     "is_case_key",
+    "keys_like",
     "load_case",
     "unit_of",
 ]
@@ -936,6 +936,17 @@ def is_case_key(key: str) -> bool:
     return _template(key) in _LEAVES
 
 
+def keys_like(key: str) -> list[str]:
+    """The valid keys to suggest for `key`: :meth:`Case.valid_keys`, with the slider keys
+    written ``sliders.J.KEY`` when `key` names slider J that way."""
+    parts = key.split(".")
+    keys = Case.valid_keys()
+    if parts[0] == "sliders" and len(parts) > 2 and parts[1].isdigit():
+        prefix = f"sliders.{parts[1]}."
+        return [prefix + k.split(".", 1)[1] if k.startswith("slider.") else k for k in keys]
+    return keys
+
+
 def _template(key: str) -> str:
     """The key with a slider index removed: ``sliders.2.mass`` -> ``slider.mass``."""
     parts = key.split(".")
@@ -1030,7 +1041,7 @@ _TABLES: frozenset[str] = frozenset([*_TABLE_NAMES, "sliders"]) - {""}
 
 def _unknown_key(key: str, names: list[str] | None = None, profile: str | None = None,
                  law: str | None = None) -> str:
-    """Message for an unknown dotted key, with the nearest valid key if there is one.
+    """Message for an unknown dotted key, ending with the nearest valid key.
 
     Parameters
     ----------
@@ -1053,13 +1064,10 @@ def _unknown_key(key: str, names: list[str] | None = None, profile: str | None =
     if names is None:
         names = _TABLE_NAMES.get(template_table)
     if names is not None:
-        matches = difflib.get_close_matches(name, names, n=1)
-        suggestion = f"{table}.{matches[0]}" if matches and table else (matches or [""])[0]
+        candidates = [f"{table}.{n}" if table else n for n in names]
     else:
         candidates = [*_LEAVES, *_TABLES]
-        suggestion = (difflib.get_close_matches(key, candidates, n=1) or [""])[0]
-    hint = f"; did you mean '{suggestion}'?" if suggestion else ""
-    return f"unknown key '{key}'{hint}"
+    return f"unknown key '{key}'{nearest(key, candidates)}"
 
 
 # --- error messages --------------------------------------------------------------------------

@@ -13,8 +13,8 @@ import xarray as xr
 from fivdisc._kernels import dynamics as dyn
 from fivdisc._kernels import layout as lay
 from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium, slip_phases
-from fivdisc.case import Case, is_case_key, unit_of
-from fivdisc.errors import CaseError, SimulationError
+from fivdisc.case import Case, is_case_key, keys_like, unit_of
+from fivdisc.errors import CaseError, SimulationError, nearest
 from fivdisc.limits import check_memory
 from fivdisc.model import Model, build_model
 from fivdisc.speed import SpeedProfile
@@ -449,9 +449,14 @@ def stability_map(
 
 
 def resolve_key(key: str, option: str) -> str:
-    """Full dotted case key from a dotted key or an unambiguous last part (``decay``)."""
-    import difflib
+    """Full dotted case key from a dotted key or an unambiguous last part (``decay``).
 
+    Raises
+    ------
+    CaseError
+        An ambiguous last part (the message lists the keys it could be), or an unknown
+        key (the message names the nearest valid one).
+    """
     keys = Case.valid_keys()
     if is_case_key(key):
         return key
@@ -460,9 +465,8 @@ def resolve_key(key: str, option: str) -> str:
         return matches[0]
     if len(matches) > 1:
         raise CaseError(f"{option}: key '{key}' is ambiguous: write one of {', '.join(matches)}")
-    near = difflib.get_close_matches(key, keys, n=1)
-    hint = f"; did you mean '{near[0]}'?" if near else ""
-    raise CaseError(f"{option}: unknown case key '{key}'{hint}")
+    raise CaseError(f"{option}: unknown case key '{key}'{nearest(key, keys_like(key))} "
+                    "(every key, with its unit: fivdisc examples default)")
 
 
 def parse_range(text: str, option: str) -> tuple[str, np.ndarray]:

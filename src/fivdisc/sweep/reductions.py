@@ -10,17 +10,16 @@ first separation) lets the run stop there; see :func:`stop_events`.
 
 from __future__ import annotations
 
-import difflib
 import importlib
 import math
 import numbers
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cache
 from typing import Any
 
 from fivdisc.case import Case
-from fivdisc.errors import FivdiscError
+from fivdisc.errors import FivdiscError, nearest
 from fivdisc.result import Result
 
 __all__ = [
@@ -29,7 +28,6 @@ __all__ = [
     "RunFailed",
     "SweepError",
     "evaluate",
-    "nearest",
     "resolve",
     "stop_events",
 ]
@@ -232,12 +230,6 @@ def _user(spec: str) -> Reduction:
         needs_run=True,
         func=lambda result, case: func(result),
     )
-
-
-def nearest(name: str, names: Iterable[str]) -> str:
-    """Hint naming the closest of `names` ("; did you mean 'x'?"), or "" if none is close."""
-    matches = difflib.get_close_matches(name, list(names), n=1)
-    return f"; did you mean '{matches[0]}'?" if matches else ""
 
 
 @cache
