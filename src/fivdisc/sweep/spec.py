@@ -14,7 +14,8 @@ A sweep file is TOML::
 
 Points are numbered in C order (the first axis varies slowest). Building a
 :class:`Sweep` validates everything, including the case of every point, so a sweep
-that starts cannot fail on its input halfway through.
+that starts cannot fail on its input halfway through. The documentation's page "Sweep
+files" describes every key.
 """
 
 from __future__ import annotations
