@@ -1269,18 +1269,10 @@ def _describe(exc: ValidationError, root: type[_Table], data: Any = None) -> str
 
 
 class KeyInfo(NamedTuple):
-    """What :func:`describe_key` knows about a case key.
-
-    Attributes
-    ----------
-    unit
-        Its unit, "" if dimensionless or not a number.
-    symbol
-        Its symbol in the paper, as matplotlib mathtext without the dollars (``c_z``,
-        ``r_0^2 c_\\phi``); "" if it has none.
-    long_name
-        A description in words, e.g. ``"slider 1 normal damping"``.
-    """
+    """What :func:`describe_key` knows about a case key: its ``unit`` ("" if
+    dimensionless or not a number), its ``symbol`` in the paper as matplotlib mathtext
+    without the dollars (``c_z``, ``r_0^2 c_\\phi``; "" if it has none) and a
+    ``long_name`` in words (``"slider 1 normal damping"``)."""
 
     unit: str
     symbol: str
