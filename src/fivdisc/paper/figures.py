@@ -735,8 +735,10 @@ def _spectra_plot(data: xr.Dataset) -> Figure:
         if constant:
             t0, t1 = (float(t) for t in np.atleast_1d(data.attrs["analysis_window"]))
             plot_spectrum(run, "w", probe=1, window=(t0, t1), fmax=_FMAX, ax=axes[2])
-            axes[2].set_title(f"(b') amplitude spectrum, {t0:g}-{t1:g} s\n"
-                              + axes[2].get_title(), fontsize="small")
+            # plot_spectrum's title ends with the periodicity verdict
+            verdict = axes[2].get_title().split("\n")[-1]
+            axes[2].set_title(f"(b') amplitude spectrum, {t0:g}-{t1:g} s\n{verdict}",
+                              fontsize="small")
     _suptitle(fig, data)
     return fig
 
