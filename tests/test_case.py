@@ -395,7 +395,8 @@ def test_several_errors_on_one_line() -> None:
             "unknown key 'simulation.perturbation.phy'; "
             "did you mean 'simulation.perturbation.phi'?",
         ),
-        ({"friction": {"zzz": 1.0}}, "unknown key 'friction.zzz'"),
+        # however far the key is from every valid one, the nearest is named
+        ({"friction": {"zzz": 1.0}}, "unknown key 'friction.zzz'; did you mean 'friction.law'?"),
     ],
 )
 def test_unknown_key(tables: dict[str, Any], message: str) -> None:

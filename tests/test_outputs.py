@@ -205,7 +205,8 @@ def test_stability_map_output_checked_before_the_map(tmp_path: Path, monkeypatch
 
     monkeypatch.setattr("fivdisc.analysis.stability.stability_map", never)
     grid = ["--x", "normal_damping=0:1:2", "--y", "rotational_damping=0:1:2"]
-    _refused(["stability", *grid, "-o", str(tmp_path / "map.pdf")], "must end in .nc, .png")
+    _refused(["stability", *grid, "-o", str(tmp_path / "map.xyz")], "'.xyz'",
+             "must end in .nc, ")
     _refused(["stability", *grid, "-o", str(tmp_path / "no" / "map.nc")], "does not exist")
 
 

@@ -15,7 +15,8 @@ import pytest
 import xarray as xr
 from click.testing import CliRunner
 
-from fivdisc import examples, linear_stability, load_case, simulate, stability_map
+from fivdisc import examples, linear_stability, load_case, open_result, simulate, stability_map
+from fivdisc.cli import cli
 from fivdisc.cli.reproduce import reproduce as reproduce_command
 from fivdisc.errors import FivdiscError
 from fivdisc.model import build_model
@@ -43,6 +44,8 @@ from fivdisc.paper import (
 from fivdisc.paper import measure as ms
 from fivdisc.paper.cases import FIG10
 from fivdisc.paper.figures import separation_grid
+
+from cf_check import check_cf
 
 EXAMPLES = examples.DIRECTORY
 
@@ -108,7 +111,8 @@ def test_stability_of_the_sliding_equilibrium(pc, stable):
 def test_linear_eigenfrequencies_of_fig8_are_f1_and_f2():
     """Fig. 8: f1 = 181 Hz and f2 = 290.5 Hz; fivdisc's linearised modes C01 and D02 at
     2 pi rad/s are at 180.85 Hz and 290.49 Hz."""
-    freq = {r["coordinate"]: r["frequency_hz"] for r in linear_stability(FIG8.case).table()}
+    table = linear_stability(FIG8.case).to_dataframe()
+    freq = dict(zip(table["coordinate"], table["frequency_hz"], strict=True))
     assert freq["C01"] == pytest.approx(181.0, abs=0.5)
     assert freq["D02"] == pytest.approx(290.5, abs=0.5)
 
@@ -123,8 +127,8 @@ def test_fig3_boundary_exists_with_stable_above(label):
     m = stability_map(case.replace({"friction.decay": alpha}),
                       x=("slider.normal_damping", np.linspace(2.0, 12.0, 6)),
                       y=("slider.rotational_damping", ys))
-    bound = m["boundary"].values[0]
-    stable = m["stable"].values[0].astype(bool)
+    bound = m["boundary"].values
+    stable = m["stable"].values.astype(bool)
     columns = np.flatnonzero(np.isfinite(bound))
     assert columns.size >= 3
     for i in columns:
@@ -204,10 +208,20 @@ def test_reproduce_one_figure_and_reuse(tmp_path):
     assert again.computed == () and again.reused == (6,)
     assert (out / "fig06.nc").stat().st_mtime_ns == stamp
 
-    with xr.open_dataset(out / "fig06.nc") as data:
+    with xr.open_datatree(out / "fig06.nc") as data:
         stored = data.load()
     assert [r.verdict for r in rows(stored)][:2] == ["agrees", "agrees"]
     assert plot(stored).axes  # drawn from the stored data alone
+    # One layout, one reader (issue 13, item 4): each run is a group in the result layout
+    check_cf(stored.to_dataset())
+    assert list(stored.children) == ["main"]
+    check_cf(stored["main"].to_dataset())
+    run = open_result(out / "fig06.nc")
+    assert run.name == "fig06" and run.dataset["phi_dot"].dims == ("time", "slider")
+    assert run.summary().status == "success"
+    drawn = CliRunner().invoke(cli, ["plot", str(out / "fig06.nc"), "--kind", "timeseries",
+                                     "--var", "phi_dot", "-o", str(tmp_path / "f.png")])
+    assert drawn.exit_code == 0, drawn.output
     stored.attrs["parameters"] = "{}"
     stored.to_netcdf(out / "fig06.nc")
     third = reproduce([6], out, progress=False, workers=1)

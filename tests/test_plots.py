@@ -119,7 +119,8 @@ def test_spectrogram_axes_and_colour_scale():
     ax, bar = fig.axes
     assert ax.get_xlabel() == "segment centre time [s]"
     assert ax.get_ylabel() == "frequency [Hz]"
-    assert bar.get_ylabel() == "STFT magnitude of slider circumferential angle [rad]"
+    assert bar.get_ylabel() == "magnitude [rad]"
+    assert ax.get_title().startswith("spectrogram of slider circumferential angle")
     # Frequencies up to fmax, each drawn as a cell of 20 Hz (1 / segment) centred on it.
     assert ax.get_ylim()[1] == pytest.approx(1010.0)
     # The strongest cell is the 1e-3 rad line at 206 Hz (about 200 Hz on 20 Hz bins).
@@ -135,7 +136,8 @@ def test_spectrum_marks_refined_peaks():
     np.testing.assert_allclose(np.sort(x), [F0, 2 * F0], atol=0.01)
     np.testing.assert_allclose(np.sort(y), [3e-4, 1e-3], rtol=1e-2)
     assert "periodic: f0 = 206 Hz" in ax.get_title()
-    assert ax.get_ylabel() == "amplitude of slider circumferential angle [rad]"
+    assert ax.get_title().startswith("spectrum of slider circumferential angle")
+    assert ax.get_ylabel() == "amplitude [rad]"
     assert ax.get_xlabel() == "frequency [Hz]"
 
 
@@ -181,6 +183,8 @@ def test_cli_writes_figures(result_file, tmp_path, args):
         (["--kind", "phase", "--var", "w"], ["--var", "--kind phase"]),
         (["--kind", "phase", "--fmax", "100"], ["--fmax", "--kind phase"]),
         (["--kind", "spectrogram", "--segment", "1"], ["segment = 1.0", "0.4001 s"]),
+        (["--kind", "spectrum", "--fmax", "6000"], ["--fmax = 6000", "(0, 5000]", "Nyquist"]),
+        (["--kind", "spectrogram", "--fmax", "5001"], ["--fmax = 5001", "Nyquist"]),
         (["-o", "figure.unknown"], ["-o", "not supported"]),
     ],
 )
@@ -225,3 +229,140 @@ def test_backend_chosen_by_mplbackend_is_kept():
         out = subprocess.run([sys.executable, "-c", code], env=environment, check=True,
                              capture_output=True, text=True)
         assert out.stdout.strip().lower() == backend
+
+
+# --- what every figure shows -----------------------------------------------------------------
+
+
+def _text_outside_canvas(fig) -> list[str]:
+    """The texts of a figure as drawn (titles, labels, drawn tick labels, legends,
+    annotations, colour bars) that are not wholly inside its canvas, after the layout
+    engine has run."""
+    from matplotlib.text import Text
+
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    canvas = fig.bbox.padded(0.5)
+    drawn = [t for ax in fig.axes for axis in (ax.xaxis, ax.yaxis)
+             for tick in axis._update_ticks() for t in (tick.label1, tick.label2)]
+    texts = [t for t in fig.findobj(Text) if t.get_visible() and t.get_text()
+             and (t in drawn or not any(t is tick for tick in _tick_labels(fig)))]
+    return [repr(t.get_text()) for t in texts
+            if not canvas.contains(*t.get_window_extent(renderer).min)
+            or not canvas.contains(*t.get_window_extent(renderer).max)]
+
+
+def _tick_labels(fig) -> list:
+    return [t for ax in fig.axes for axis in (ax.xaxis, ax.yaxis)
+            for tick in (*axis.majorTicks, *axis.minorTicks) for t in (tick.label1, tick.label2)]
+
+
+@pytest.fixture(scope="module")
+def simulated():
+    """0.3 s of the paper's first example, named as the command line names a case file."""
+    from fivdisc import Case, simulate
+
+    return simulate(Case(simulation={"duration": 0.3})).named("default")
+
+
+@pytest.mark.parametrize("kind", plots.KINDS)
+def test_every_kind_names_case_and_variable_and_keeps_its_text_inside(simulated, kind):
+    fig = simulated.plot(kind)
+    title = fig.axes[0].get_title()
+    assert title.startswith("default: ")
+    variable = {"timeseries": "slider circumferential angle",
+                "spectrogram": "spectrogram of slider circumferential angle",
+                "spectrum": "spectrum of slider circumferential angle",
+                "phase": "phase portrait", "friction": "friction force",
+                "normal-force": "normal contact force"}[kind]
+    assert variable in title.split("\n")[0] + " " + title.split("\n")[1]
+    assert "disc at 6.283 rad/s" in title  # the run, on the second line
+    assert _text_outside_canvas(fig) == []
+
+
+def test_result_plot_draws_what_the_command_draws(simulated, tmp_path):
+    """Result.plot and fivdisc plot are one function: the same title, labels and lines."""
+    path = tmp_path / "run.nc"
+    simulated.to_netcdf(path)
+    run = CliRunner().invoke(plot_command, [str(path), "--kind", "spectrum", "--window",
+                                            "0.1:", "-o", str(tmp_path / "s.svg")])
+    assert run.exit_code == 0, run.output
+    ax = simulated.plot("spectrum", window=(0.1, None)).axes[0]
+    svg = (tmp_path / "s.svg").read_text()
+    for text in (ax.get_xlabel(), ax.get_ylabel(), *ax.get_title().split("\n")):
+        assert text.replace("&", "&amp;") in svg or text in svg, text
+
+
+def test_zero_hz_is_never_a_peak():
+    """A mean and a slow drift that detrending leaves (a quadratic) give the lobe around
+    0 Hz its largest amplitude; it is not reported, the 206 Hz line is."""
+    t = np.arange(0.0, 1.0, 1e-4)
+    drifting = 5.0 + 20.0 * t**2 + 1e-2 * np.sin(2 * np.pi * F0 * t)
+    ds = xr.Dataset({"x": ("time", drifting, {"units": "m", "long_name": "x"})},
+                    coords={"time": ("time", t, {"units": "s"})})
+    spec = plots.spectrum(ds, "x")
+    assert spec.frequencies[np.argmax(spec.amplitude)] < 1.0  # the lobe dominates
+    peaks = plots.find_peaks(spec, n=3, min_rel_height=0.5)
+    np.testing.assert_allclose(peaks.frequencies, [F0], atol=0.01)
+    # A slow line of its own, above the lobe, is still found.
+    slow = ds.assign(x=("time", np.sin(2 * np.pi * 3.0 * t), {"units": "m"}))
+    assert plots.find_peaks(plots.spectrum(slow, "x"), n=1).frequencies[0] == pytest.approx(
+        3.0, abs=0.05)
+
+
+def test_spectrogram_segment_follows_the_record_and_the_band():
+    # 100 segments per record, or bins of 1/50 of the band shown, whichever is longer
+    assert plots.default_segment(35.0, 1000.0) == 0.35
+    assert plots.default_segment(1.0, 1000.0) == 0.05
+    assert plots.default_segment(1.0, 5000.0) == 0.01
+    assert plots.default_segment(0.1, 100.0) == 0.025  # at most a quarter of the record
+    fig = plots.plot_spectrogram(_result(), "phi", fmax=1000.0)
+    assert "0.05 s segments (20 Hz bins)" in fig.axes[0].get_title()
+
+
+def test_fmax_above_nyquist_is_refused():
+    for draw in (plots.plot_spectrum, plots.plot_spectrogram):
+        with pytest.raises(FivdiscError, match=r"fmax = 5001 \[Hz\] is invalid: must be in "
+                           r"\(0, 5000\] Hz, up to the Nyquist frequency"):
+            draw(_result(), "phi", fmax=5001.0)
+
+
+def _map(curves):
+    from fivdisc import Case, stability_map
+
+    return stability_map(Case(speed={"value": 1.0}),
+                         ("slider.normal_damping", np.linspace(4.0, 14.0, 6)),
+                         ("slider.rotational_damping", np.linspace(0.2, 3.0, 12)),
+                         curves=curves)
+
+
+def test_stability_map_marks_the_stable_side_and_drops_absent_curves():
+    ds = _map(("friction.decay", [1.0, 10.0, 50.0]))
+    present = [bool(np.isfinite(ds["boundary"].sel({"friction.decay": a})).any())
+               for a in (1.0, 10.0, 50.0)]
+    assert present[0] and not all(present)  # some curve lies outside this grid
+    fig = plots.plot_stability_map(ds)
+    ax = fig.axes[0]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    shown = [f"$\\alpha$ = {a:g} s/m, stable above" for a, p in zip((1, 10, 50), present,
+                                                                     strict=True) if p]
+    assert labels == shown
+    missing = [a for a, p in zip((1, 10, 50), present, strict=True) if not p]
+    assert all(f"$\\alpha$ = {a:g} s/m" in ax.get_title() for a in missing)
+    # the stable regions are shaded, one filled contour per curve drawn
+    assert len(ax.collections) >= len(shown)
+    assert ax.get_xlabel() == "slider normal damping $c_z$ [N s/m]"
+    assert ax.get_ylabel() == "slider rotational damping $r_0^2 c_\\phi$ [N m s/rad]"
+    assert _text_outside_canvas(fig) == []
+
+
+@pytest.mark.parametrize("suffix", [".pdf", ".svg", ".png"])
+def test_stability_map_command_writes_any_matplotlib_format(tmp_path, suffix):
+    from fivdisc.cli import cli
+
+    out = tmp_path / f"map{suffix}"
+    run = CliRunner().invoke(cli, ["stability", "fig03b", "--x", "normal_damping=4:14:4",
+                                   "--y", "rotational_damping=0.2:3:4", "-o", str(out),
+                                   "--no-progress"])
+    assert run.exit_code == 0, run.output
+    assert out.read_bytes()[:4] in (b"%PDF", b"<?xm", b"\x89PNG")

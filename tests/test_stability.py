@@ -122,20 +122,20 @@ def test_stability_map_fast_path_is_exact():
         for ix, x in enumerate(xs):
             point = case.replace({"slider.normal_damping": x, "slider.rotational_damping": y})
             slow = linear_stability(point).max_growth_rate
-            assert fast["max_growth_rate"].values[0, iy, ix] == pytest.approx(slow, rel=1e-9,
-                                                                              abs=1e-12)
+            assert fast["max_growth_rate"].values[iy, ix] == pytest.approx(slow, rel=1e-9,
+                                                                           abs=1e-12)
 
 
 def test_stability_map_boundary_separates_stable_above():
     case = Case(speed={"value": 1.0}, friction={"decay": 1.0})
     ds = stability_map(case, ("slider.normal_damping", np.linspace(4, 14, 6)),
                        ("slider.rotational_damping", np.linspace(0.2, 3.0, 30)))
-    stable = ds["stable"].values[0].astype(bool)
-    boundary = ds["boundary"].values[0]
+    stable = ds["stable"].values.astype(bool)
+    boundary = ds["boundary"].values
     assert np.isfinite(boundary).any()
     for ix, b in enumerate(boundary):
         if np.isfinite(b):
-            ys = ds["y"].values
+            ys = ds["slider.rotational_damping"].values
             assert stable[ys > b + 1e-9, ix].all()
             assert not stable[np.searchsorted(ys, b) - 1, ix]
 
@@ -158,7 +158,11 @@ def test_stability_command(tmp_path):
     import xarray as xr
 
     ds = xr.open_dataset(target)
+    assert ds["max_growth_rate"].dims == ("friction.decay", "slider.rotational_damping",
+                                          "slider.normal_damping")
     assert ds["max_growth_rate"].shape == (2, 4, 5)
     assert ds["max_growth_rate"].attrs["units"] == "1/s"
+    assert ds["slider.normal_damping"].attrs["units"] == "N s/m"
+    np.testing.assert_allclose(ds["friction.decay"].values, [0.0, 1.0])
     bad = runner.invoke(cli, ["stability", "--x", "normal_dampin=1:2:3", "--y", "decay=0:1:2"])
     assert bad.exit_code == 2 and "did you mean 'slider.normal_damping'" in bad.output

@@ -123,7 +123,7 @@ def test_a_chunk_copied_from_another_point_fails(store: Path) -> None:
         ("delete", "checksum"),
         ("truncate", "done"),
         ("delete", "slider.normal_damping"),  # a coordinate
-        ("truncate", "point"),
+        ("truncate", "slider.normal_damping"),
     ],
 )
 def test_damaged_variables_are_reported_and_rebuilt(store: Path, damage: str, name: str) -> None:
@@ -170,7 +170,7 @@ def test_a_store_of_an_older_format_is_refused(store: Path) -> None:
     data = json.loads(meta.read_text())
     del data["attributes"]["store_format"]
     meta.write_text(json.dumps(data))
-    with pytest.raises(SweepError, match="store format 1, this version writes 2"):
+    with pytest.raises(SweepError, match="store format 1, this version writes 3"):
         verify_store(store)
 
 

@@ -5,7 +5,9 @@ The public API::
     import fivdisc
     case = fivdisc.load_case("mycase.toml")             # or fivdisc.Case(...)
     result = fivdisc.simulate(case)                     # result.dataset is an xarray.Dataset
-    fivdisc.linear_stability(case).max_growth_rate      # constant-speed cases
+    print(result.summary())
+    result.to_netcdf("run.nc"); fivdisc.open_result("run.nc") == result
+    print(fivdisc.linear_stability(case))               # constant-speed cases
 
 Plotting lives in :mod:`fivdisc.plots`, parameter sweeps in :mod:`fivdisc.sweep` and the
 paper's cases in :mod:`fivdisc.paper`; they import matplotlib or dask only when used. The
@@ -33,7 +35,7 @@ from fivdisc.case import Case, load_case
 from fivdisc.errors import CaseError, FivdiscError, ModeError, SimulationError
 from fivdisc.model import Model, build_model
 from fivdisc.plate import AnnularPlate, PlateMode
-from fivdisc.result import Result
+from fivdisc.result import Result, Summary, open_result
 from fivdisc.simulate import simulate
 from fivdisc.speed import SpeedProfile
 
@@ -52,6 +54,7 @@ __all__ = [
     "Result",
     "SimulationError",
     "SpeedProfile",
+    "Summary",
     "__version__",
     "build_model",
     "classify",
@@ -60,6 +63,7 @@ __all__ = [
     "find_peaks",
     "linear_stability",
     "load_case",
+    "open_result",
     "perturbation_test",
     "separation_stats",
     "simulate",

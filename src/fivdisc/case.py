@@ -14,7 +14,6 @@ is done elsewhere.
 
 from __future__ import annotations
 
-import difflib
 import itertools
 import json
 import math
@@ -22,7 +21,7 @@ import tomllib
 from collections.abc import Iterator, Mapping
 from os import PathLike
 from pathlib import Path
-from typing import Annotated, Any, ClassVar, Literal, Union
+from typing import Annotated, Any, ClassVar, Literal, NamedTuple, Union
 
 import annotated_types
 import numpy as np
@@ -44,7 +43,7 @@ from pydantic import (
 from pydantic.fields import FieldInfo
 from pydantic_core import ErrorDetails, PydanticCustomError
 
-from fivdisc.errors import CaseError
+from fivdisc.errors import CaseError, nearest
 from fivdisc.files import read_text
 from fivdisc.limits import disc_problem
 
@@ -56,6 +55,7 @@ __all__ = [
     "Disc",
     "ExponentialFriction",
     "Friction",
+    "KeyInfo",
     "Perturbation",
     "Simulation",
     "Slider",
@@ -63,7 +63,9 @@ __all__ = [
     "StribeckFriction",
     "TableFriction",
     "TableSpeed",
+    "describe_key",
     "is_case_key",
+    "keys_like",
     "load_case",
     "unit_of",
 ]
@@ -130,9 +132,13 @@ NonNegative = Annotated[Real, Field(ge=0)]
 SpeedValues = Annotated[tuple[NonNegative, ...], BeforeValidator(_plain)]
 
 
-def _field(default: Any, unit: str = "", **constraints: Any) -> Any:
-    """A pydantic field that records its unit, for error messages."""
-    return Field(default, json_schema_extra={"unit": unit}, **constraints)
+def _field(default: Any, unit: str = "", symbol: str = "", name: str = "",
+           **constraints: Any) -> Any:
+    """A pydantic field that records its unit (for error messages), and its symbol in the
+    paper (matplotlib mathtext, for axis labels) and a name where the key's words are not
+    one (for ``long_name`` attributes); see :func:`describe_key`."""
+    extra = {"unit": unit, "symbol": symbol, "name": name}
+    return Field(default, json_schema_extra=extra, **constraints)
 
 
 def _distinct_modes(modes: tuple[tuple[int, int], ...]) -> tuple[tuple[int, int], ...]:
@@ -237,12 +243,12 @@ class Disc(_Table):
 
     _key: ClassVar[tuple[str, ...]] = ("disc",)
 
-    inner_radius: Real = _field(0.044, "m", gt=0)
-    outer_radius: Real = _field(0.12, "m", gt=0)
-    thickness: Real = _field(0.002, "m", gt=0)
-    density: Real = _field(7200.0, "kg/m^3", gt=0)
-    youngs_modulus: Real = _field(150e9, "Pa", gt=0)
-    poisson_ratio: Real = _field(0.211, gt=-1, lt=0.5)
+    inner_radius: Real = _field(0.044, "m", "a", "disc inner radius", gt=0)
+    outer_radius: Real = _field(0.12, "m", "b", "disc outer radius", gt=0)
+    thickness: Real = _field(0.002, "m", "h", gt=0)
+    density: Real = _field(7200.0, "kg/m^3", r"\rho", gt=0)
+    youngs_modulus: Real = _field(150e9, "Pa", "E", gt=0)
+    poisson_ratio: Real = _field(0.211, "", r"\nu", gt=-1, lt=0.5)
     modes: Annotated[tuple[Mode, ...], AfterValidator(_distinct_modes)] = _field(
         ((0, 0), (0, 1), (0, 2), (0, 3))
     )
@@ -315,14 +321,14 @@ class Slider(_Table):
 
     _key: ClassVar[tuple[str, ...]] = ("slider",)
 
-    track_radius: Real = _field(0.1, "m", gt=0)
-    mass: Real = _field(0.1, "kg", gt=0)
-    normal_stiffness: Real = _field(3e4, "N/m", gt=0)
-    normal_damping: Real = _field(0.1, "N s/m", ge=0)
-    rotational_stiffness: Real = _field(2e3, "N m/rad", gt=0)
-    rotational_damping: Real = _field(0.1, "N m s/rad", ge=0)
-    preload: Real = _field(500.0, "N", ge=0)
-    angle: Real = _field(0.0, "rad")
+    track_radius: Real = _field(0.1, "m", "r_0", gt=0)
+    mass: Real = _field(0.1, "kg", "m", gt=0)
+    normal_stiffness: Real = _field(3e4, "N/m", "k_z", gt=0)
+    normal_damping: Real = _field(0.1, "N s/m", "c_z", ge=0)
+    rotational_stiffness: Real = _field(2e3, "N m/rad", r"r_0^2 k_\phi", gt=0)
+    rotational_damping: Real = _field(0.1, "N m s/rad", r"r_0^2 c_\phi", ge=0)
+    preload: Real = _field(500.0, "N", "N_0", ge=0)
+    angle: Real = _field(0.0, "rad", r"\theta", "slider base angle")
     face: Literal["top", "bottom"] = "top"
 
     @property
@@ -336,7 +342,7 @@ class _FrictionLaw(_Table):
 
     _key: ClassVar[tuple[str, ...]] = ("friction",)
 
-    static: Real = _field(0.8, ge=0)
+    static: Real = _field(0.8, "", r"\mu_s", "static friction coefficient", ge=0)
 
     def kinetic_at_rest(self) -> tuple[tuple[str, float], ...]:
         """(key, value) pairs that the static coefficient may not be below."""
@@ -373,9 +379,10 @@ class ExponentialFriction(_FrictionLaw):
     """
 
     law: Literal["exponential"] = "exponential"
-    kinetic_max: Real = _field(0.6, ge=0)
-    kinetic_min: Real = _field(0.35, ge=0)
-    decay: Real = _field(1.0, "s/m", ge=0)
+    kinetic_max: Real = _field(0.6, "", r"\mu_0", "kinetic friction coefficient at rest", ge=0)
+    kinetic_min: Real = _field(0.35, "", r"\mu_1", "kinetic friction coefficient at high speed",
+                               ge=0)
+    decay: Real = _field(1.0, "s/m", r"\alpha", "friction decay rate", ge=0)
 
     def kinetic_at_rest(self) -> tuple[tuple[str, float], ...]:
         return (("kinetic_max", self.kinetic_max), ("kinetic_min", self.kinetic_min))
@@ -403,11 +410,12 @@ class StribeckFriction(_FrictionLaw):
     """
 
     law: Literal["stribeck"] = "stribeck"
-    kinetic_max: Real = _field(0.6, ge=0)
-    kinetic_min: Real = _field(0.35, ge=0)
-    stribeck_velocity: Real = _field(1.0, "m/s", gt=0)
-    stribeck_exponent: Real = _field(2.0, gt=0)
-    viscous: Real = _field(0.0, "s/m", ge=0)
+    kinetic_max: Real = _field(0.6, "", r"\mu_0", "kinetic friction coefficient at rest", ge=0)
+    kinetic_min: Real = _field(0.35, "", r"\mu_1", "kinetic friction coefficient at high speed",
+                               ge=0)
+    stribeck_velocity: Real = _field(1.0, "m/s", "v_s", gt=0)
+    stribeck_exponent: Real = _field(2.0, "", r"\delta", gt=0)
+    viscous: Real = _field(0.0, "s/m", r"\mu_v", "viscous friction coefficient", ge=0)
 
     def kinetic_at_rest(self) -> tuple[tuple[str, float], ...]:
         return (("kinetic_max", self.kinetic_max), ("kinetic_min", self.kinetic_min))
@@ -468,7 +476,7 @@ class ConstantSpeed(_Table):
     _key: ClassVar[tuple[str, ...]] = ("speed",)
 
     profile: Literal["constant"] = "constant"
-    value: Real = _field(_TWO_PI, "rad/s", ge=0)
+    value: Real = _field(_TWO_PI, "rad/s", r"\Omega_c", "disc speed", ge=0)
 
 
 class DeceleratingSpeed(_Table):
@@ -489,8 +497,8 @@ class DeceleratingSpeed(_Table):
     _key: ClassVar[tuple[str, ...]] = ("speed",)
 
     profile: Literal["decelerating"] = "decelerating"
-    initial: Real = _field(_TWO_PI, "rad/s", ge=0)
-    duration: Real = _field(35.0, "s", gt=0)
+    initial: Real = _field(_TWO_PI, "rad/s", r"\Omega_0", "initial disc speed", ge=0)
+    duration: Real = _field(35.0, "s", r"t_{\max}", "time to stop", gt=0)
 
 
 class AcceleratingSpeed(_Table):
@@ -511,8 +519,8 @@ class AcceleratingSpeed(_Table):
     _key: ClassVar[tuple[str, ...]] = ("speed",)
 
     profile: Literal["accelerating"] = "accelerating"
-    initial: Real = _field(_TWO_PI, "rad/s", ge=0)
-    rate: Real = _field(0.2, "rad/s^2", ge=0)
+    initial: Real = _field(_TWO_PI, "rad/s", r"\Omega_1", "initial disc speed", ge=0)
+    rate: Real = _field(0.2, "rad/s^2", "c", "disc acceleration", ge=0)
 
 
 class TableSpeed(_Table):
@@ -618,8 +626,9 @@ class Perturbation(_Table):
 
     _key: ClassVar[tuple[str, ...]] = ("simulation", "perturbation")
 
-    phi: Real = _field(1e-3, "rad")
-    phi_dot: Real = _field(0.0, "rad/s")
+    phi: Real = _field(1e-3, "rad", r"\Delta\phi", "perturbation of the slider angle")
+    phi_dot: Real = _field(0.0, "rad/s", r"\Delta\dot\phi",
+                          "perturbation of the slider angular velocity")
 
 
 class Simulation(_Table):
@@ -667,7 +676,7 @@ class Simulation(_Table):
 
     _key: ClassVar[tuple[str, ...]] = ("simulation",)
 
-    duration: Real = _field(1.0, "s", gt=0)
+    duration: Real = _field(1.0, "s", "", "simulated time", gt=0)
     output_rate: Real = _field(10000.0, "Hz", gt=0)
     impact: Flag = True
     initial_state: Literal["rest", "equilibrium"] = "rest"
@@ -927,6 +936,17 @@ def is_case_key(key: str) -> bool:
     return _template(key) in _LEAVES
 
 
+def keys_like(key: str) -> list[str]:
+    """The valid keys to suggest for `key`: :meth:`Case.valid_keys`, with the slider keys
+    written ``sliders.J.KEY`` when `key` names slider J that way."""
+    parts = key.split(".")
+    keys = Case.valid_keys()
+    if parts[0] == "sliders" and len(parts) > 2 and parts[1].isdigit():
+        prefix = f"sliders.{parts[1]}."
+        return [prefix + k.split(".", 1)[1] if k.startswith("slider.") else k for k in keys]
+    return keys
+
+
 def _template(key: str) -> str:
     """The key with a slider index removed: ``sliders.2.mass`` -> ``slider.mass``."""
     parts = key.split(".")
@@ -1021,7 +1041,7 @@ _TABLES: frozenset[str] = frozenset([*_TABLE_NAMES, "sliders"]) - {""}
 
 def _unknown_key(key: str, names: list[str] | None = None, profile: str | None = None,
                  law: str | None = None) -> str:
-    """Message for an unknown dotted key, with the nearest valid key if there is one.
+    """Message for an unknown dotted key, ending with the nearest valid key.
 
     Parameters
     ----------
@@ -1044,13 +1064,10 @@ def _unknown_key(key: str, names: list[str] | None = None, profile: str | None =
     if names is None:
         names = _TABLE_NAMES.get(template_table)
     if names is not None:
-        matches = difflib.get_close_matches(name, names, n=1)
-        suggestion = f"{table}.{matches[0]}" if matches and table else (matches or [""])[0]
+        candidates = [f"{table}.{n}" if table else n for n in names]
     else:
         candidates = [*_LEAVES, *_TABLES]
-        suggestion = (difflib.get_close_matches(key, candidates, n=1) or [""])[0]
-    hint = f"; did you mean '{suggestion}'?" if suggestion else ""
-    return f"unknown key '{key}'{hint}"
+    return f"unknown key '{key}'{nearest(key, candidates)}"
 
 
 # --- error messages --------------------------------------------------------------------------
@@ -1251,11 +1268,32 @@ def _describe(exc: ValidationError, root: type[_Table], data: Any = None) -> str
     return "; ".join(messages)
 
 
-def unit_of(key: str) -> str:
-    """Unit of a dotted case key (``"slider.normal_damping"`` -> ``"N s/m"``), "" if none.
+class KeyInfo(NamedTuple):
+    """What :func:`describe_key` knows about a case key: its ``unit`` ("" if
+    dimensionless or not a number), its ``symbol`` in the paper as matplotlib mathtext
+    without the dollars (``c_z``, ``r_0^2 c_\\phi``; "" if it has none) and a
+    ``long_name`` in words (``"slider 1 normal damping"``)."""
 
-    ``sliders.J.KEY`` is the unit of ``slider.KEY``; the keys of every speed profile
-    and friction law are known.
+    unit: str
+    symbol: str
+    long_name: str
+
+
+_TABLE_WORDS = {"disc": "disc", "friction": "friction", "speed": "", "simulation": "",
+                "simulation.perturbation": ""}
+
+
+def describe_key(key: str) -> KeyInfo:
+    """Unit, symbol and description of a dotted case key.
+
+    ``sliders.J.KEY`` is described as ``slider.KEY`` of slider J; the keys of every speed
+    profile and friction law are known (a key of two profiles, ``speed.initial``, takes
+    the first one's symbol). An unknown key gives its own words and no unit.
+
+    Parameters
+    ----------
+    key
+        E.g. ``"slider.normal_damping"`` -> ``("N s/m", "c_z", "slider normal damping")``.
     """
     table, _, name = _template(key).rpartition(".")
     models = {
@@ -1266,8 +1304,30 @@ def unit_of(key: str) -> str:
         "simulation": (Simulation,),
         "simulation.perturbation": (Perturbation,),
     }.get(table, ())
+    extra: dict[str, str] = {}
     for model in models:
         field = model.model_fields.get(name)
         if field is not None:
-            return str((field.json_schema_extra or {}).get("unit", ""))
-    return ""
+            extra = dict(field.json_schema_extra or {})
+            break
+    words = extra.get("name") or name.replace("_", " ")
+    if table == "slider":
+        parts = key.split(".")
+        owner = f"slider {parts[1]}" if parts[0] == "sliders" else "slider"
+    else:
+        owner = _TABLE_WORDS.get(table, table)
+    head = owner.split(" ")[0]
+    if head and head in words.split(" "):
+        words = words.replace(head, owner, 1)
+    elif owner:
+        words = f"{owner} {words}"
+    return KeyInfo(extra.get("unit", ""), extra.get("symbol", ""), words)
+
+
+def unit_of(key: str) -> str:
+    """Unit of a dotted case key (``"slider.normal_damping"`` -> ``"N s/m"``), "" if none.
+
+    ``sliders.J.KEY`` is the unit of ``slider.KEY``; the keys of every speed profile
+    and friction law are known.
+    """
+    return describe_key(key).unit

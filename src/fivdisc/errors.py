@@ -1,4 +1,10 @@
-"""Exceptions that carry a message a user can act on."""
+"""Exceptions that carry a message a user can act on, and the hint naming the nearest
+valid name that every message about an unknown key or name ends with."""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Iterable
 
 
 class FivdiscError(Exception):
@@ -15,3 +21,30 @@ class ModeError(FivdiscError, ValueError):
 
 class SimulationError(FivdiscError, RuntimeError):
     """A simulation could not start (bad initial state, no equilibrium, ...)."""
+
+
+def nearest(name: str, names: Iterable[str]) -> str:
+    """The valid name closest to `name`, as the end of a message: ``"; did you mean
+    'slider.mass'?"`` ("" if there are no names).
+
+    Dotted names are compared whole and by their last part, so that ``dcay`` finds
+    ``friction.decay``; the closest is named however far it is.
+
+    Parameters
+    ----------
+    name
+        The unknown name.
+    names
+        The valid ones.
+    """
+    candidates = list(dict.fromkeys(names))
+    if not candidates:
+        return ""
+
+    def likeness(candidate: str) -> float:
+        whole = difflib.SequenceMatcher(None, name, candidate).ratio()
+        last = difflib.SequenceMatcher(None, name.rsplit(".", 1)[-1],
+                                       candidate.rsplit(".", 1)[-1]).ratio()
+        return max(whole, last)
+
+    return f"; did you mean '{max(candidates, key=likeness)}'?"

@@ -1,16 +1,21 @@
-"""Matplotlib figures of simulation results (the paper's Figs. 4-26).
+"""Matplotlib figures of simulation results (the paper's Figs. 4-26) and stability maps.
 
 Every function draws into ``ax`` (a new figure when None) and returns the Figure
 without showing it. ``window`` is a time window ``(t0, t1)`` [s]; either end may be
 None for the start or end of the record. Axis labels are the variables' ``long_name``
-and ``units`` attributes. Matplotlib is imported only when a figure is drawn.
+and ``units`` attributes; titles name the case (its ``case_name``, see
+:meth:`fivdisc.Result.named`) and what is drawn. :func:`plot_kind` draws what
+``fivdisc plot --kind KIND`` draws. Matplotlib (the ``plot`` extra) is imported only when
+a figure is drawn.
 """
 
 from __future__ import annotations
 
+import functools
 import os
 import sys
-from typing import TYPE_CHECKING
+from collections.abc import Callable
+from typing import TYPE_CHECKING, ParamSpec, TypeVar
 
 import numpy as np
 import xarray as xr
@@ -30,6 +35,7 @@ from fivdisc.analysis.trajectories import (
     phase_portrait,
     separation_intervals,
 )
+from fivdisc.conventions import axis_label
 from fivdisc.result import select_slider
 
 if TYPE_CHECKING:
@@ -37,15 +43,43 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 __all__ = [
+    "KINDS",
+    "default_segment",
     "plot_friction",
+    "plot_kind",
     "plot_normal_force",
     "plot_phase_portrait",
     "plot_spectrogram",
     "plot_spectrum",
+    "plot_stability_map",
     "plot_timeseries",
 ]
 
 Window = tuple[float | None, float | None] | None
+P = ParamSpec("P")
+R = TypeVar("R")
+
+#: The kinds of figure of a simulation result (``fivdisc plot --kind``).
+KINDS = ("timeseries", "spectrogram", "spectrum", "phase", "friction", "normal-force")
+# Default spectrogram segments: at least this many per record, and frequency bins at
+# most this fraction of the frequency range shown.
+_SEGMENTS_PER_RECORD = 100
+_BINS_PER_RANGE = 50
+# Average width of a character of the default font, in units of its size (for wrapping).
+_CHAR_WIDTH = 0.6
+
+
+def _drawing(function: Callable[P, R]) -> Callable[P, R]:
+    """A function that draws: it checks for matplotlib (the plot extra) before any work."""
+
+    @functools.wraps(function)
+    def checked(*args: P.args, **kwargs: P.kwargs) -> R:
+        from fivdisc.extras import require
+
+        require("plot", "fivdisc.plots")
+        return function(*args, **kwargs)
+
+    return checked
 
 
 def _axes(ax: Axes | None) -> tuple[Figure, Axes]:
@@ -83,18 +117,98 @@ def _bounds(window: Window) -> tuple[float | None, float | None]:
     return t0, t1
 
 
-def _where(da: xr.DataArray) -> str:
-    """Title naming the probe or modal coordinate a 1-D series was taken at."""
+def _where(da: xr.DataArray | xr.Dataset) -> str:
+    """Which slider, probe or modal coordinate a series was taken at, for titles."""
+    parts = []
+    if "slider" in da.coords and da["slider"].ndim == 0:
+        parts.append(f"slider {int(da['slider'])}")
     if "probe" in da.coords and da["probe"].ndim == 0:
-        parts = [f"probe {int(da['probe'])}"]
+        probe = f"probe {int(da['probe'])}"
         if "probe_r" in da.coords and "probe_theta" in da.coords:
-            parts.append(f"r = {float(da['probe_r']):g} m, θ = {float(da['probe_theta']):g} rad")
-        return ": ".join(parts)
+            probe += f" (r = {float(da['probe_r']):g} m, θ = {float(da['probe_theta']):g} rad)"
+        parts.append(probe)
     if "coordinate" in da.coords and da["coordinate"].ndim == 0:
-        return f"coordinate {da['coordinate'].item()}"
-    return ""
+        parts.append(f"coordinate {da['coordinate'].item()}")
+    return ", ".join(parts)
 
 
+def _title(ax: Axes, ds: xr.Dataset, what: str, where: str = "", detail: str = "") -> None:
+    """Title: the case's name and what is drawn; the run and where; a detail."""
+    name = str(ds.attrs.get("case_name", ""))
+    title = str(ds.attrs.get("title", ""))
+    run = title.split(": ", 1)[1] if ": " in title else ""
+    lines = [f"{name}: {what}" if name else what, "; ".join(p for p in (run, where) if p),
+             detail]
+    ax.set_title(_fit(ax, "\n".join(line for line in lines if line), "medium"),
+                 fontsize="medium")
+
+
+def _fit(ax: Axes, text: str, size: str) -> str:
+    """`text` wrapped to the width of `ax` (at font `size`), never inside $math$."""
+    import textwrap
+
+    from matplotlib.font_manager import FontProperties
+
+    points = FontProperties(size=size).get_size_in_points()
+    width = ax.get_position().width * ax.figure.get_figwidth() * 72.0  # [pt]
+    chars = max(20, int(width / (_CHAR_WIDTH * points)))
+    # Spaces inside $...$ are kept from the line breaks.
+    parts = text.split("$")
+    parts[1::2] = [part.replace(" ", "\0") for part in parts[1::2]]
+    wrapped = "\n".join(textwrap.fill(line, chars, break_on_hyphens=False)
+                         for line in "$".join(parts).split("\n"))
+    return wrapped.replace("\0", " ")
+
+
+def _nyquist(ds: xr.Dataset) -> float:
+    """Half the sampling rate of a result [Hz]."""
+    time = ds["time"].values
+    return 0.5 * (time.size - 1) / (time[-1] - time[0])
+
+
+def check_fmax(fmax: float | None, nyquist: float, name: str = "fmax") -> None:
+    """Refuse a highest frequency that is not positive or lies above the Nyquist frequency.
+
+    Parameters
+    ----------
+    fmax
+        The frequency [Hz], or None (no limit).
+    nyquist
+        Half the sampling rate of the data [Hz].
+    name
+        The parameter or option, for the message.
+
+    Raises
+    ------
+    AnalysisError
+        One line naming `name`, its value and the allowed range.
+    """
+    if fmax is None:
+        return
+    if not 0 < fmax <= nyquist * (1 + 1e-9):
+        raise AnalysisError(f"{name} = {fmax:g} [Hz] is invalid: must be in (0, {nyquist:g}] "
+                            "Hz, up to the Nyquist frequency (half the output rate)")
+
+
+def default_segment(duration: float, fmax: float) -> float:
+    """Default STFT segment of a spectrogram [s], from the record and the frequencies shown.
+
+    Long enough that the frequency bins (1 / segment) are at most 1/50 of the range shown,
+    and short enough for at least 100 segments per record, whichever is longer; never
+    more than a quarter of the record. Two significant digits.
+
+    Parameters
+    ----------
+    duration
+        Length of the record [s].
+    fmax
+        Highest frequency shown [Hz].
+    """
+    segment = min(max(_BINS_PER_RANGE / fmax, duration / _SEGMENTS_PER_RECORD), duration / 4)
+    return float(f"{segment:.2g}")
+
+
+@_drawing
 def plot_timeseries(data: xr.Dataset | object, var: str, probe: int | None = None,
                     window: Window = None, ax: Axes | None = None) -> Figure:
     """Time history of one variable (paper Figs. 8a, 9a, 12).
@@ -112,7 +226,8 @@ def plot_timeseries(data: xr.Dataset | object, var: str, probe: int | None = Non
     ax : matplotlib Axes, optional
         Where to draw.
     """
-    da = series(data, var, probe, *_bounds(window))
+    ds = as_dataset(data)
+    da = series(ds, var, probe, *_bounds(window))
     fig, ax = _axes(ax)
     if "flag_values" in da.attrs:
         ax.step(da["time"].values, da.values, where="post")
@@ -123,12 +238,13 @@ def plot_timeseries(data: xr.Dataset | object, var: str, probe: int | None = Non
         ax.plot(da["time"].values, da.values, lw=0.8)
     ax.set_xlabel(_label(da["time"], "time"))
     ax.set_ylabel(_label(da, var))
-    ax.set_title(_where(da))
+    _title(ax, ds, str(da.attrs.get("long_name", var)), _where(da))
     return fig
 
 
+@_drawing
 def plot_spectrogram(data: xr.Dataset | object, var: str = "phi", probe: int | None = None,
-                     window: Window = None, segment: float = 0.05, overlap: float = 0.75,
+                     window: Window = None, segment: float | None = None, overlap: float = 0.75,
                      taper: str | tuple = "hann", fmax: float | None = None,
                      dynamic_range: float = 60.0, ax: Axes | None = None) -> Figure:
     """Time-frequency plot: STFT magnitude on a log colour scale (paper Figs. 8b, 9b).
@@ -143,41 +259,52 @@ def plot_spectrogram(data: xr.Dataset | object, var: str = "phi", probe: int | N
         Index along the variable's second dimension.
     window : (float, float), optional
         Time window [s].
-    segment, overlap, taper
-        Segment length [s], overlap fraction and scipy window of
-        :func:`fivdisc.analysis.spectra.stft`.
+    segment : float, optional
+        STFT segment length [s]; default :func:`default_segment` of the window's length
+        and the frequencies shown.
+    overlap, taper
+        Overlap fraction and scipy window of :func:`fivdisc.analysis.spectra.stft`.
     fmax : float, optional
-        Highest frequency shown [Hz]; default the Nyquist frequency.
+        Highest frequency shown [Hz], up to the Nyquist frequency (the default).
     dynamic_range : float
         Magnitudes more than this below the maximum share the lowest colour [dB], > 0.
     ax : matplotlib Axes, optional
         Where to draw.
     """
-    from matplotlib.colors import LogNorm
-
     if not dynamic_range > 0:
         raise AnalysisError(f"dynamic_range = {dynamic_range!r} [dB] is invalid: must be > 0")
+    ds = as_dataset(data)
     t0, t1 = _bounds(window)
-    mag = stft(data, var, probe, window=taper, segment=segment, overlap=overlap, t0=t0, t1=t1)
+    nyquist = _nyquist(ds)
+    check_fmax(fmax, nyquist)
+    if segment is None:
+        span = time_window(ds[["time"]], t0, t1)["time"].values
+        segment = default_segment(float(span[-1] - span[0]), fmax or nyquist)
+    mag = stft(ds, var, probe, window=taper, segment=segment, overlap=overlap, t0=t0, t1=t1)
     if fmax is not None:
-        if not fmax > 0:
-            raise AnalysisError(f"fmax = {fmax!r} [Hz] is invalid: must be > 0")
         mag = mag.sel(frequency=slice(None, fmax))
     top = float(mag.max())
     fig, ax = _axes(ax)
+    from matplotlib.colors import LogNorm
+
     if top > 0:
         norm = LogNorm(vmin=top * 10 ** (-dynamic_range / 20), vmax=top, clip=True)
     else:
         norm = None
     mesh = ax.pcolormesh(mag["time"].values, mag["frequency"].values, mag.values.T,
                          shading="nearest", norm=norm, rasterized=True)
-    fig.colorbar(mesh, ax=ax, label=_label(mag, "STFT magnitude"))
+    units = mag.attrs.get("units", "")
+    fig.colorbar(mesh, ax=ax, label=f"magnitude [{units}]" if units and units != "1"
+                 else "magnitude")
     ax.set_xlabel(_label(mag["time"], "time"))
     ax.set_ylabel(_label(mag["frequency"], "frequency"))
-    ax.set_title(_where(mag))
+    long_name = ds[var].attrs.get("long_name", var)
+    _title(ax, ds, f"spectrogram of {long_name}", _where(mag),
+           f"{segment:g} s segments ({1 / segment:.3g} Hz bins)")
     return fig
 
 
+@_drawing
 def plot_spectrum(data: xr.Dataset | object, var: str = "phi", probe: int | None = None,
                   window: Window = None, taper: str | tuple = "hann", n_peaks: int = 10,
                   min_rel_height: float = 0.05, fmax: float | None = None,
@@ -199,12 +326,15 @@ def plot_spectrum(data: xr.Dataset | object, var: str = "phi", probe: int | None
     n_peaks, min_rel_height
         Passed to :func:`fivdisc.analysis.spectra.find_peaks`.
     fmax : float, optional
-        Highest frequency shown and searched for peaks [Hz]; default the Nyquist frequency.
+        Highest frequency shown and searched for peaks [Hz], up to the Nyquist frequency
+        (the default).
     ax : matplotlib Axes, optional
         Where to draw.
     """
+    ds = as_dataset(data)
+    check_fmax(fmax, _nyquist(ds))
     t0, t1 = _bounds(window)
-    spec = spectrum(data, var, probe, t0, t1, window=taper)
+    spec = spectrum(ds, var, probe, t0, t1, window=taper)
     peaks = find_peaks(spec, n=n_peaks, min_rel_height=min_rel_height, fmax=fmax)
     verdict = classify(peaks)
     fig, ax = _axes(ax)
@@ -212,22 +342,40 @@ def plot_spectrum(data: xr.Dataset | object, var: str = "phi", probe: int | None
     if fmax is not None:
         shown &= spec.frequencies <= fmax
     ax.semilogy(spec.frequencies[shown], spec.amplitude[shown], lw=0.8)
-    ax.plot(peaks.frequencies, peaks.amplitudes, "v", color="C3", label="refined peaks")
-    for f, a in zip(peaks.frequencies, peaks.amplitudes, strict=True):
-        ax.annotate(f"{f:.1f}", (f, a), textcoords="offset points", xytext=(0, 6),
-                    ha="center", fontsize="x-small")
+    ax.plot(peaks.frequencies, peaks.amplitudes, "v", color="C3", label="refined peaks [Hz]")
     if len(peaks):
         top = float(peaks.amplitudes.max())
-        ax.set_ylim(top * 1e-4, top * 3)
+        ax.set_ylim(top * 1e-4, top * 5)
+    ax.set_xlim(0.0, float(spec.frequencies[shown][-1]) if shown.any() else fmax)
+    _label_peaks(ax, peaks.frequencies, peaks.amplitudes)
     units = f" [{spec.units}]" if spec.units and spec.units != "1" else ""
-    ax.set_ylabel(f"amplitude of {spec.long_name}{units}")
+    ax.set_ylabel(f"amplitude{units}")
     ax.set_xlabel("frequency [Hz]")
-    ax.set_title(f"{spec.name}\n{verdict.summary}", fontsize="small")
+    _title(ax, ds, f"spectrum of {spec.long_name}", _where(series(ds, var, probe)),
+           verdict.summary)
     if len(peaks):
         ax.legend(loc="upper right", fontsize="small")
     return fig
 
 
+def _label_peaks(ax: Axes, frequencies: np.ndarray, amplitudes: np.ndarray) -> None:
+    """Write each peak's frequency above it, strongest first, leaving out a label that
+    would overlap one already written or leave the axes."""
+    renderer = ax.figure.canvas.get_renderer()
+    inside = ax.get_window_extent(renderer)
+    written = []
+    for f, a in zip(frequencies, amplitudes, strict=True):
+        label = ax.annotate(f"{f:.1f}", (f, a), textcoords="offset points", xytext=(0, 5),
+                            ha="center", fontsize="x-small")
+        box = label.get_window_extent(renderer)
+        if any(box.overlaps(other) for other in written) or not (
+                inside.x0 <= box.x0 and box.x1 <= inside.x1 and box.y1 <= inside.y1):
+            label.remove()
+        else:
+            written.append(box)
+
+
+@_drawing
 def plot_phase_portrait(data: xr.Dataset | object, window: Window = None,
                         ax: Axes | None = None, slider: int = 0) -> Figure:
     """Slider angular velocity against angle (paper Fig. 17a, c, e, ...).
@@ -243,10 +391,11 @@ def plot_phase_portrait(data: xr.Dataset | object, window: Window = None,
     slider : int
         Which slider (from 0).
     """
-    return _trajectory(phase_portrait(data, *_bounds(window), slider=slider), "phi", "phi_dot",
-                       ax)
+    ds = phase_portrait(data, *_bounds(window), slider=slider)
+    return _trajectory(ds, "phi", "phi_dot", "phase portrait of the slider", ax)
 
 
+@_drawing
 def plot_friction(data: xr.Dataset | object, window: Window = None,
                   ax: Axes | None = None, slider: int = 0) -> Figure:
     """Friction force against relative angular velocity (paper Fig. 17b, d, f, ...).
@@ -263,18 +412,22 @@ def plot_friction(data: xr.Dataset | object, window: Window = None,
         Which slider (from 0).
     """
     ds = friction_trajectory(data, *_bounds(window), slider=slider)
-    return _trajectory(ds, "relative_velocity", "friction_force", ax)
+    return _trajectory(ds, "relative_velocity", "friction_force",
+                       "friction force against sliding speed", ax)
 
 
-def _trajectory(ds: xr.Dataset, x: str, y: str, ax: Axes | None) -> Figure:
+def _trajectory(ds: xr.Dataset, x: str, y: str, what: str, ax: Axes | None) -> Figure:
     """One variable of ``ds`` against another, labelled with names and units."""
     fig, ax = _axes(ax)
     ax.plot(ds[x].values, ds[y].values, lw=0.8)
     ax.set_xlabel(_label(ds[x], x))
     ax.set_ylabel(_label(ds[y], y))
+    time = ds["time"].values
+    _title(ax, ds, what, _where(ds), f"{time[0]:g} s to {time[-1]:g} s")
     return fig
 
 
+@_drawing
 def plot_normal_force(data: xr.Dataset | object, window: Window = None,
                       ax: Axes | None = None, slider: int = 0) -> Figure:
     """Normal contact force with separation intervals shaded (paper Figs. 18, 19, 24).
@@ -301,14 +454,78 @@ def plot_normal_force(data: xr.Dataset | object, window: Window = None,
         ax.legend(loc="upper right", fontsize="small")
     ax.set_xlabel(_label(ds["time"], "time"))
     ax.set_ylabel(_label(force, "normal_force"))
+    _title(ax, ds, str(force.attrs.get("long_name", "normal force")), _where(ds))
     return fig
 
 
+@_drawing
+def plot_kind(data: xr.Dataset | object, kind: str = "timeseries", var: str | None = None,
+              probe: int | None = None, slider: int = 0, window: Window = None,
+              fmax: float | None = None, segment: float | None = None,
+              ax: Axes | None = None) -> Figure:
+    """The figure ``fivdisc plot --kind KIND`` draws (and :meth:`fivdisc.Result.plot`).
+
+    Parameters
+    ----------
+    data : xarray.Dataset or Result
+        Simulation result.
+    kind : str
+        One of :data:`KINDS`: ``timeseries``, ``spectrogram`` and ``spectrum`` of `var`;
+        ``phase`` (portrait), ``friction`` (against sliding speed) and ``normal-force``
+        of the slider.
+    var : str, optional
+        Variable of timeseries, spectrogram and spectrum [default: ``"phi"``].
+    probe : int, optional
+        Index along the variable's second dimension (``w``: probe).
+    slider : int
+        Which slider (from 0).
+    window : (float, float), optional
+        Time window [s].
+    fmax : float, optional
+        Highest frequency of spectrogram and spectrum [Hz].
+    segment : float, optional
+        STFT segment of spectrogram [s] (default: :func:`default_segment`).
+    ax : matplotlib Axes, optional
+        Where to draw.
+
+    Raises
+    ------
+    AnalysisError
+        An unknown kind, or an option the kind does not use.
+    """
+    if kind not in KINDS:
+        raise AnalysisError(f"kind = {kind!r} is invalid: must be one of {', '.join(KINDS)}")
+    spectral = ("spectrogram", "spectrum")
+    unused = [name for name, value, users in (
+        ("var", var, ("timeseries", *spectral)), ("probe", probe, ("timeseries", *spectral)),
+        ("fmax", fmax, spectral), ("segment", segment, ("spectrogram",)))
+        if value is not None and kind not in users]
+    if unused:
+        raise AnalysisError(f"{unused[0]} is not used by kind = {kind!r}: leave it out")
+    ds = select_slider(as_dataset(data), slider)
+    name = "phi" if var is None else var
+    if kind == "timeseries":
+        return plot_timeseries(ds, name, probe, window, ax=ax)
+    if kind == "spectrogram":
+        return plot_spectrogram(ds, name, probe, window, segment=segment, fmax=fmax, ax=ax)
+    if kind == "spectrum":
+        return plot_spectrum(ds, name, probe, window, fmax=fmax, ax=ax)
+    if kind == "phase":
+        return plot_phase_portrait(ds, window, ax=ax)
+    if kind == "friction":
+        return plot_friction(ds, window, ax=ax)
+    return plot_normal_force(ds, window, ax=ax)
+
+
+@_drawing
 def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None) -> Figure:
     """Stability map of :func:`fivdisc.analysis.stability.stability_map` (paper Fig. 3).
 
-    With one curve the map is shaded by the sign of the largest growth rate; with several,
-    only their boundary curves are drawn ('stable' lies above each curve).
+    With one map (no ``curve_key``) the grid is shaded stable against unstable. With
+    several, each value of the third key draws its boundary curve and shades the region
+    where it is stable, in its colour; values whose boundary lies outside the grid are
+    listed under the legend instead. Axes are labelled with the keys' descriptions,
+    symbols and units.
 
     Parameters
     ----------
@@ -318,21 +535,43 @@ def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None) -> Figure:
         Where to draw.
     """
     fig, ax = _axes(ax)
-    x, y = ds["x"].values, ds["y"].values
-    if ds.sizes["curve"] == 1:
-        ax.contourf(x, y, ds["stable"].values[0], levels=[-0.5, 0.5, 1.5],
+    xkey, ykey = ds.attrs["x_key"], ds.attrs["y_key"]
+    ckey = ds.attrs.get("curve_key", "")
+    absent: list[str] = []
+    x, y = ds[xkey].values, ds[ykey].values
+    if not ckey:
+        ax.contourf(x, y, ds["stable"].transpose(ykey, xkey).values, levels=[-0.5, 0.5, 1.5],
                     colors=["#f4c7c3", "#c6e5c3"])
         ax.plot([], [], color="#c6e5c3", lw=8, label="stable")
         ax.plot([], [], color="#f4c7c3", lw=8, label="unstable")
-    for i, value in enumerate(ds["curve"].values):
-        label = f"{ds.attrs['curve_key']} = {value:g}" if ds.attrs["curve_key"] else "boundary"
-        ax.plot(x, ds["boundary"].values[i], lw=1.5, label=label)
-    from fivdisc.case import unit_of
-
-    for key, set_label in ((ds.attrs["x_key"], ax.set_xlabel), (ds.attrs["y_key"], ax.set_ylabel)):
-        unit = unit_of(key)
-        set_label(f"{key} [{unit}]" if unit else key)
+        if np.isfinite(ds["boundary"].values).any():
+            ax.plot(x, ds["boundary"].values, color="k", lw=1.5, label="boundary")
+    else:
+        coord = ds[ckey]
+        symbol = coord.attrs.get("symbol", "")
+        units = coord.attrs.get("units", "")
+        unit = f" {units}" if units and units != "1" else ""
+        for value in coord.values:
+            one = ds.sel({ckey: value})
+            text = f"${symbol}$ = {value:g}{unit}" if symbol else f"{ckey} = {value:g}{unit}"
+            boundary = one["boundary"].values
+            if not np.isfinite(boundary).any():
+                stable = one["stable"].values.astype(bool)
+                state = ("stable throughout" if stable.all() else "unstable throughout"
+                         if not stable.any() else "unstable at the top")
+                absent.append(f"{text} ({state})")
+                continue
+            (line,) = ax.plot(x, boundary, lw=1.5, label=f"{text}, stable above")
+            ax.contourf(x, y, one["stable"].transpose(ykey, xkey).values, levels=[0.5, 1.5],
+                        colors=[line.get_color()], alpha=0.15)
+    ax.set_xlabel(axis_label(ds[xkey]))
+    ax.set_ylabel(axis_label(ds[ykey]))
     ax.set_xlim(x[0], x[-1])
     ax.set_ylim(y[0], y[-1])
-    ax.legend(loc="best", fontsize="small")
+    if ax.get_legend_handles_labels()[1]:
+        ax.legend(loc="best", fontsize="small")
+    what = ("sliding equilibrium stable above each boundary (shaded)" if ckey
+            else "stability of the sliding equilibrium")
+    _title(ax, ds, what, detail="no boundary in the grid: " + ", ".join(absent) if absent
+           else "")
     return fig

@@ -1,14 +1,33 @@
-"""Simulation results: an :class:`xarray.Dataset` with units, events, status and statistics."""
+"""Simulation results: an :class:`xarray.Dataset` with units, events, status and statistics.
+
+A result dataset follows the CF conventions (see :mod:`fivdisc.conventions`): every
+variable has ``units`` and ``long_name``, the time coordinate ``standard_name`` and
+``axis``, the phases ``flag_values`` and ``flag_meanings``. :func:`open_result` reads a
+saved result back, equal to the run that wrote it.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from os import PathLike
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import xarray as xr
 
+from fivdisc.errors import FivdiscError
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.figure import Figure
+
+    from fivdisc.case import Case
+    from fivdisc.speed import SpeedProfile
+
 PHASE_NAMES = ("slip", "stick", "separation")
+# Run attributes that are arrays (one entry per slider or state component).
+_ARRAY_ATTRS = ("final_phase", "final_state")
 EVENT_KINDS = ("stick", "slip", "reversal", "separation", "recontact")
 
 
@@ -101,7 +120,7 @@ def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarr
             "work done since t = 0 by each kind of force (impact terms: sum of the jumps)",
         )
     coords = {
-        "time": _var("time", times, "s", "time"),
+        "time": _var("time", times, "s", "time", standard_name="time", axis="T"),
         "coordinate": ("coordinate", list(model.labels),
                        {"units": "1", "long_name": "modal coordinate (C/D, k, l)"}),
         "k": _var("coordinate", model.k, "1", "nodal circles"),
@@ -120,7 +139,40 @@ def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarr
     if "energy_work" in data:
         coords["energy_term"] = ("energy_term", list(ENERGY_NAMES),
                                  {"units": "1", "long_name": "kind of force"})
+    from fivdisc.conventions import global_attrs
+
+    title = f"fivdisc simulation: {describe_run(model.case, model.speed)}"
+    attrs = {**global_attrs(title, "fivdisc.simulate"), "case_name": "", **attrs}
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def describe_run(case: Case, speed: SpeedProfile | None = None) -> str:
+    """A short description of a run: sliders, disc speed and duration.
+
+    Parameters
+    ----------
+    case
+        The case.
+    speed
+        The speed profile the run used, if it overrides the case's.
+    """
+    from fivdisc.speed import SpeedProfile
+
+    table = case.speed
+    own = SpeedProfile.from_case(table)
+    if speed is not None and not (np.array_equal(speed.knots, own.knots)
+                                  and np.array_equal(speed.coefficients, own.coefficients)):
+        how = "disc speed given as a function of time"
+    elif table.profile == "constant":
+        how = f"disc at {table.value:.4g} rad/s"
+    elif table.profile == "decelerating":
+        how = f"disc slowing from {table.initial:.4g} rad/s to rest in {table.duration:g} s"
+    elif table.profile == "accelerating":
+        how = f"disc speeding up from {table.initial:.4g} rad/s at {table.rate:g} rad/s^2"
+    else:
+        how = "disc speed from a table"
+    count = len(case.sliders)
+    return f"{count} slider{'s' if count > 1 else ''}, {how}, {case.simulation.duration:g} s"
 
 
 def select_slider(ds: xr.Dataset, slider: int = 0) -> xr.Dataset:
@@ -154,8 +206,110 @@ def select_slider(ds: xr.Dataset, slider: int = 0) -> xr.Dataset:
 
 
 @dataclass(frozen=True)
+class SliderSummary:
+    """What one slider did in a run (see :class:`Summary`).
+
+    Attributes
+    ----------
+    time_in_phase : dict
+        Phase name (slip, stick, separation) -> time spent in it [s], from the output
+        samples.
+    separations : int
+        Times the slider left the disc.
+    peak_normal_force : float
+        Largest normal contact force [N] (nan if no sample).
+    """
+
+    time_in_phase: dict[str, float]
+    separations: int
+    peak_normal_force: float
+
+
+@dataclass(frozen=True)
+class Summary:
+    """The numbers that sum up a run, as :meth:`Result.summary` returns them.
+
+    ``str(summary)`` is what ``fivdisc simulate`` prints; :meth:`to_dataframe` gives one
+    row per slider.
+
+    Attributes
+    ----------
+    status : str
+        ``"success"``, ``"stopped"`` or a failure name (see :attr:`Result.status`).
+    end_time : float
+        Simulated time reached [s].
+    sliders : tuple of SliderSummary
+        Per slider, in order.
+    switches : int
+        Phase switches of all sliders.
+    impacts : int
+        Plastic impacts at re-contact (0 when ``simulation.impact`` is off).
+    max_abs_w : float
+        Largest |w| at the probes [m].
+    wall_time : float
+        Time the integration took [s], without compiling or loading the kernel.
+    """
+
+    status: str
+    end_time: float
+    sliders: tuple[SliderSummary, ...]
+    switches: int
+    impacts: int
+    max_abs_w: float
+    wall_time: float
+
+    @property
+    def separations(self) -> int:
+        """Separations of all sliders."""
+        return sum(s.separations for s in self.sliders)
+
+    @property
+    def peak_normal_force(self) -> float:
+        """Largest normal contact force of any slider [N]."""
+        return max(s.peak_normal_force for s in self.sliders)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The summary as plain Python values (``sliders`` a list of dicts)."""
+        return asdict(self)
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """One row per slider: time in each phase [s], separations, peak normal force [N]."""
+        import pandas as pd
+
+        rows = [{**{f"{k} [s]": v for k, v in s.time_in_phase.items()},
+                 "separations": s.separations, "peak normal force [N]": s.peak_normal_force}
+                for s in self.sliders]
+        return pd.DataFrame(rows, index=pd.RangeIndex(len(rows), name="slider"))
+
+    def lines(self) -> list[str]:
+        """The summary as lines of text (what ``str()`` joins)."""
+        several = len(self.sliders) > 1
+        out = [f"status: {self.status} at t = {self.end_time:.6g} s"]
+        for j, s in enumerate(self.sliders):
+            spent = ", ".join(f"{k} {v:.4g} s" for k, v in s.time_in_phase.items())
+            out.append(f"{f'slider {j} ' if several else ''}time in phase: {spent}")
+        out.append(f"switches: {self.switches}, separations: {self.separations}, "
+                   f"impacts: {self.impacts}")
+        peaks = ", ".join(f"{s.peak_normal_force:.6g}" for s in self.sliders)
+        out.append(f"peak normal force: {peaks} N, largest |w| at probes: "
+                   f"{self.max_abs_w:.6g} m")
+        out.append(f"wall time: {self.wall_time:.3g} s (integration only, without compiling "
+                   "the kernel)")
+        return out
+
+    def __str__(self) -> str:
+        return "\n".join(self.lines())
+
+    def _repr_pretty_(self, printer: Any, cycle: bool) -> None:  # IPython, Jupyter
+        printer.text(str(self))
+
+
+@dataclass(frozen=True)
 class Result:
-    """Outcome of :func:`fivdisc.simulate`.
+    """Outcome of :func:`fivdisc.simulate`, or of :func:`open_result` on a saved one.
+
+    Results compare equal, pickle and round-trip through netCDF (:meth:`to_netcdf`,
+    :func:`open_result`) unchanged.
 
     Attributes
     ----------
@@ -164,6 +318,44 @@ class Result:
     """
 
     dataset: xr.Dataset
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Result) and self.dataset.identical(other.dataset)
+
+    __hash__ = None  # type: ignore[assignment]  # mutable content
+
+    def __repr__(self) -> str:
+        ds = self.dataset
+        name = ds.attrs.get("case_name") or "run"
+        return (f"<fivdisc.Result {name}: {self.status}, {ds.attrs.get('end_time', np.nan):.6g}"
+                f" s simulated, {ds.sizes.get('slider', 1)} slider(s), {ds.sizes['time']} "
+                f"samples, {ds.sizes.get('event', 0)} events>")
+
+    def __str__(self) -> str:
+        title = self.dataset.attrs.get("title", "fivdisc simulation")
+        return f"{self!r}\n{title}\n{self.summary()}"
+
+    def _repr_pretty_(self, printer: Any, cycle: bool) -> None:  # IPython, Jupyter
+        printer.text(str(self))
+
+    @property
+    def name(self) -> str:
+        """Name of the case (its file or example), "" if not named (see :meth:`named`)."""
+        return str(self.dataset.attrs.get("case_name", ""))
+
+    def named(self, name: str) -> Result:
+        """The same result with the case's name (e.g. its file's stem) in its title.
+
+        Parameters
+        ----------
+        name
+            The name, e.g. ``"fig10"``; plots and ``repr`` show it.
+        """
+        ds = self.dataset.copy()
+        title = str(ds.attrs.get("title", "fivdisc simulation"))
+        what = title.split(": ", 1)[-1]
+        ds.attrs.update(case_name=name, title=f"fivdisc simulation of {name}: {what}")
+        return Result(ds)
 
     @property
     def status(self) -> str:
@@ -190,42 +382,121 @@ class Result:
             raise ValueError(f"kind = {kind!r} is invalid: must be one of {EVENT_KINDS}")
         return times[ds["event_kind"].values == kind]
 
-    def summary(self) -> dict:
-        """Time in each phase [s], switches, separations, impacts, peak normal force [N],
-        largest |w| at the probes [m], wall time [s].
+    def summary(self) -> Summary:
+        """Time in each phase, switches, separations, impacts, peak normal force, largest
+        |w| at the probes and wall time; ``print()`` it, or take its attributes.
 
-        With several sliders the per-slider entries (time in each phase, separations,
-        peak normal force) are lists, one item per slider.
+        A result that lacks ``normal_force`` or ``w`` (a run of ``fivdisc reproduce`` keeps
+        only what its figure draws) has nan for them.
         """
         ds = self.dataset
         dt = np.diff(ds["time"].values)
         kinds = ds["event_kind"].values
-        sliders = ds["event_slider"].values
-        count = ds.sizes["slider"]
-        per: dict[str, list] = {"time_in_phase": [], "separations": [], "peak_normal_force": []}
-        for j in range(count):
+        owners = ds["event_slider"].values
+        sliders = []
+        for j in range(ds.sizes["slider"]):
             phase = ds["phase"].values[:, j]
-            per["time_in_phase"].append(
-                {name: float(np.sum(dt[phase[:-1] == i])) for i, name in enumerate(PHASE_NAMES)}
-            )
-            per["separations"].append(int(np.sum((kinds == "separation") & (sliders == j))))
-            force = ds["normal_force"].values[:, j]
-            per["peak_normal_force"].append(float(np.nanmax(force, initial=np.nan)))
-        one = {k: v[0] for k, v in per.items()} if count == 1 else per
+            force = ds["normal_force"].values[:, j] if "normal_force" in ds else np.empty(0)
+            sliders.append(SliderSummary(
+                {name: float(np.sum(dt[phase[:-1] == i])) for i, name in enumerate(PHASE_NAMES)},
+                int(np.sum((kinds == "separation") & (owners == j))),
+                float(np.nanmax(force)) if np.isfinite(force).any() else np.nan,
+            ))
         impacts = int(np.sum(kinds == "recontact")) if ds.attrs.get("impact", 1) else 0
-        return {
-            "status": self.status,
-            "time_in_phase": one["time_in_phase"],
-            "switches": int(kinds.size),
-            "separations": one["separations"],
-            "impacts": impacts,
-            "peak_normal_force": one["peak_normal_force"],
-            "max_abs_w": float(np.nanmax(np.abs(ds["w"].values), initial=0.0)),
-            "wall_time": float(ds.attrs["wall_time"]),
-        }
+        w = np.abs(ds["w"].values) if "w" in ds else np.full(1, np.nan)
+        return Summary(
+            status=self.status,
+            end_time=float(ds.attrs.get("end_time", ds["time"].values[-1])),
+            sliders=tuple(sliders),
+            switches=int(kinds.size),
+            impacts=impacts,
+            max_abs_w=float(np.nanmax(w, initial=0.0) if np.isfinite(w).any() else np.nan),
+            wall_time=float(ds.attrs.get("wall_time", np.nan)),
+        )
+
+    def plot(self, kind: str = "timeseries", **options: Any) -> Figure:
+        """Draw the figure ``fivdisc plot --kind KIND`` draws.
+
+        Parameters
+        ----------
+        kind
+            One of :data:`fivdisc.plots.KINDS`.
+        **options
+            ``var``, ``probe``, ``slider``, ``window`` (t0, t1) [s], ``fmax`` [Hz],
+            ``segment`` [s], ``ax``: see :func:`fivdisc.plots.plot_kind`.
+        """
+        from fivdisc.plots import plot_kind
+
+        return plot_kind(self.dataset, kind, **options)
 
     def to_netcdf(self, path: str | PathLike[str]) -> None:
-        """Write the dataset to a netCDF file atomically (a temporary file is renamed)."""
+        """Write the dataset to a netCDF file atomically (a temporary file is renamed);
+        :func:`open_result` reads it back."""
         from fivdisc.files import write_atomic
 
         write_atomic(path, self.dataset.to_netcdf)
+
+
+def open_result(path: str | PathLike[str], run: str | None = None) -> Result:
+    """Read a result written by :meth:`Result.to_netcdf`, ``fivdisc simulate`` or
+    ``fivdisc reproduce``.
+
+    Parameters
+    ----------
+    path
+        The netCDF file.
+    run
+        For a file of ``fivdisc reproduce`` that holds several runs (``a``, ``b``,
+        ``a_printed``, ...), which one; a file with one run needs none.
+
+    Returns
+    -------
+    Result
+        Equal to the result that was written (a reproduced figure's runs keep only the
+        variables the figure draws).
+
+    Raises
+    ------
+    FivdiscError
+        The file is not a fivdisc result, or `run` is missing or not one of its runs;
+        one line naming the file and what it holds.
+    FileNotFoundError
+        The file does not exist.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(2, "No such file", str(path))
+    try:
+        runs = run_groups(path)
+        if runs and run is None and len(runs) == 1:
+            run = runs[0]
+        if runs and run not in runs:
+            need = "choose one with run=" if run is None else f"run = {run!r} is not one of them:"
+            raise FivdiscError(f"{path} holds the runs {', '.join(runs)}: {need} "
+                               f"{', '.join(runs)}")
+        if not runs and run is not None:
+            raise FivdiscError(f"run = {run!r} is invalid: {path} holds one run; leave run out")
+        with xr.open_dataset(path, group=run) as stored:
+            ds = stored.load()
+    except (OSError, ValueError) as exc:
+        raise FivdiscError(f"cannot read {path} as a fivdisc result: {exc}") from None
+    kind = ds.attrs.get("fivdisc_kind", "simulation")
+    if kind != "simulation" or "time" not in ds.coords or ds.sizes["time"] < 2:
+        what = {"stability_map": "a stability map (fivdisc stability)",
+                "separation_map": "a separation map"}.get(kind, "not a simulation result")
+        raise FivdiscError(f"{path}{f' (run {run})' if run else ''} is {what}: read it with "
+                           "xarray.open_dataset, draw it with fivdisc plot")
+    for name in _ARRAY_ATTRS:
+        # netCDF stores an attribute of one value as a scalar: give the array back.
+        if name in ds.attrs:
+            ds.attrs[name] = np.atleast_1d(ds.attrs[name])
+    return Result(ds)
+
+
+def run_groups(path: str | PathLike[str]) -> list[str]:
+    """The groups of a netCDF file of ``fivdisc reproduce``, one per run (none for a plain
+    result or map)."""
+    import netCDF4
+
+    with netCDF4.Dataset(path) as root:
+        return list(root.groups)

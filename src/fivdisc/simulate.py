@@ -11,6 +11,7 @@ import numpy as np
 from fivdisc._kernels import integrate as kern
 from fivdisc._kernels import layout as lay
 from fivdisc.case import Case
+from fivdisc.compilation import compile_notice
 from fivdisc.errors import SimulationError
 from fivdisc.limits import check_simulation
 from fivdisc.model import Model, build_model
@@ -125,7 +126,8 @@ def simulate(
         Event kinds (``"separation"``, ``"stick"``, ...) that end the run early;
         the status is then ``"stopped"``.
     progress : bool
-        Show a progress bar in simulated time.
+        Show a progress bar in simulated time, and a notice while the kernel compiles
+        (the first run of a fresh installation).
 
     Returns
     -------
@@ -194,8 +196,10 @@ def simulate(
         return status
 
     # A first call with target 0 only sets up the start: it compiles or loads the kernel
-    # before the progress bar starts, so the bar's rate and estimate are the integrator's.
-    advance(0.0)
+    # before the progress bar starts, so the bar's rate and estimate are the integrator's
+    # (and the wall time excludes the compilation, announced with the bar).
+    with compile_notice(kern.run, show=progress):
+        advance(0.0)
     bar = None
     if progress:
         from tqdm import tqdm

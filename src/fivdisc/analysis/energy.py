@@ -73,9 +73,9 @@ def energy_balance(data: xr.Dataset | object) -> xr.Dataset:
         bending moment, the normal forces on the sloped disc surface, the sliders' and the
         disc's dampers, the kinetic energy lost in impacts and the work of the moving
         surface during impacts; ``residual`` [J] = energy - energy(0) - sum of work.
-        Attribute ``relative_residual`` is the largest absolute residual over the largest
-        absolute change of the energy or of a work term: small (integration error) when
-        the energy is accounted for.
+        Attribute ``relative_residual`` is max |residual| over the largest of
+        |energy - energy(0)| and the work terms: small (integration error) when the
+        energy is accounted for.
 
     Raises
     ------

@@ -498,7 +498,10 @@ def find_peaks(spectrum: Spectrum, n: int = 10, min_rel_height: float = 0.05,
         in (0, 1]. Keep it above the window's highest side lobe (Hann: 0.027,
         Blackman: 0.0014, boxcar: 0.22) so that side lobes are not taken for lines.
     fmin, fmax : float, optional
-        Frequency band searched [Hz]; default everything above 0 Hz.
+        Frequency band searched [Hz]; default everything. The lobe of 0 Hz and its
+        side lobes (what detrending leaves of the mean and of a slow drift: the spectrum
+        up to its first local minimum, then its local maxima as long as they decrease)
+        never count as peaks.
 
     Returns
     -------
@@ -521,7 +524,9 @@ def find_peaks(spectrum: Spectrum, n: int = 10, min_rel_height: float = 0.05,
     if not 0.0 <= lo < hi:
         raise AnalysisError(f"fmin = {fmin!r}, fmax = {fmax!r} [Hz] is not a band: need "
                             f"0 <= fmin < fmax (Nyquist {freq[-1]:g} Hz)")
-    band = (freq >= lo) & (freq <= hi)
+    # The lobe around 0 Hz and its side lobes are what detrending leaves of the mean and
+    # of a slow drift: never a line.
+    band = (freq >= lo) & (freq <= hi) & (np.arange(freq.size) > _zero_lobe_end(amp))
     empty = Peaks(np.empty(0), np.empty(0), spectrum.resolution, spectrum.units)
     if not band.any():
         return empty
@@ -545,6 +550,30 @@ def find_peaks(spectrum: Spectrum, n: int = 10, min_rel_height: float = 0.05,
     amplitudes = np.exp(mid - 0.25 * (left - right) * shift)
     order = np.argsort(-amplitudes, kind="stable")[:n]
     return Peaks(frequencies[order], amplitudes[order], spectrum.resolution, spectrum.units)
+
+
+def _zero_lobe_end(amplitude: np.ndarray) -> int:
+    """Last index of the lobe of 0 Hz and of its side lobes in a spectrum.
+
+    The lobe ends at the first local minimum above 0 Hz; its side lobes (the window's
+    leakage of a mean or a slow drift) are the local maxima after it that keep
+    decreasing. The first local maximum that is not lower than the one before it is a
+    line of the signal, and ends the search.
+    """
+    from scipy import signal
+
+    falls = np.flatnonzero((amplitude[1:-1] <= amplitude[:-2])
+                           & (amplitude[1:-1] <= amplitude[2:]))
+    if falls.size == 0:
+        return amplitude.size - 1
+    end = int(falls[0] + 1)
+    previous = float(amplitude[: end + 1].max())
+    tops, _ = signal.find_peaks(amplitude)
+    for top in tops[tops > end]:
+        if amplitude[top] >= previous:
+            break
+        previous, end = float(amplitude[top]), int(top)
+    return end
 
 
 def _combinations(count: int, max_order: int) -> np.ndarray:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import xarray as xr
@@ -12,11 +13,14 @@ import xarray as xr
 from fivdisc._kernels import dynamics as dyn
 from fivdisc._kernels import layout as lay
 from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium, slip_phases
-from fivdisc.case import Case, is_case_key
-from fivdisc.errors import CaseError, SimulationError
+from fivdisc.case import Case, is_case_key, keys_like, unit_of
+from fivdisc.errors import CaseError, SimulationError, nearest
 from fivdisc.limits import check_memory
 from fivdisc.model import Model, build_model
 from fivdisc.speed import SpeedProfile
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 # Bytes per grid point of a stability map: growth rate and stability flag, and the
 # dataset's and the netCDF writer's copies of them.
@@ -34,7 +38,7 @@ _SLIDER_ARRAYS = {
 }
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class LinearStability:
     """Eigen-analysis of the slip equations linearised about the sliding equilibrium.
 
@@ -76,19 +80,46 @@ class LinearStability:
         """Damped natural frequencies ``|Im(lambda)| / 2 pi`` [Hz]."""
         return np.abs(self.eigenvalues.imag) / (2.0 * np.pi)
 
-    def table(self) -> list[dict]:
-        """One row per eigenvalue with a non-negative imaginary part: growth rate [1/s],
-        frequency [Hz] and dominant coordinate."""
-        return [
-            {
-                "growth_rate": float(lam.real),
-                "frequency_hz": float(abs(lam.imag) / (2.0 * np.pi)),
-                "coordinate": name,
-            }
-            for lam, name in zip(self.eigenvalues, self.dominant, strict=True)
-            if lam.imag >= 0.0
-        ]
+    def to_dataframe(self) -> pd.DataFrame:
+        """The eigenvalues as a table: one row per eigenvalue with a non-negative imaginary
+        part (one of each complex pair), in order of decreasing growth rate.
 
+        Columns: ``growth_rate`` [1/s] (the real part), ``frequency_hz`` [Hz] (the damped
+        frequency) and ``coordinate`` (the dominant one, see :attr:`dominant`).
+        """
+        import pandas as pd
+
+        rows = [(float(lam.real), float(abs(lam.imag) / (2.0 * np.pi)), name)
+                for lam, name in zip(self.eigenvalues, self.dominant, strict=True)
+                if lam.imag >= 0.0]
+        return pd.DataFrame(rows, columns=["growth_rate", "frequency_hz", "coordinate"])
+
+    def lines(self) -> list[str]:
+        """The equilibrium, the eigenvalue table and the verdict, as lines of text."""
+        eq = self.equilibrium
+        out = [f"sliding equilibrium at Omega = {eq.speed:.6g} rad/s:"]
+        for j, (phi, nf, f) in enumerate(zip(eq.phi, eq.normal_force, eq.friction_force,
+                                             strict=True)):
+            who = f"slider {j}: " if eq.phi.size > 1 else ""
+            out.append(f"  {who}phi = {phi:.6g} rad, N = {nf:.6g} N, f = {f:.6g} N")
+        out.append(f"{'growth rate [1/s]':>18} {'frequency [Hz]':>15}  mode")
+        out += [f"{row.growth_rate:18.6g} {row.frequency_hz:15.6g}  {row.coordinate}"
+                for row in self.to_dataframe().itertuples()]
+        out.append("stable" if self.stable
+                   else f"unstable (max growth {self.max_growth_rate:.4g} 1/s)")
+        return out
+
+    def __str__(self) -> str:
+        return "\n".join(self.lines())
+
+    def __repr__(self) -> str:
+        verdict = "stable" if self.stable else "unstable"
+        return (f"<LinearStability at Omega = {self.equilibrium.speed:.6g} rad/s: {verdict}, "
+                f"largest growth rate {self.max_growth_rate:.4g} 1/s ({self.dominant[0]}), "
+                f"{self.eigenvalues.size} eigenvalues>")
+
+    def _repr_pretty_(self, printer: Any, cycle: bool) -> None:  # IPython, Jupyter
+        printer.text(str(self))
 
     def to_dict(self) -> dict:
         """The equilibrium and every eigenvalue as plain Python values (for JSON).
@@ -303,11 +334,15 @@ def stability_map(
     Returns
     -------
     xarray.Dataset
+        Dimensions named after the keys, with their values, units and descriptions:
+        (curves key, y key, x key), or (y key, x key) without `curves`. Variables
         ``max_growth_rate`` [1/s] (NaN where no sliding equilibrium exists) and
-        ``stable`` on (curve, y, x), and ``boundary``
-        (curve, x): the value of y above which the equilibrium is stable at that x,
+        ``stable`` (1 stable, 0 unstable) on all of them, and ``boundary`` (curves key,
+        x key): the value of y above which the equilibrium is stable at that x,
         interpolated where the growth rate changes sign for the last time (NaN if the
-        column is never stable at the top or stable throughout).
+        column is never stable at the top or stable throughout). Attributes ``x_key``,
+        ``y_key`` and (with `curves`) ``curve_key`` name the axes; the CF global
+        attributes and the base case's TOML (``case``) are there too.
     """
     xkey, xs = _axis(x, "x")
     ykey, ys = _axis(y, "y")
@@ -367,31 +402,53 @@ def stability_map(
             g0, g1 = growth[ic, last_unstable, ix], growth[ic, last_unstable + 1, ix]
             y0, y1 = ys[last_unstable], ys[last_unstable + 1]
             boundary[ic, ix] = y0 + (y1 - y0) * g0 / (g0 - g1)
+    from fivdisc.conventions import global_attrs, key_attrs, units
+
     ckey = curves[0] if curves else ""
-    coords = {
-        "x": ("x", xs, {"long_name": xkey}),
-        "y": ("y", ys, {"long_name": ykey}),
-        "curve": ("curve", np.asarray(cs if curves else [np.nan], dtype=float),
-                  {"long_name": ckey or "none"}),
+    dims = (ckey, ykey, xkey) if curves else (ykey, xkey)
+    growth = growth if curves else growth[0]
+    stable = stable if curves else stable[0]
+    boundary = boundary if curves else boundary[0]
+    coords = {key: (key, values, key_attrs(key)) for key, values in axes}
+    yinfo = key_attrs(ykey)
+    attrs = {
+        **global_attrs(f"fivdisc stability map over {xkey} and {ykey}"
+                       + (f", one per {ckey}" if curves else ""), "fivdisc.stability_map"),
+        "fivdisc_kind": "stability_map",
+        "x_key": xkey,
+        "y_key": ykey,
+        **({"curve_key": ckey} if curves else {}),
+        "case": case.to_toml(),
     }
     return xr.Dataset(
         {
-            "max_growth_rate": (("curve", "y", "x"), growth,
-                                {"units": "1/s", "long_name": "largest real part of eigenvalues"}),
-            "stable": (("curve", "y", "x"), stable.astype(np.int8),
-                       {"units": "1", "long_name": "sliding equilibrium asymptotically stable"}),
-            "boundary": (("curve", "x"), boundary,
-                         {"units": "", "long_name": f"stability boundary in {ykey}"}),
+            "max_growth_rate": (dims, growth, {
+                "units": "1/s",
+                "long_name": "largest real part of the eigenvalues of the linearised slip "
+                             "equations (nan: no sliding equilibrium)"}),
+            "stable": (dims, stable.astype(np.int8), {
+                "units": "1", "long_name": "sliding equilibrium asymptotically stable",
+                "flag_values": np.array([0, 1], dtype=np.int8),
+                "flag_meanings": "unstable stable"}),
+            "boundary": ((*dims[:-2], xkey), boundary, {
+                "units": units(unit_of(ykey)),
+                "long_name": f"stability boundary: the {yinfo['long_name']} above which the "
+                             "equilibrium is stable (nan: none in the grid)"}),
         },
         coords=coords,
-        attrs={"x_key": xkey, "y_key": ykey, "curve_key": ckey, "case": case.to_toml()},
+        attrs=attrs,
     )
 
 
 def resolve_key(key: str, option: str) -> str:
-    """Full dotted case key from a dotted key or an unambiguous last part (``decay``)."""
-    import difflib
+    """Full dotted case key from a dotted key or an unambiguous last part (``decay``).
 
+    Raises
+    ------
+    CaseError
+        An ambiguous last part (the message lists the keys it could be), or an unknown
+        key (the message names the nearest valid one).
+    """
     keys = Case.valid_keys()
     if is_case_key(key):
         return key
@@ -400,9 +457,8 @@ def resolve_key(key: str, option: str) -> str:
         return matches[0]
     if len(matches) > 1:
         raise CaseError(f"{option}: key '{key}' is ambiguous: write one of {', '.join(matches)}")
-    near = difflib.get_close_matches(key, keys, n=1)
-    hint = f"; did you mean '{near[0]}'?" if near else ""
-    raise CaseError(f"{option}: unknown case key '{key}'{hint}")
+    raise CaseError(f"{option}: unknown case key '{key}'{nearest(key, keys_like(key))} "
+                    "(every key, with its unit: fivdisc examples default)")
 
 
 def parse_range(text: str, option: str) -> tuple[str, np.ndarray]:

@@ -73,7 +73,8 @@ def friction_trajectory(data: xr.Dataset | object, t0: float | None = None,
     relative = (ds["disc_speed"] - ds["phi_dot"]).assign_attrs(
         units="rad/s", long_name="relative angular velocity (disc minus slider)"
     )
-    return xr.Dataset({"relative_velocity": relative, "friction_force": ds["friction_force"]})
+    return xr.Dataset({"relative_velocity": relative, "friction_force": ds["friction_force"]},
+                      attrs=ds.attrs)
 
 
 def separation_intervals(data: xr.Dataset | object,

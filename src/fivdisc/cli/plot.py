@@ -1,5 +1,5 @@
-"""``fivdisc plot RESULT.nc --kind KIND [--var NAME] [--probe I] [--slider J] [--window T0:T1]
--o FIG.png``."""
+"""``fivdisc plot FILE.nc [--run LABEL] --kind KIND [--var NAME] [--probe I] [--slider J]
+[--window T0:T1] -o FIG.png``: any netCDF file fivdisc writes, drawn."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import click
 import numpy as np
 
 from fivdisc.errors import FivdiscError
+from fivdisc.plots import KINDS
 
-KINDS = ("timeseries", "spectrogram", "spectrum", "phase", "friction", "normal-force")
 _USES_VAR = ("timeseries", "spectrogram", "spectrum")
 # Variables each kind of plot reads, besides --var.
 _NEEDS = {
@@ -80,8 +80,11 @@ def _check(ds, kind: str, var: str | None, probe: int | None) -> str | None:
 
 @click.command()
 @click.argument("result", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--run", default=None, metavar="LABEL",
+              help="Which run of a file of fivdisc reproduce that holds several (a, b, "
+              "a_printed, ...).")
 @click.option("--kind", type=click.Choice(KINDS), default="timeseries", show_default=True,
-              help="What to plot.")
+              help="What to plot (simulation results).")
 @click.option("--var", default=None,
               help="Variable for timeseries, spectrogram and spectrum [default: phi].")
 @click.option("--probe", type=int, default=None,
@@ -91,64 +94,77 @@ def _check(ds, kind: str, var: str | None, probe: int | None) -> str | None:
 @click.option("--window", "window_text", metavar="T0:T1", default=None,
               help="Time window in s; either side may be empty [default: all].")
 @click.option("--fmax", type=float, default=None,
-              help="Highest frequency shown by spectrogram and spectrum [Hz].")
+              help="Highest frequency shown by spectrogram and spectrum, up to the Nyquist "
+              "frequency (half the output rate) [Hz].")
 @click.option("--segment", type=float, default=None,
-              help="STFT segment length of spectrogram [s] [default: 0.05].")
+              help="STFT segment length of spectrogram [s] [default: from the window's "
+              "length and the frequencies shown].")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               help="Figure file; the format follows the extension [default: RESULT-KIND.png].")
 @click.option("--dpi", type=click.IntRange(min=10), default=150, show_default=True,
               help="Resolution of raster formats.")
-def plot(result: Path, kind: str, var: str | None, probe: int | None, slider: int,
-         window_text: str | None, fmax: float | None, segment: float | None,
+def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int | None,
+         slider: int, window_text: str | None, fmax: float | None, segment: float | None,
          output: Path | None, dpi: int) -> None:
-    """Plot a simulation RESULT (netCDF written by ``fivdisc simulate``) to a file."""
+    """Draw a netCDF FILE that fivdisc wrote to a figure file.
+
+    A simulation result (``fivdisc simulate``, or a run of ``fivdisc reproduce``) is drawn
+    as --kind says; a stability map (``fivdisc stability -o map.nc``) or a separation map
+    (a run of Fig. 3 or 27 of ``fivdisc reproduce``) as a map.
+    """
+    from fivdisc.extras import require
+
+    require("plot", "fivdisc plot")
     import xarray as xr
 
     from fivdisc import plots
     from fivdisc.files import check_output, figure_suffixes, write_atomic
     from fivdisc.limits import check_raster
-    from fivdisc.result import select_slider
+    from fivdisc.result import open_result, run_groups
 
     out = check_output(output or result.with_name(f"{result.stem}-{kind}.png"), "-o",
                        figure_suffixes(), inputs=[result])
-    try:
-        with xr.open_dataset(result) as stored:
-            ds = stored.load()
-    except FileNotFoundError:
-        # The command group reports a missing file itself.
-        raise
-    except (OSError, ValueError) as exc:
-        raise FivdiscError(f"cannot read {result} as a netCDF result: {exc}") from None
-    if "time" not in ds.coords or ds.sizes["time"] < 2:
-        raise FivdiscError(f"{result} has no time coordinate: is it a fivdisc result?")
-    count = ds.sizes.get("slider", 1)
-    if not 0 <= slider < count:
-        raise FivdiscError(f"--slider {slider} is invalid: the run has {count} slider"
-                           f"{'s' if count > 1 else ''}, numbered from 0")
-    ds = select_slider(ds, slider)
-    if fmax is not None and kind not in ("spectrogram", "spectrum"):
-        raise FivdiscError(f"--fmax is not used by --kind {kind}: only by spectrogram and "
-                           "spectrum")
-    if fmax is not None and not fmax > 0:
-        raise FivdiscError(f"--fmax {fmax:g} is invalid: must be > 0 [Hz]")
-    if segment is not None and kind != "spectrogram":
-        raise FivdiscError(f"--segment is not used by --kind {kind}: only by spectrogram")
-    name = _check(ds, kind, var, probe)
-    window = parse_window(window_text, ds["time"].values)
-
-    if kind == "timeseries":
-        fig = plots.plot_timeseries(ds, name, probe, window)
-    elif kind == "spectrogram":
-        fig = plots.plot_spectrogram(ds, name, probe, window, fmax=fmax,
-                                     segment=0.05 if segment is None else segment)
-    elif kind == "spectrum":
-        fig = plots.plot_spectrum(ds, name, probe, window, fmax=fmax)
-    elif kind == "phase":
-        fig = plots.plot_phase_portrait(ds, window)
-    elif kind == "friction":
-        fig = plots.plot_friction(ds, window)
+    if not result.exists():
+        raise FileNotFoundError(2, "No such file", str(result))
+    groups = _groups(result, run_groups)
+    if run is not None and run not in groups:
+        raise FivdiscError(f"--run {run!r} is invalid: {result} holds "
+                           + (f"the runs {', '.join(groups)}" if groups else "one run; "
+                              "leave --run out"))
+    if run is None and len(groups) > 1:
+        raise FivdiscError(f"{result} holds the runs {', '.join(groups)}: choose one with "
+                           "--run LABEL")
+    run = run if run is not None else (groups[0] if groups else None)
+    with xr.open_dataset(result, group=run) as stored:
+        what = stored.attrs.get("fivdisc_kind", "simulation")
+    if what in ("stability_map", "sweep"):
+        given = [name for name, value in (("--var", var), ("--probe", probe),
+                                          ("--window", window_text), ("--fmax", fmax),
+                                          ("--segment", segment)) if value is not None]
+        if given:
+            raise FivdiscError(f"{given[0]} is not used for {result}: it is a map, drawn whole")
+        with xr.open_dataset(result, group=run) as stored:
+            fig = _map(stored.load(), result)
     else:
-        fig = plots.plot_normal_force(ds, window)
+        ds = open_result(result, run).dataset
+        count = ds.sizes.get("slider", 1)
+        if not 0 <= slider < count:
+            raise FivdiscError(f"--slider {slider} is invalid: the run has {count} slider"
+                               f"{'s' if count > 1 else ''}, numbered from 0")
+        from fivdisc.result import select_slider
+
+        one = select_slider(ds, slider)
+        if fmax is not None and kind not in ("spectrogram", "spectrum"):
+            raise FivdiscError(f"--fmax is not used by --kind {kind}: only by spectrogram and "
+                               "spectrum")
+        plots.check_fmax(fmax, 0.5 * (one.sizes["time"] - 1)
+                         / float(one["time"].values[-1] - one["time"].values[0]), "--fmax")
+        if segment is not None and kind != "spectrogram":
+            raise FivdiscError(f"--segment is not used by --kind {kind}: only by spectrogram")
+        name = _check(one, kind, var, probe)
+        window = parse_window(window_text, one["time"].values)
+        fig = plots.plot_kind(ds, kind, var=name, probe=probe, slider=slider, window=window,
+                              fmax=fmax, segment=segment)
 
     import matplotlib.pyplot as plt
 
@@ -158,3 +174,24 @@ def plot(result: Path, kind: str, var: str | None, probe: int | None, slider: in
     finally:
         plt.close(fig)
     click.echo(f"wrote {out}")
+
+
+def _groups(path: Path, run_groups) -> list[str]:
+    try:
+        return run_groups(path)
+    except (OSError, ValueError) as exc:
+        raise FivdiscError(f"cannot read {path} as a netCDF file of fivdisc: {exc}") from None
+
+
+def _map(ds, path: Path):
+    """The figure of a stability map or a separation map."""
+    if ds.attrs.get("fivdisc_kind") == "stability_map":
+        from fivdisc.plots import plot_stability_map
+
+        return plot_stability_map(ds)
+    if "separated" not in ds:
+        raise FivdiscError(f"{path} is a sweep without 'separated': read it with "
+                           "xarray.open_dataset")
+    from fivdisc.sweep import plot_separation_map
+
+    return plot_separation_map(ds)

@@ -30,14 +30,19 @@ def reproduce(figures: str | None, all_figures: bool, outdir: Path, force: bool,
     (same parameters) are reused unless --force is given, so an interrupted run
     resumes where it stopped.
     """
+    from fivdisc.extras import require
     from fivdisc.files import check_output
-    from fivdisc.paper.reproduce import parse_figures
+    from fivdisc.paper.reproduce import SWEEP_FIGURES, parse_figures
     from fivdisc.paper.reproduce import reproduce as run
 
+    require("plot", "fivdisc reproduce")
     check_output(outdir, "-o", (), kind="directory")
     if all_figures == (figures is not None):
         raise FivdiscError("give either --figures LIST (e.g. --figures 3,8,27) or --all")
     numbers = None if all_figures else parse_figures(figures, "--figures")
+    sweeps = [n for n in numbers or SWEEP_FIGURES if n in SWEEP_FIGURES]
+    if sweeps:
+        require("distributed", f"fivdisc reproduce (Fig. {sweeps[0]}, a sweep)")
     if workers is not None and workers < 1:
         raise FivdiscError(f"--workers = {workers} is invalid: must be >= 1")
     report = run(numbers, outdir, force=force, progress=progress, workers=workers)

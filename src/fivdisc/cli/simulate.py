@@ -33,20 +33,11 @@ def simulate(case_file: Path, output: Path | None, progress: bool) -> None:
     case = load_case(case_file)
     out = check_output(output or default_output(case_file, ".nc"), "-o", NETCDF,
                        inputs=[case_file])
-    result = run(case, progress=progress)
+    result = run(case, progress=progress).named(case_file.stem)
     result.to_netcdf(out)
-    s = result.summary()
     click.echo(f"wrote {out}")
-    several = isinstance(s["time_in_phase"], list)
-    spent = s["time_in_phase"] if several else [s["time_in_phase"]]
-    for j, times in enumerate(spent):
-        phases = ", ".join(f"{k} {v:.4g} s" for k, v in times.items())
-        click.echo(f"{f'slider {j} ' if several else ''}time in phase: {phases}")
-    peaks = s["peak_normal_force"] if several else [s["peak_normal_force"]]
-    click.echo(f"switches: {s['switches']}, separations: {s['separations']}, "
-               f"impacts: {s['impacts']}")
-    click.echo(f"peak normal force: {', '.join(f'{p:.6g}' for p in peaks)} N, "
-               f"largest |w| at probes: {s['max_abs_w']:.6g} m, wall time: {s['wall_time']:.3g} s")
+    for line in result.summary().lines()[1:]:
+        click.echo(line)
     if not result.ok:
         click.echo(f"error: simulation failed: {result.message}", err=True)
         sys.exit(1)

@@ -19,7 +19,8 @@ from fivdisc.errors import FivdiscError
 @click.option("--curves", "curve_spec", metavar="KEY=v1,v2,...",
               help="One map and boundary curve per value, e.g. decay=0,1,10.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
-              help="map.nc (netCDF dataset) or map.png (figure).")
+              help="map.nc (netCDF dataset) or a figure in any format matplotlib writes "
+              "(map.png, map.pdf, map.svg, ...).")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the equilibrium and the eigenvalues as JSON (without a map).")
 @click.option("--progress/--no-progress", default=True, show_default=True)
@@ -35,7 +36,8 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
     """
     from fivdisc.analysis.stability import linear_stability, parse_range, stability_map
     from fivdisc.case import Case, load_case
-    from fivdisc.files import check_output, write_atomic
+    from fivdisc.extras import require
+    from fivdisc.files import check_output, figure_suffixes, write_atomic
 
     case = load_case(case_file) if case_file else Case()
     if x_spec is None and y_spec is None:
@@ -49,24 +51,17 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
 
             click.echo(json.dumps(res.to_dict(), indent=2))
             return
-        eq = res.equilibrium
-        click.echo(f"sliding equilibrium at Omega = {eq.speed:.6g} rad/s:")
-        for j, (phi, nf, f) in enumerate(zip(eq.phi, eq.normal_force, eq.friction_force,
-                                             strict=True)):
-            who = f"slider {j}: " if eq.phi.size > 1 else ""
-            click.echo(f"  {who}phi = {phi:.6g} rad, N = {nf:.6g} N, f = {f:.6g} N")
-        click.echo(f"{'growth rate [1/s]':>18} {'frequency [Hz]':>15}  mode")
-        for row in res.table():
-            click.echo(f"{row['growth_rate']:18.6g} {row['frequency_hz']:15.6g}  "
-                       f"{row['coordinate']}")
-        click.echo("stable" if res.stable else f"unstable (max growth {res.max_growth_rate:.4g}"
-                                                " 1/s)")
+        click.echo(str(res))
         return
     if x_spec is None or y_spec is None:
         raise FivdiscError("a stability map needs both --x and --y (KEY=START:STOP:N)")
     if as_json:
         raise FivdiscError("--json prints the equilibrium and eigenvalues: leave out --x/--y")
-    out = check_output(output or Path("stability.nc"), "-o", (".nc", ".png"),
+    target = output or Path("stability.nc")
+    figure = target.suffix.lower() != ".nc"
+    if figure:
+        require("plot", f"fivdisc stability -o {target.name} (a figure)")
+    out = check_output(target, "-o", (".nc", *figure_suffixes()) if figure else (".nc",),
                        inputs=[case_file])
     axes = {"--x": parse_range(x_spec, "--x"), "--y": parse_range(y_spec, "--y")}
     if curve_spec is not None:
@@ -78,17 +73,20 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
                                "give each axis its own key")
         varied[key] = option
     ds = stability_map(case, axes["--x"], axes["--y"], axes.get("--curves"), progress=progress)
-    if out.suffix == ".nc":
+    if case_file is not None:
+        ds.attrs["case_name"] = case_file.stem
+    if not figure:
         write_atomic(out, ds.to_netcdf)
     else:
         from fivdisc.plots import plot_stability_map
 
-        figure = plot_stability_map(ds)
-        write_atomic(out, lambda path: figure.savefig(path, dpi=150))
+        drawn = plot_stability_map(ds)
+        write_atomic(out, lambda path: drawn.savefig(path, dpi=150))
     click.echo(f"wrote {out}")
-    for i, c in enumerate(ds["curve"].values):
-        b = ds["boundary"].values[i]
-        label = f"{ds.attrs['curve_key']} = {c:g}: " if ds.attrs["curve_key"] else ""
-        stable = ds["stable"].values[i]
+    ckey = ds.attrs.get("curve_key", "")
+    for value in ds[ckey].values if ckey else [None]:
+        one = ds if value is None else ds.sel({ckey: value})
+        boundary, stable = one["boundary"].values, one["stable"].values
+        label = "" if value is None else f"{ckey} = {value:g}: "
         click.echo(f"{label}stable at {stable.mean():.1%} of the grid; boundary found at "
-                   f"{int(np.sum(~np.isnan(b)))} of {b.size} x values")
+                   f"{int(np.sum(~np.isnan(boundary)))} of {boundary.size} x values")

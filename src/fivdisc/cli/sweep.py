@@ -155,9 +155,11 @@ def sweep(
     A point whose run fails is stored with its error message, and the sweep goes on.
     One sweep at a time may write a store.
     """
+    from fivdisc.extras import require
     from fivdisc.files import ZARR, check_output
     from fivdisc.sweep import load_sweep
 
+    require("distributed", "fivdisc sweep")
     if verify_store is not None:
         if sweep_file is not None or output is not None or scheduler or workers:
             raise click.UsageError("--verify STORE takes no sweep file and no other option")
@@ -236,6 +238,10 @@ def separation_map(
     against acceleration (accelerating disc), each run ending at its first
     separation, and draws the separation region.
     """
+    from fivdisc.extras import require
+
+    require("distributed", "fivdisc separation-map")
+    require("plot", "fivdisc separation-map")
     from fivdisc.case import load_case
     from fivdisc.files import ZARR, check_output, figure_suffixes
     from fivdisc.sweep import plot_separation_map, separation_sweep

@@ -48,7 +48,10 @@ RECIPE = 1
 # Result variables a figure may draw, and the event table.
 _KEEP = ("phi", "phi_dot", "w", "normal_force", "friction_force", "phase", "disc_speed",
          "event_time", "event_kind", "event_from", "event_slider")
-_RUN_ATTRS = ("status", "message", "end_time", "impact", "case")
+_RUN_ATTRS = ("status", "message", "end_time", "impact", "case", "wall_time")
+# The variables of _KEEP that have a slider dimension in a result, and the event table.
+_PER_SLIDER = ("phi", "phi_dot", "normal_force", "friction_force", "phase")
+_EVENTS = ("phase", "event_time", "event_kind", "event_from", "event_slider")
 _STFT_SEGMENT = 0.2  # [s]: 5 Hz resolution, fine enough to tell the disc modes apart
 _FMAX = 1000.0  # [Hz], the Nyquist frequency of the 2 kHz output
 _WINDOW = 5.0  # [s], windows of the per-stage frequency lists
@@ -136,7 +139,7 @@ class Runs:
 # --- public API ------------------------------------------------------------------------------
 
 
-def compute(figure: int | PaperCase, runs: Runs | None = None) -> xr.Dataset:
+def compute(figure: int | PaperCase, runs: Runs | None = None) -> xr.DataTree:
     """The data behind one figure, with its comparison rows.
 
     Parameters
@@ -148,68 +151,84 @@ def compute(figure: int | PaperCase, runs: Runs | None = None) -> xr.Dataset:
 
     Returns
     -------
-    xarray.Dataset
-        Attributes: ``figure``, ``title``, ``caption``, ``parameters`` (see
+    xarray.DataTree
+        One group per run (``main``; ``a``, ``b``; ``a_printed``, ...), each a result
+        in the layout of :func:`fivdisc.simulate` with the variables the figure draws
+        (:func:`fivdisc.open_result` and ``fivdisc plot`` read them); Fig. 3's groups
+        are stability maps, Fig. 27's separation maps. The root's attributes:
+        ``figure``, ``title``, ``caption``, ``parameters`` (see
         :meth:`PaperCase.parameters`), ``recipe`` and ``comparison`` (JSON list of
-        :class:`Row`). Runs are stored with their variables and dimensions
-        prefixed by the run's label (``main__phi``, ``a__time``, ...).
+        :class:`Row`), with the CF global attributes.
     """
+    from fivdisc.conventions import global_attrs
+
     pc = FIGURES[figure] if isinstance(figure, int) else figure
     runs = runs if runs is not None else Runs()
     data, table = _KINDS[pc.figure][0](pc, runs)
     data.attrs.update(
+        global_attrs(f"fivdisc reproduction of Fig. {pc.figure} of the paper: {pc.title}",
+                     "fivdisc.paper.compute"),
+        fivdisc_kind="paper_figure",
         figure=pc.figure,
-        title=pc.title,
         caption=pc.caption,
         choices=pc.choices,
         parameters=pc.parameters(),
         recipe=RECIPE,
         comparison=json.dumps([asdict(r) for r in table]),
     )
+    data.attrs["figure_title"] = pc.title
     return data
 
 
-def plot(data: xr.Dataset) -> Figure:
-    """Draw a figure from the dataset :func:`compute` returned (or its netCDF file's)."""
+def plot(data: xr.DataTree) -> Figure:
+    """Draw a figure from the data :func:`compute` returned (or its netCDF file's, read
+    with :func:`xarray.open_datatree`)."""
     return _KINDS[int(data.attrs["figure"])][1](data)
 
 
-def rows(data: xr.Dataset) -> list[Row]:
-    """The comparison rows stored in a figure's dataset."""
+def rows(data: xr.DataTree | xr.Dataset) -> list[Row]:
+    """The comparison rows stored in a figure's data (its root attributes)."""
     return [Row(**r) for r in json.loads(data.attrs["comparison"])]
 
 
 # --- storing runs ----------------------------------------------------------------------------
 
 
-def _pack(runs: dict[str, xr.Dataset], variables: tuple[str, ...]) -> xr.Dataset:
-    """Runs side by side in one dataset, names and dimensions prefixed by their label."""
-    parts = []
-    attrs = {}
+def _with_slider(ds: xr.Dataset) -> xr.Dataset:
+    """A run kept by :class:`Runs` (slider 0 selected) back in the result layout, with its
+    ``slider`` dimension of one."""
+    scalars = [c for c in ("slider", "angle", "face", "track_radius") if c in ds.coords]
+    out = ds.drop_vars(scalars)
+    for name in _PER_SLIDER:
+        if name in out:
+            out[name] = out[name].expand_dims("slider", axis=-1)
+    return out.assign_coords({c: ("slider", [ds[c].item()], ds[c].attrs) for c in scalars})
+
+
+def _pack(pc: PaperCase, runs: dict[str, xr.Dataset], variables: tuple[str, ...]
+          ) -> xr.DataTree:
+    """Runs as the groups of one tree, each in the result layout (see :func:`compute`)."""
+    from fivdisc.conventions import global_attrs
+
+    groups = {}
     for label, ds in runs.items():
-        sub = ds[[*variables, "phase", "event_time", "event_kind", "event_from"]]
-        # The probes are the same in every run, so they stay shared.
-        names = {name: f"{label}__{name}" for name in [*sub.variables, *sub.dims]
-                 if name != "probe" and not str(name).startswith("probe_")}
-        parts.append(sub.rename(names))
-        attrs |= {f"{label}__{key}": ds.attrs[key] for key in _RUN_ATTRS}
-    data = xr.merge(parts, combine_attrs="drop_conflicts", join="outer", compat="no_conflicts")
-    data.attrs = {**attrs, "runs": json.dumps(list(runs))}
-    return data
+        sub = _with_slider(ds[list(dict.fromkeys([*variables, *_EVENTS]))])
+        name = f"{pc.stem}{'_' + label if label != 'main' else ''}"
+        run = ("" if label == "main" else f" (run {label})")
+        sub.attrs = {**global_attrs(f"fivdisc simulation of {name}: Fig. {pc.figure}{run}",
+                                    "fivdisc.paper.compute"),
+                     "case_name": name, **{key: ds.attrs[key] for key in _RUN_ATTRS}}
+        groups[label] = sub
+    return xr.DataTree.from_dict(groups)
 
 
-def _unpack(data: xr.Dataset, label: str) -> xr.Dataset:
-    """One run of :func:`_pack`'s dataset, with its plain names back."""
-    prefix = f"{label}__"
-    ds = data[[n for n in data.data_vars if str(n).startswith(prefix)]]
-    ds = ds.rename({n: str(n)[len(prefix):] for n in [*ds.variables, *ds.dims]
-                    if str(n).startswith(prefix)})
-    ds.attrs = {k[len(prefix):]: v for k, v in data.attrs.items() if k.startswith(prefix)}
-    return ds
+def _unpack(data: xr.DataTree, label: str) -> xr.Dataset:
+    """One run of :func:`_pack`'s tree, slider 0 selected as :class:`Runs` keeps it."""
+    return select_slider(data[label].to_dataset(), 0)
 
 
-def _labels(data: xr.Dataset) -> list[str]:
-    return json.loads(data.attrs["runs"])
+def _labels(data: xr.DataTree) -> list[str]:
+    return list(data.children)
 
 
 # --- rows shared by several figures ------------------------------------------------------------
@@ -333,20 +352,16 @@ def _window_text(values: list[tuple[float, float]], width: float = _WINDOW) -> s
 # --- Fig. 3: stability map ---------------------------------------------------------------------
 
 
-def _map_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
+def _map_compute(pc: PaperCase, runs: Runs) -> tuple[xr.DataTree, list[Row]]:
     (xkey, xs), (ykey, ys), (ckey, cs) = pc.axes
-    maps = [stability_map(case, x=(xkey, xs), y=(ykey, ys), curves=(ckey, cs))
-            for case in pc.runs.values()]
-    data = xr.concat(maps, dim="panel", combine_attrs="drop")
-    data = data.assign_coords(panel=list(pc.runs),
-                              speed=("panel", [c.speed.value for c in pc.runs.values()],
-                                     {"units": "rad/s", "long_name": "disc speed"}))
-    data.attrs.update(x_key=xkey, y_key=ykey, curve_key=ckey)
+    maps = {label: stability_map(case, x=(xkey, xs), y=(ykey, ys), curves=(ckey, cs))
+            for label, case in pc.runs.items()}
     table = []
-    for ip, (label, case) in enumerate(pc.runs.items()):
-        for ic, alpha in enumerate(cs):
-            stable = data["stable"].values[ip, ic]
-            bound = data["boundary"].values[ip, ic]
+    for label, case in pc.runs.items():
+        for alpha in cs:
+            one = maps[label].sel({ckey: alpha})
+            stable = one["stable"].values.astype(bool)
+            bound = one["boundary"].values
             cols = np.flatnonzero(np.isfinite(bound))
             if cols.size == 0:
                 # The values of alpha are this module's choice (see FIG3.choices), so a
@@ -374,28 +389,34 @@ def _map_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
             f"point of Fig. {fig} (c_z = {point.slider.normal_damping:g}, r0^2 c_phi = "
             f"{point.slider.rotational_damping:g}, alpha = {point.friction.decay:g}, "
             f"Omega_c = {point.speed.value:g})"))
-    return data, table
+    for label, one in maps.items():
+        one.attrs["case_name"] = f"{pc.stem}{label}"
+    return xr.DataTree.from_dict(maps), table
 
 
-def _map_plot(data: xr.Dataset) -> Figure:
+def _map_plot(data: xr.DataTree) -> Figure:
     from matplotlib.figure import Figure
 
     from fivdisc.plots import plot_stability_map
 
-    fig = Figure(figsize=(11, 4.5), layout="constrained")
-    axes = fig.subplots(1, data.sizes["panel"])
-    for ax, label in zip(axes, data["panel"].values, strict=True):
-        panel = data.sel(panel=label)
-        plot_stability_map(panel.assign_attrs(data.attrs), ax=ax)
-        speed = float(panel["speed"])
+    labels = _labels(data)
+    fig = Figure(figsize=(12, 5.5), layout="constrained")
+    axes = fig.subplots(1, len(labels))
+    for ax, label in zip(axes, labels, strict=True):
+        panel = data[label].to_dataset()
+        plot_stability_map(panel, ax=ax)
+        speed = Case.from_toml(panel.attrs["case"]).speed.value
         for fig_no in (4, 6):
             case = FIGURES[fig_no].case
             if np.isclose(case.speed.value, speed):
                 ax.plot(case.slider.normal_damping, case.slider.rotational_damping, "k*",
-                        ms=10, label=f"Fig. {fig_no} (alpha = {case.friction.decay:g})")
+                        ms=10, label=rf"Fig. {fig_no} ($\alpha$ = {case.friction.decay:g} s/m)")
         ax.legend(loc="upper right", fontsize="small")
-        ax.set_title(f"({label}) Omega_c = {speed:g} rad/s", fontsize="medium")
-    fig.suptitle("Fig. 3: sliding equilibrium stable above each curve", fontsize="medium")
+        absent = [line for line in ax.get_title().split("\n") if line.startswith("no boundary")]
+        ax.set_title("\n".join([rf"({label}) $\Omega_c$ = {speed:g} rad/s", *absent]),
+                     fontsize="medium")
+    fig.suptitle("Fig. 3: sliding equilibrium stable above each curve (shaded)",
+                 fontsize="medium")
     return fig
 
 
@@ -412,7 +433,8 @@ def _decay_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
     after = float(np.max(dev[(t >= 1.0) & (t <= 1.1)]))
     final = float(np.max(dev[t >= t[-1] - 0.5]))
     _, w_range = ms.envelope(ds, "w", 0, width=0.5)
-    slowest = next(r for r in stab.table() if r["coordinate"] != "phi")
+    eigen = stab.to_dataframe()
+    slowest = eigen[eigen["coordinate"] != "phi"].iloc[0]
     table = [
         _stability_row(pc.figure, pc.case, "stable"),
         Row(pc.figure, "slider: decay of |phi - phi_eq|", "decays fast to the equilibrium",
@@ -427,7 +449,7 @@ def _decay_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
             verdict=_verdict(w_range[-1] < 0.01 * w_range[0], partly=True)),
         _printed_row(pc, runs),
     ]
-    return _pack({"main": ds}, ("phi_dot", "w")), table
+    return _pack(pc, {"main": ds}, ("phi_dot", "w")), table
 
 
 def _critical_speed(pc: PaperCase) -> tuple[float, float]:
@@ -486,7 +508,7 @@ def _transient_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]
     else:
         table.append(Row(pc.figure, "separation", "not mentioned", _separation_text(ds)))
     table += [_omega_dot_row(pc, runs), _printed_row(pc, runs)]
-    return _pack({"main": ds}, ("phi_dot", "w")), table
+    return _pack(pc, {"main": ds}, ("phi_dot", "w")), table
 
 
 def _two_panel_plot(data: xr.Dataset) -> Figure:
@@ -518,8 +540,8 @@ def _spectrogram(run: xr.Dataset, var: str, probe: int | None, ax: Axes) -> None
     ax.figure.axes[-1].set_ylabel(f"STFT magnitude of {var} [{unit}]")
 
 
-def _suptitle(fig: Figure, data: xr.Dataset) -> None:
-    fig.suptitle(f"Fig. {data.attrs['figure']}: {data.attrs['title']}", fontsize="medium")
+def _suptitle(fig: Figure, data: xr.DataTree) -> None:
+    fig.suptitle(f"Fig. {data.attrs['figure']}: {data.attrs['figure_title']}", fontsize="medium")
 
 
 # --- Figs. 8-16: slider and disc spectra, constant and decelerating ----------------------------
@@ -638,7 +660,8 @@ def _spectra_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
             table.append(_stability_row(pc.figure, pc.case, "unstable"))
             if pc.figure == 8:
                 stab = linear_stability(pc.case)
-                freq = {r["coordinate"]: r["frequency_hz"] for r in stab.table()}
+                eigen = stab.to_dataframe()
+                freq = dict(zip(eigen["coordinate"], eigen["frequency_hz"], strict=True))
                 table.append(Row(pc.figure, "linear eigenfrequencies C01 and D02",
                                  "f1 = 181 Hz, f2 = 290.5 Hz",
                                  f"{freq['C01']:.2f} Hz, {freq['D02']:.2f} Hz",
@@ -652,7 +675,7 @@ def _spectra_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
         table += [Row(pc.figure, "separation", "not mentioned", _separation_text(ds)),
                   _omega_dot_row(pc, runs)]
     table.append(_printed_row(pc, runs))
-    data = _pack({"main": ds}, ("phi", "phi_dot") if slider else ("w",))
+    data = _pack(pc, {"main": ds}, ("phi", "phi_dot") if slider else ("w",))
     data.attrs["profile"] = pc.case.speed.profile
     data.attrs["analysis_window"] = list(_analysis_window(ds))
     return data, table
@@ -712,8 +735,10 @@ def _spectra_plot(data: xr.Dataset) -> Figure:
         if constant:
             t0, t1 = (float(t) for t in np.atleast_1d(data.attrs["analysis_window"]))
             plot_spectrum(run, "w", probe=1, window=(t0, t1), fmax=_FMAX, ax=axes[2])
-            axes[2].set_title(f"(b') amplitude spectrum, {t0:g}-{t1:g} s\n"
-                              + axes[2].get_title(), fontsize="small")
+            # plot_spectrum's title ends with the periodicity verdict
+            verdict = axes[2].get_title().split("\n")[-1]
+            axes[2].set_title(f"(b') amplitude spectrum, {t0:g}-{t1:g} s\n{verdict}",
+                              fontsize="small")
     _suptitle(fig, data)
     return fig
 
@@ -762,7 +787,7 @@ def _windows_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
                          verdict=_verdict(all(sticks) and distinct == 6,
                                           partly=any(sticks) and distinct > 1)))
     parts = [_window(ds, t0, t1) for t0, t1 in pc.windows]
-    data = _pack({f"w{i}": p for i, p in enumerate(parts)},
+    data = _pack(pc, {f"w{i}": p for i, p in enumerate(parts)},
                  ("phi", "phi_dot", "friction_force", "disc_speed"))
     return data, table
 
@@ -847,7 +872,7 @@ def _normal_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
                              _verdict(ref_sep["count"] == 0)))
         if pc.figure != 18:
             table.append(_omega_dot_row(pc, runs, label))
-    return _pack(packed, ("normal_force", "w")), table
+    return _pack(pc, packed, ("normal_force", "w")), table
 
 
 def _normal_plot(data: xr.Dataset) -> Figure:
@@ -939,7 +964,7 @@ def _responses_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]
                              f"phi {before:.1f} -> {after:.1f} Hz, w {w_before:.1f} -> "
                              f"{w_after:.1f} Hz", verdict=_verdict(shift)))
         table.append(_omega_dot_row(pc, runs))
-    return _pack({"main": ds}, ("phi", "phi_dot", "w")), table
+    return _pack(pc, {"main": ds}, ("phi", "phi_dot", "w")), table
 
 
 def _responses_plot(data: xr.Dataset) -> Figure:
@@ -986,10 +1011,11 @@ def separation_grid(pc: PaperCase, directory: str | PathLike[str], printed: bool
     Returns
     -------
     xarray.Dataset
-        ``separated`` and ``first_separation_time`` [s] on (``omega0`` [rad/s],
-        ``t_max`` [s]).
+        The sweep (:func:`fivdisc.sweep.open_sweep`) without its checksums:
+        ``separated``, ``first_separation_time`` [s], ``error`` and ``done`` on
+        (``speed.initial`` [rad/s], ``speed.duration`` [s]).
     """
-    from fivdisc.sweep import as_grid, open_sweep, run_sweep, separation_sweep
+    from fivdisc.sweep import open_sweep, run_sweep, separation_sweep
 
     base = pc.case.replace({"simulation.printed_gyroscopic_sign": printed})
     (_, xs), (_, ys) = pc.axes
@@ -997,29 +1023,18 @@ def separation_grid(pc: PaperCase, directory: str | PathLike[str], printed: bool
     name = "printed" if printed else "skew"
     store = Path(directory) / f"fig27_{name}_{sweep.digest[:12]}.zarr"
     run_sweep(sweep, store, workers=workers, progress=progress)
-    grid = as_grid(open_sweep(store))
-    out = xr.Dataset(
-        {
-            "separated": (("omega0", "t_max"), grid["separated"].values.astype(np.int8),
-                          {"units": "1", "long_name": "slider separates before the disc stops"}),
-            "first_separation_time": (("omega0", "t_max"),
-                                      grid["first_separation_time"].values,
-                                      {"units": "s", "long_name": "first separation"}),
-        },
-        coords={"omega0": ("omega0", np.asarray(xs), {"units": "rad/s",
-                                                     "long_name": "initial disc speed Omega_0"}),
-                "t_max": ("t_max", np.asarray(ys), {"units": "s",
-                                                    "long_name": "time to stop t_max"})},
-    )
-    failed = int(np.sum(grid["error"].values != ""))
-    out.attrs["failed_points"] = failed
-    return out
+    grid = open_sweep(store).drop_vars("checksum")
+    # netCDF has no numpy StringDType: the messages as Python strings.
+    grid["error"] = grid["error"].astype(object)
+    grid.attrs["case_name"] = f"{pc.stem} ({name} gyroscopic sign)"
+    return grid
 
 
 def _map_text(grid: xr.Dataset) -> tuple[str, bool]:
     """Where a separation grid separates, and whether more speed and longer stops only add."""
+    grid = grid.transpose("speed.initial", "speed.duration")
     sep = grid["separated"].values.astype(bool)
-    xs, ys = grid["omega0"].values, grid["t_max"].values
+    xs, ys = grid["speed.initial"].values, grid["speed.duration"].values
     if not sep.any():
         return "no separation anywhere in the grid", False
     # Monotone: separation at (Omega_0, t_max) implies it at higher Omega_0 and longer t_max.
@@ -1033,7 +1048,7 @@ def _map_text(grid: xr.Dataset) -> tuple[str, bool]:
     return text, bool(up_x and up_y)
 
 
-def _sweep_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
+def _sweep_compute(pc: PaperCase, runs: Runs) -> tuple[xr.DataTree, list[Row]]:
     grids = {}
     with tempfile.TemporaryDirectory() as tmp:
         for printed in (False, True):
@@ -1041,40 +1056,26 @@ def _sweep_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
                 pc, runs.sweep_dir or tmp, printed, runs.sweep_workers, runs.progress)
     text, ok = _map_text(grids["skew"])
     text_bad, _ = _map_text(grids["printed"])
-    failed = sum(int(g.attrs["failed_points"]) for g in grids.values())
+    failed = sum(int(np.sum(g["error"].values != "")) for g in grids.values())
     table = [Row(pc.figure, "separation region over (Omega_0, t_max)",
                  "more likely at high Omega_0 and long t_max", text, text_bad,
                  _verdict(ok, partly=bool(grids["skew"]["separated"].values.any())))]
     if failed:
         table.append(Row(pc.figure, "failed sweep points", "", str(failed)))
-    data = xr.merge([g.rename({v: f"{k}__{v}" for v in g.data_vars})
-                     for k, g in grids.items()], combine_attrs="drop")
-    return data, table
+    return xr.DataTree.from_dict(grids), table
 
 
-def _sweep_plot(data: xr.Dataset) -> Figure:
+def _sweep_plot(data: xr.DataTree) -> Figure:
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(11, 4.5), layout="constrained")
-    axes = fig.subplots(1, 2)
-    xs, ys = data["omega0"].values, data["t_max"].values
-    X, Y = np.meshgrid(xs, ys, indexing="ij")
-    for ax, key, title in zip(axes, ("skew", "printed"),
+    from fivdisc.sweep import plot_separation_map
+
+    fig = Figure(figsize=(11, 4.8), layout="constrained")
+    for ax, key, title in zip(fig.subplots(1, 2), ("skew", "printed"),
                               ("fivdisc (skew gyroscopic terms)", "printed gyroscopic sign"),
                               strict=True):
-        sep = data[f"{key}__separated"].values.astype(bool)
-        if sep.any() and not sep.all():
-            ax.contourf(X, Y, sep.astype(float), levels=[0.5, 1.5], colors=["0.85"])
-            ax.contour(X, Y, sep.astype(float), levels=[0.5], colors=["0.3"], linewidths=1.0)
-        ax.plot(X[sep], Y[sep], "o", color="k", ms=4, label="separation")
-        ax.plot(X[~sep], Y[~sep], "o", mfc="none", color="0.4", ms=4, label="no separation")
-        if sep.any():
-            ax.text(X[sep].mean(), Y[sep].mean(), "SR", ha="center", va="center", fontsize=14,
-                    fontweight="bold", bbox={"fc": "white", "ec": "none", "alpha": 0.7})
-        ax.set_xlabel(r"initial disc speed $\Omega_0$ [rad/s]")
-        ax.set_ylabel(r"time to stop $t_{\max}$ [s]")
+        plot_separation_map(data[key].to_dataset(), ax=ax)
         ax.set_title(title, fontsize="medium")
-        ax.legend(loc="upper left", fontsize="small", framealpha=0.9)
     _suptitle(fig, data)
     return fig
 
@@ -1103,7 +1104,7 @@ def _impact_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
                      f"max {max_a:.2e} vs {max_b:.2e} m (x{max_b / max_a:.2f}); RMS {rms_a:.2e} "
                      f"vs {rms_b:.2e} m (x{rms_b / rms_a:.2f})",
                      verdict=_verdict(max_b > 1.5 * max_a, partly=max_b > max_a)))
-    return _pack(packed, ("w",)), table
+    return _pack(pc, packed, ("w",)), table
 
 
 def _impact_plot(data: xr.Dataset) -> Figure:

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from fivdisc.compilation import warm_kernel
 from fivdisc.errors import FivdiscError
 from fivdisc.files import write_atomic
 from fivdisc.paper.cases import CITATION, FIGURES
@@ -36,7 +37,8 @@ from fivdisc.paper.report import figure_blocks, render_html, render_markdown, su
 
 __all__ = ["ReproduceReport", "parse_figures", "reproduce"]
 
-_SWEEP_FIGURES = (27,)
+#: Figures computed by parameter sweeps (they need the ``distributed`` extra).
+SWEEP_FIGURES = (27,)
 # Largest float stored as float32; larger values (diverging printed-sign runs) stay float64.
 _FLOAT32_MAX = 1e30
 
@@ -144,14 +146,17 @@ def reproduce(figures: Iterable[int] | None = None,
 
     from tqdm import tqdm
 
+    if todo:
+        # Compiled here once (with a notice), the worker processes load it from the cache.
+        warm_kernel(show=progress)
     with tqdm(total=len(numbers), initial=len(reused), unit="fig", desc="figures",
               disable=not progress, dynamic_ncols=True) as bar:
-        for number in (n for n in todo if n in _SWEEP_FIGURES):
+        for number in (n for n in todo if n in SWEEP_FIGURES):
             bar.set_postfix_str(f"fig {number} (sweep)")
             runs = Runs(sweep_dir=out, sweep_workers=workers, progress=progress)
             seconds |= _make([number], str(out), runs)
             bar.update(1)
-        groups = _groups([n for n in todo if n not in _SWEEP_FIGURES])
+        groups = _groups([n for n in todo if n not in SWEEP_FIGURES])
         if workers == 1 or len(groups) <= 1:
             for group in groups:
                 bar.set_postfix_str("figs " + ",".join(map(str, group)))
@@ -206,19 +211,22 @@ def _make(numbers: list[int], outdir: str, runs: Runs | None = None) -> dict[int
     return seconds
 
 
-def _encoding(data: xr.Dataset) -> dict:
-    """Compressed storage; float32 for time histories that fit it."""
-    encoding = {}
-    for name, var in data.data_vars.items():
-        if var.dtype.kind != "f":
-            continue
-        spec = {"zlib": True, "complevel": 4}
-        values = var.values
-        finite = values[np.isfinite(values)]
-        if not name.endswith("event_time") and (finite.size == 0
-                                                 or np.max(np.abs(finite)) < _FLOAT32_MAX):
-            spec["dtype"] = "float32"
-        encoding[name] = spec
+def _encoding(data: xr.DataTree) -> dict[str, dict]:
+    """Compressed storage, group by group; float32 for time histories that fit it."""
+    encoding: dict[str, dict] = {}
+    for node in data.subtree:
+        group = {}
+        for name, var in node.data_vars.items():
+            if var.dtype.kind != "f":
+                continue
+            spec = {"zlib": True, "complevel": 4}
+            finite = var.values[np.isfinite(var.values)]
+            if name != "event_time" and (finite.size == 0
+                                         or np.max(np.abs(finite)) < _FLOAT32_MAX):
+                spec["dtype"] = "float32"
+            group[name] = spec
+        if group:
+            encoding[node.path] = group
     return encoding
 
 

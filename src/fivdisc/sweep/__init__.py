@@ -4,11 +4,11 @@
 >>> from fivdisc.sweep import load_sweep, run_sweep, open_sweep
 >>> spec = load_sweep(examples.path("sweep_fig27"))
 >>> report = run_sweep(spec, "fig27.zarr")  # doctest: +SKIP
->>> open_sweep("fig27.zarr")["separated"]  # doctest: +SKIP
+>>> open_sweep("fig27.zarr")["separated"]  # doctest: +SKIP  (on the grid's axes)
 
-See :mod:`fivdisc.sweep.spec` for the sweep file format, :mod:`fivdisc.sweep.store`
-for the store layout and :mod:`fivdisc.sweep.separation` for the paper's separation
-maps (Fig. 27).
+See the documentation's page "Sweep files" (and :mod:`fivdisc.sweep.spec`) for the sweep
+file format, :mod:`fivdisc.sweep.store` for the store layout and
+:mod:`fivdisc.sweep.separation` for the paper's separation maps (Fig. 27).
 """
 
 from fivdisc.sweep.reductions import BUILTIN, Reduction, RunFailed, SweepError
@@ -18,7 +18,6 @@ from fivdisc.sweep.spec import Sweep, load_sweep, parse_range
 from fivdisc.sweep.store import (
     StoreHealth,
     SweepStore,
-    as_grid,
     open_sweep,
     read_mask,
     store_lock,
@@ -34,7 +33,6 @@ __all__ = [
     "SweepError",
     "SweepReport",
     "SweepStore",
-    "as_grid",
     "load_sweep",
     "open_sweep",
     "parse_range",

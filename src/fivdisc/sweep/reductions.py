@@ -10,17 +10,16 @@ first separation) lets the run stop there; see :func:`stop_events`.
 
 from __future__ import annotations
 
-import difflib
 import importlib
 import math
 import numbers
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cache
 from typing import Any
 
 from fivdisc.case import Case
-from fivdisc.errors import FivdiscError
+from fivdisc.errors import FivdiscError, nearest
 from fivdisc.result import Result
 
 __all__ = [
@@ -29,7 +28,6 @@ __all__ = [
     "RunFailed",
     "SweepError",
     "evaluate",
-    "nearest",
     "resolve",
     "stop_events",
 ]
@@ -100,17 +98,12 @@ def _first_separation(result: Result | None, case: Case) -> float:
     return float(times[0]) if times.size else math.nan
 
 
-def _per_slider(value: Any) -> list:
-    """A summary entry as a list over sliders (one-slider summaries hold the item)."""
-    return value if isinstance(value, list) else [value]
-
-
 def _phase_fraction(phase: str) -> Callable[[Result | None, Case], float]:
     def fraction(result: Result | None, case: Case) -> float:
         shares = [
-            spent[phase] / sum(spent.values())
-            for spent in _per_slider(result.summary()["time_in_phase"])
-            if sum(spent.values()) > 0
+            slider.time_in_phase[phase] / sum(slider.time_in_phase.values())
+            for slider in result.summary().sliders
+            if sum(slider.time_in_phase.values()) > 0
         ]
         return sum(shares) / len(shares) if shares else math.nan
 
@@ -173,13 +166,13 @@ BUILTIN: dict[str, Reduction] = {
         ),
         _builtin(
             "max_abs_w",
-            lambda result, case: result.summary()["max_abs_w"],
+            lambda result, case: result.summary().max_abs_w,
             "m",
             "largest |w| at the probes",
         ),
         _builtin(
             "max_normal_force",
-            lambda result, case: max(_per_slider(result.summary()["peak_normal_force"])),
+            lambda result, case: result.summary().peak_normal_force,
             "N",
             "largest normal contact force of any slider",
         ),
@@ -237,12 +230,6 @@ def _user(spec: str) -> Reduction:
         needs_run=True,
         func=lambda result, case: func(result),
     )
-
-
-def nearest(name: str, names: Iterable[str]) -> str:
-    """Hint naming the closest of `names` ("; did you mean 'x'?"), or "" if none is close."""
-    matches = difflib.get_close_matches(name, list(names), n=1)
-    return f"; did you mean '{matches[0]}'?" if matches else ""
 
 
 @cache

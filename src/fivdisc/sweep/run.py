@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from fivdisc.case import Case
+from fivdisc.compilation import warm_kernel
 from fivdisc.errors import FivdiscError
 from fivdisc.sweep.reductions import SweepError, evaluate
 from fivdisc.sweep.spec import Sweep
@@ -69,13 +70,6 @@ class SweepReport:
     computed: int
     failed: dict[int, str]
     wall_time: float
-
-
-def warm_kernel() -> None:
-    """Compile or load the simulator's numba code with a tiny run (about 1 ms simulated)."""
-    from fivdisc.simulate import simulate
-
-    simulate(Case(simulation={"duration": 1e-3, "output_rate": 1000.0}))
 
 
 def run_point(index: int, case: Case, keep: tuple[str, ...]) -> PointOutcome:
@@ -306,7 +300,10 @@ def run_sweep(
             already = spec.n_points - len(todo)
             failed = target.errors(done)
             if todo:
-                pool = pool or _LocalPool(workers or os.cpu_count() or 1)
+                if pool is None:
+                    # Compiled here once (with a notice), the workers load it from the cache.
+                    warm_kernel(show=progress)
+                    pool = _LocalPool(workers or os.cpu_count() or 1)
                 try:
                     _drive(pool, spec, target, todo, already, failed, progress)
                 except ClusterLost as exc:

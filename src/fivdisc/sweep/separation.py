@@ -16,12 +16,13 @@ import numpy as np
 import xarray as xr
 
 from fivdisc.case import Case
+from fivdisc.conventions import axis_label
 from fivdisc.files import write_atomic
 from fivdisc.sweep.reductions import SweepError
 from fivdisc.sweep.spec import Sweep
-from fivdisc.sweep.store import as_grid
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
 __all__ = [
@@ -128,7 +129,8 @@ def _profile_of(grid: xr.Dataset) -> str:
 
 
 def plot_separation_map(
-    data: xr.Dataset | str | PathLike[str], path: str | PathLike[str] | None = None
+    data: xr.Dataset | str | PathLike[str], path: str | PathLike[str] | None = None,
+    ax: Axes | None = None,
 ) -> Figure:
     """Draw a separation map like the paper's Fig. 27.
 
@@ -143,34 +145,42 @@ def plot_separation_map(
         :func:`~fivdisc.sweep.store.open_sweep`, or the store's path).
     path
         Image file to write (format from its suffix); None only returns the figure.
+    ax
+        Axes to draw into (the legend then goes into them); None: a new figure.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    from matplotlib.figure import Figure
-
+    from fivdisc.extras import require
     from fivdisc.sweep.store import open_sweep
 
-    if not isinstance(data, xr.Dataset):
-        data = open_sweep(data)
-    grid = as_grid(data)
-    if len(grid.dims) != 2 or "separated" not in grid:
+    require("plot", "a separation map")
+    from matplotlib.figure import Figure
+
+    grid = data if isinstance(data, xr.Dataset) else open_sweep(data)
+    if len(grid.dims) != 2 or "separated" not in grid or grid.attrs.get("sweep_mode") != "grid":
         raise SweepError(
-            "a separation map needs a grid sweep over two axes keeping 'separated'; got axes "
-            f"{list(grid.dims)} and variables {list(grid.data_vars)}"
+            "a separation map needs a grid sweep over two axes keeping 'separated'; got "
+            f"dimensions {list(grid.dims)} and variables {list(grid.data_vars)}"
         )
-    x_key, y_key = list(grid.dims)
+    x_key, y_key = json.loads(grid.attrs["sweep_axes"])
+    grid = grid.transpose(x_key, y_key)
     profile = _profile_of(grid)
     xs, ys = grid[x_key].values, grid[y_key].values
-    done = grid["done"].values
+    done = grid["done"].values.astype(bool)
     failed = done & (grid["error"].values != "")
-    separated = done & ~failed & grid["separated"].values
+    separated = done & ~failed & grid["separated"].values.astype(bool)
     clear = done & ~failed & ~separated
     X, Y = np.meshgrid(xs, ys, indexing="ij")
 
-    fig = Figure(figsize=(6.0, 4.5), layout="constrained")
-    ax = fig.add_subplot()
+    if ax is None:
+        fig = Figure(figsize=(6.0, 4.8), layout="constrained")
+        ax = fig.add_subplot()
+        legend = fig
+    else:
+        fig = ax.figure
+        legend = ax
     if separated.any() and len(xs) > 1 and len(ys) > 1:
         ax.contourf(X, Y, separated.astype(float), levels=[0.5, 1.5], colors=["0.85"])
         ax.contour(X, Y, separated.astype(float), levels=[0.5], colors=["0.3"], linewidths=1.0)
@@ -192,15 +202,21 @@ def plot_separation_map(
             color="0.45",
             zorder=1,
         )
-    ax.set_xlabel(_LABELS.get((profile, x_key), f"{x_key} [{grid[x_key].attrs.get('units')}]"))
-    ax.set_ylabel(_LABELS.get((profile, y_key), f"{y_key} [{grid[y_key].attrs.get('units')}]"))
+    for key, set_label in ((x_key, ax.set_xlabel), (y_key, ax.set_ylabel)):
+        set_label(_LABELS.get((profile, key), axis_label(grid[key])))
     # Half a grid step around the points, so that markers on the edges show whole.
     for values, set_lim in ((xs, ax.set_xlim), (ys, ax.set_ylim)):
         pad = 0.5 * (values.max() - values.min()) / max(len(values) - 1, 1) or 0.5
         set_lim(values.min() - pad, values.max() + pad)
-    ax.set_title(f"separation region (SR), {profile} disc", fontsize="medium")
-    # Outside the axes, so that it hides no point.
-    fig.legend(loc="outside upper center", ncol=3, fontsize="small", frameon=False)
+    name = grid.attrs.get("case_name", "")
+    ax.set_title(f"{name + ': ' if name else ''}separation region (SR), {profile} disc",
+                 fontsize="medium")
+    if legend is fig:
+        # Outside the axes, so that it hides no point.
+        fig.legend(loc="outside upper center", ncol=3, fontsize="small", frameon=False)
+    else:
+        ax.legend(loc="upper left", fontsize="small", framealpha=0.9)
     if path is not None:
         write_atomic(path, lambda p: fig.savefig(p, dpi=_DPI))
     return fig
+

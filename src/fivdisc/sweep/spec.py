@@ -14,7 +14,8 @@ A sweep file is TOML::
 
 Points are numbered in C order (the first axis varies slowest). Building a
 :class:`Sweep` validates everything, including the case of every point, so a sweep
-that starts cannot fail on its input halfway through.
+that starts cannot fail on its input halfway through. The documentation's page "Sweep
+files" describes every key.
 """
 
 from __future__ import annotations
@@ -32,11 +33,11 @@ from typing import Any, Literal
 
 import numpy as np
 
-from fivdisc.case import Case, is_case_key, load_case
-from fivdisc.errors import CaseError
+from fivdisc.case import Case, is_case_key, keys_like, load_case
+from fivdisc.errors import CaseError, nearest
 from fivdisc.files import read_text
 from fivdisc.limits import check_memory, check_simulation, simulation_bytes
-from fivdisc.sweep.reductions import Reduction, SweepError, nearest, resolve, stop_events
+from fivdisc.sweep.reductions import Reduction, SweepError, resolve, stop_events
 
 __all__ = ["Sweep", "SweepError", "load_sweep", "parse_range"]
 
@@ -189,7 +190,8 @@ class Sweep:
         axes: dict[str, tuple[Any, ...]] = {}
         for key, raw in self.axes.items():
             if not is_case_key(key):
-                raise SweepError(f"axes: unknown case key '{key}'{nearest(key, valid)}")
+                raise SweepError(f"axes: unknown case key '{key}'{nearest(key, keys_like(key))} "
+                                 "(every key, with its unit: fivdisc examples default)")
             axes[key] = _axis_values(key, raw)
         if self.mode == "zip" and len({len(v) for v in axes.values()}) > 1:
             lengths = ", ".join(f"'{k}' has {len(v)}" for k, v in axes.items())
@@ -365,7 +367,8 @@ def _file_fields(data: dict[str, Any], root: Path) -> dict[str, Any]:
     reduce = data.get("reduce", {})
     for key in reduce:
         if key not in _REDUCE_KEYS:
-            raise SweepError(f"unknown key 'reduce.{key}'{nearest(key, _REDUCE_KEYS)}")
+            raise SweepError(f"unknown key 'reduce.{key}'"
+                             f"{nearest(f'reduce.{key}', [f'reduce.{k}' for k in _REDUCE_KEYS])}")
     if "keep" not in reduce:
         raise SweepError("reduce.keep is missing: list the reductions to store")
     return {

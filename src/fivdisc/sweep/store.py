@@ -1,32 +1,38 @@
 """Sweep results in a Zarr store, written point by point, verified and safe to resume.
 
-Layout (one Zarr v3 group, written through xarray)::
+Layout (one Zarr v3 group, written through xarray, with consolidated metadata so that
+``xarray.open_zarr`` opens it directly)::
 
-    dims        point                          one per sweep point, C order over the axes
-    coords      point                          index
-                <axis key>, e.g. speed.initial axis value at each point (JSON text if
-                                               the values are not numbers, booleans or text)
+    dims        <axis key>, ...                a grid sweep: one per axis, named after its
+                                               key (e.g. speed.initial), in the sweep's order
+                point                          a zip sweep: one entry per point
+    coords      <axis key>                     the axis values, with units and long_name
+                                               (JSON text if the values are not numbers,
+                                               booleans or text); along point for a zip sweep
     data vars   <reduction name>               one per kept reduction (bool or float64)
                 error                          "" or why the point failed
                 checksum                       hash of the sweep, the point's index, values
                                                and error (0: nothing written)
                 done                           the point's values are written
-    attrs       sweep_definition, sweep_hash   canonical JSON of the sweep and its SHA-256
-                sweep_mode, sweep_axes, sweep_shape, sweep_variables, fivdisc_version,
-                store_format
+    attrs       CF global attributes (Conventions, title, source, history, references),
+                fivdisc_kind = "sweep", sweep_definition, sweep_hash (canonical JSON of the
+                sweep and its SHA-256), sweep_mode, sweep_axes, sweep_shape,
+                sweep_variables, fivdisc_version, store_format
 
-Every data variable has chunks of one point, so writing a point touches only its
-own chunk files (each replaced atomically by Zarr's local store). Values, ``error`` and
-``checksum`` are written before ``done``. A point is complete only if its ``done``
-chunk says so and its values read back to its checksum: Zarr reads a lost chunk file
-as the fill value, so without the checksum a deleted chunk would pass for data.
+Points are numbered in C order over the axes (the first axis varies slowest). Every data
+variable has chunks of one point, so writing a point touches only its own chunk files
+(each replaced atomically by Zarr's local store). Values, ``error`` and ``checksum`` are
+written before ``done``. A point is complete only if its ``done`` chunk says so and its
+values read back to its checksum: Zarr reads a lost chunk file as the fill value, so
+without the checksum a deleted chunk would pass for data.
 
 One coordinator writes a store at a time: :func:`store_lock` holds a lock file next
 to the store (``STORE.lock``, through ``filelock``) and records its holder in
 ``STORE.lock.owner``. A store is created complete (metadata and coordinates) under a
 temporary name and renamed into place; temporary stores left by a killed coordinator
 are removed by the next. A variable whose metadata is lost or damaged is rebuilt empty
-when the sweep is resumed, and its points recomputed.
+when the sweep is resumed, and its points recomputed. fivdisc itself reads every
+variable's own metadata, never the consolidated copy, so that damage is seen.
 """
 
 from __future__ import annotations
@@ -40,6 +46,7 @@ import shutil
 import socket
 import struct
 import sys
+import warnings
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -51,16 +58,14 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from fivdisc.case import unit_of
 from fivdisc.files import write_atomic
 from fivdisc.sweep.reductions import SweepError
-from fivdisc.sweep.spec import Sweep, strides_of
+from fivdisc.sweep.spec import Sweep
 
 __all__ = [
     "PointOutcome",
     "StoreHealth",
     "SweepStore",
-    "as_grid",
     "open_sweep",
     "read_mask",
     "store_lock",
@@ -69,7 +74,7 @@ __all__ = [
 
 DIM = "point"
 #: Version of the layout above; stores of another version are refused.
-STORE_FORMAT = 2
+STORE_FORMAT = 3
 _STRING = np.dtypes.StringDType()
 _BRIEF_CHARS = 160
 
@@ -94,15 +99,35 @@ class PointOutcome:
 
 
 def _require_zarr() -> Any:
-    try:
-        import dask.array  # noqa: F401  (the empty store's template is lazy)
-        import zarr
-    except ImportError as exc:
-        raise SweepError(
-            f"sweep stores need zarr and dask ({exc}); install them with "
-            "`pip install fivdisc[distributed]`"
-        ) from None
+    from fivdisc.extras import require
+
+    require("distributed", "sweep stores")
+    import zarr
+
     return zarr
+
+
+def _open_group(path: Path) -> Any:
+    """The store's Zarr group, read from every array's own metadata (not the consolidated
+    copy, which would hide damaged or lost metadata)."""
+    return _require_zarr().open_group(path, mode="r", use_consolidated=False)
+
+
+def _consolidate(path: Path) -> None:
+    """Write the consolidated metadata that lets ``xarray.open_zarr`` open the store at once.
+
+    zarr warns that consolidated metadata is not part of the Zarr v3 specification; it is
+    an extension zarr-python and xarray read, and fivdisc does not rely on it.
+    """
+    zarr = _require_zarr()
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Consolidated metadata", category=UserWarning)
+        zarr.consolidate_metadata(str(path))
+
+
+def dims_of(sweep: Sweep) -> tuple[str, ...]:
+    """The store's dimensions: the axis keys of a grid sweep, ``("point",)`` for a zip."""
+    return tuple(sweep.axes) if sweep.mode == "grid" else (DIM,)
 
 
 def _coordinate(values: Sequence[Any]) -> np.ndarray:
@@ -120,53 +145,62 @@ def _template(sweep: Sweep) -> xr.Dataset:
     """The empty store: coordinates filled, data variables lazy (only metadata is written)."""
     import dask.array as da
 
-    n = sweep.n_points
+    from fivdisc.conventions import global_attrs, key_attrs
+
+    dims, shape = dims_of(sweep), sweep.shape
+    chunks = (1,) * len(shape)
     data = {
         r.name: (
-            DIM,
-            da.full(n, r.fill, dtype=r.dtype, chunks=1),
-            {"units": r.units, "long_name": r.long_name, "reduction": r.spec},
+            dims,
+            da.full(shape, r.fill, dtype=r.dtype, chunks=chunks),
+            {"units": r.units or "1", "long_name": r.long_name, "reduction": r.spec},
         )
         for r in sweep.reductions
     }
     data["error"] = (
-        DIM,
-        da.from_array(np.full(n, "", dtype=_STRING), chunks=1),
+        dims,
+        da.from_array(np.full(shape, "", dtype=_STRING), chunks=chunks),
         {"long_name": 'why the point failed ("" if it did not)'},
     )
     data["checksum"] = (
-        DIM,
-        da.zeros(n, dtype=np.uint64, chunks=1),
-        {"long_name": "hash of the sweep, the point's index, values and error (0: none)"},
+        dims,
+        da.zeros(shape, dtype=np.uint64, chunks=chunks),
+        {"units": "1",
+         "long_name": "hash of the sweep, the point's index, values and error (0: none)"},
     )
     data["done"] = (
-        DIM,
-        da.zeros(n, dtype=bool, chunks=1),
-        {"long_name": "the point's values are written"},
+        dims,
+        da.zeros(shape, dtype=bool, chunks=chunks),
+        {"units": "1", "long_name": "the point's values are written"},
     )
-    updates = [sweep.updates(i) for i in range(n)]
-    coords = {DIM: (DIM, np.arange(n), {"long_name": "sweep point (C order over the axes)"})}
-    for key in sweep.axes:
-        attrs = {"long_name": f"case key {key}"}
-        if unit := unit_of(key):
-            attrs["units"] = unit
-        coords[key] = (DIM, _coordinate([u[key] for u in updates]), attrs)
+    if sweep.mode == "grid":
+        coords = {key: (key, _coordinate(values), key_attrs(key))
+                  for key, values in sweep.axes.items()}
+    else:
+        coords = {DIM: (DIM, np.arange(sweep.n_points), {"units": "1",
+                                                           "long_name": "sweep point"})}
+        coords |= {key: (DIM, _coordinate(values), key_attrs(key))
+                   for key, values in sweep.axes.items()}
+    keys = " and ".join(sweep.axes)
     attrs = {
-        "title": "fivdisc sweep",
+        **global_attrs(f"fivdisc sweep over {keys} ({sweep.mode}, {sweep.n_points} points)",
+                       "fivdisc.sweep.run_sweep"),
+        "fivdisc_kind": "sweep",
         "sweep_definition": sweep.definition,
         "sweep_hash": sweep.digest,
         "sweep_mode": sweep.mode,
         "sweep_axes": json.dumps(list(sweep.axes)),
-        "sweep_shape": json.dumps(list(sweep.shape)),
+        "sweep_shape": json.dumps(list(shape)),
         "sweep_variables": json.dumps([*(r.name for r in sweep.reductions), "error"]),
         "fivdisc_version": version("fivdisc"),
         "store_format": STORE_FORMAT,
     }
     dataset = xr.Dataset(data, coords=coords, attrs=attrs)
-    # Name the axis coordinates on every data variable, so that a variable rebuilt
-    # alone (see _repair) still carries them.
-    for var in dataset.data_vars.values():
-        var.encoding["coordinates"] = " ".join(sweep.axes)
+    if sweep.mode == "zip":
+        # Name the axis coordinates on every data variable, so that a variable rebuilt
+        # alone (see _repair) still carries them.
+        for var in dataset.data_vars.values():
+            var.encoding["coordinates"] = " ".join(sweep.axes)
     return dataset
 
 
@@ -195,13 +229,13 @@ def _checksum(digest: str, index: int, row: Sequence[Any]) -> int:
 
 def _read_attrs(path: Path) -> dict[str, Any]:
     """The group attributes of a sweep store; SweepError if `path` is not one."""
-    zarr = _require_zarr()
+    _require_zarr()
     if not path.is_dir():
         raise SweepError(f"{path} is not a sweep store: no such directory")
     if not (path / "zarr.json").is_file():
         raise SweepError(f"{path} exists and is not a Zarr store (it has no zarr.json)")
     try:
-        attrs = dict(zarr.open_group(path, mode="r").attrs)
+        attrs = dict(_open_group(path).attrs)
     except Exception as exc:  # zarr raises several types for damaged metadata
         raise SweepError(
             f"{path} has damaged metadata ({path / 'zarr.json'}: {_brief(exc)}); delete the "
@@ -225,35 +259,36 @@ def _differences(stored: str, current: str) -> list[str]:
 
 
 def _readable(array: Any) -> tuple[np.ndarray, np.ndarray]:
-    """(values, readable) of a one-dimensional Zarr array, chunk by chunk if need be.
+    """(values, readable) of a Zarr array of one-point chunks, chunk by chunk if need be,
+    both flattened in C order (the order of the sweep's points).
 
     A chunk cut short or damaged by a crash raises on decoding; Zarr's error types
     vary with the codec, hence the broad except. Unreadable points get the fill value.
     """
     try:
-        return array[:], np.ones(array.shape, dtype=bool)
+        return np.ravel(array[...]), np.ones(array.size, dtype=bool)
     except Exception:
         values = np.full(array.shape, array.fill_value, dtype=array.dtype)
         ok = np.zeros(array.shape, dtype=bool)
-        for i in range(array.shape[0]):
+        for index in np.ndindex(array.shape):
             try:
-                values[i] = array[i]
-                ok[i] = True
+                values[index] = array[index]
+                ok[index] = True
             except Exception:
                 continue
-        return values, ok
+        return values.ravel(), ok.ravel()
 
 
-def _arrays(path: Path, names: Sequence[str], n: int) -> tuple[dict[str, Any], list[str]]:
-    """The store's arrays by name, and the names whose metadata is missing or damaged."""
-    zarr = _require_zarr()
-    group = zarr.open_group(path, mode="r")
+def _arrays(path: Path, shapes: dict[str, tuple[int, ...]]) -> tuple[dict[str, Any], list[str]]:
+    """The store's arrays by name, and the names whose metadata is missing, damaged or of
+    another shape than `shapes` gives."""
+    group = _open_group(path)
     arrays: dict[str, Any] = {}
     broken: list[str] = []
-    for name in names:
+    for name, shape in shapes.items():
         try:
             array = group[name]
-            ok = array.shape == (n,)
+            ok = array.shape == shape
         except Exception:  # missing directory (KeyError), damaged JSON, bad metadata
             ok = False
         if ok:
@@ -296,19 +331,26 @@ class StoreHealth:
         return not self.damaged.any() and not self.broken
 
 
-def _layout(attrs: dict[str, Any]) -> tuple[list[str], list[str], int]:
-    """(checksummed variables: reductions then "error"; every variable; number of points)."""
+def _layout(attrs: dict[str, Any]) -> tuple[list[str], dict[str, tuple[int, ...]]]:
+    """(checksummed variables: reductions then "error"; every variable -> its shape)."""
     variables = json.loads(attrs["sweep_variables"])
-    coords = [DIM, *json.loads(attrs["sweep_axes"])]
-    return variables, [*variables, "checksum", "done", *coords], \
-        math.prod(json.loads(attrs["sweep_shape"]))
+    keys = json.loads(attrs["sweep_axes"])
+    shape = tuple(json.loads(attrs["sweep_shape"]))
+    shapes = {name: shape for name in [*variables, "checksum", "done"]}
+    if attrs["sweep_mode"] == "grid":
+        shapes |= {key: (length,) for key, length in zip(keys, shape, strict=True)}
+    else:
+        shapes |= {name: shape for name in [DIM, *keys]}
+    return variables, shapes
 
 
 def _inspect(path: Path, attrs: dict[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray,
                                                           list[str]]:
-    """(complete, damaged, failed, broken variables) of a store; see :class:`StoreHealth`."""
-    variables, names, n = _layout(attrs)
-    arrays, broken = _arrays(path, names, n)
+    """(complete, damaged, failed, broken variables) of a store; see :class:`StoreHealth`.
+    The masks are flat, one entry per point."""
+    variables, shapes = _layout(attrs)
+    arrays, broken = _arrays(path, shapes)
+    n = math.prod(shapes["done"])
     if "done" in arrays:
         done, done_readable = _readable(arrays["done"])
         done = np.asarray(done, dtype=bool)
@@ -497,8 +539,7 @@ class SweepStore:
                     f"{path} holds a different sweep (its definition differs in: {fields}); "
                     "write to a new store, or delete this one to start over"
                 )
-            _, names, n = _layout(attrs)
-            _repair(path, sweep, _arrays(path, names, n)[1])
+            _repair(path, sweep, _arrays(path, _layout(attrs)[1])[1], attrs)
         else:
             _create(path, sweep)
         return cls(path, sweep)
@@ -509,52 +550,57 @@ class SweepStore:
 
     def errors(self, points: np.ndarray) -> dict[int, str]:
         """Point index -> error message of the failed ones among `points`."""
-        group = _require_zarr().open_group(self.path, mode="r")
-        errors, _ = _readable(group["error"])
+        errors, _ = _readable(_open_group(self.path)["error"])
         return {int(i): str(errors[i]) for i in np.flatnonzero(points) if errors[i]}
 
     def write(self, outcomes: Sequence[PointOutcome]) -> None:
         """Store finished points: values and errors first, then their ``done`` flags.
 
-        Points with consecutive indices are written by one region write each.
+        Points with consecutive indices along the last axis are written by one region
+        write each.
         """
+        shape = self.sweep.shape
         outcomes = sorted(outcomes, key=lambda o: o.index)
         runs: list[list[PointOutcome]] = []
         for outcome in outcomes:
-            if runs and runs[-1][-1].index + 1 == outcome.index:
+            # A run stays within one row of the last axis, so that it is a region.
+            if (runs and runs[-1][-1].index + 1 == outcome.index
+                    and outcome.index % shape[-1] != 0):
                 runs[-1].append(outcome)
             else:
                 runs.append([outcome])
+        names = (*(r.name for r in self.sweep.reductions), "error")
         for run in runs:
             data = {
-                r.name: (
-                    DIM,
-                    np.array(
-                        [r.fill if o.values is None else o.values[r.name] for o in run],
-                        dtype=r.dtype,
-                    ),
-                )
+                r.name: np.array([r.fill if o.values is None else o.values[r.name] for o in run],
+                                 dtype=r.dtype)
                 for r in self.sweep.reductions
             }
-            data["error"] = (DIM, np.array([o.error for o in run], dtype=_STRING))
-            columns = [data[name][1] for name in (*(r.name for r in self.sweep.reductions),
-                                                  "error")]
-            checksums = [
-                _checksum(self.sweep.digest, o.index, [column[j] for column in columns])
-                for j, o in enumerate(run)
-            ]
-            data["checksum"] = (DIM, np.array(checksums, dtype=np.uint64))
-            self._write_region(xr.Dataset(data), run)
+            data["error"] = np.array([o.error for o in run], dtype=_STRING)
+            data["checksum"] = np.array(
+                [_checksum(self.sweep.digest, o.index, [data[name][j] for name in names])
+                 for j, o in enumerate(run)],
+                dtype=np.uint64,
+            )
+            self._write_region(data, run)
         for run in runs:
-            self._write_region(xr.Dataset({"done": (DIM, np.ones(len(run), dtype=bool))}), run)
+            self._write_region({"done": np.ones(len(run), dtype=bool)}, run)
 
-    def _write_region(self, data: xr.Dataset, run: list[PointOutcome]) -> None:
-        region = {DIM: slice(run[0].index, run[-1].index + 1)}
+    def _write_region(self, columns: dict[str, np.ndarray], run: list[PointOutcome]) -> None:
+        """Write values of the consecutive points of `run`, all in one row of the last axis."""
+        dims, shape = dims_of(self.sweep), self.sweep.shape
+        first = np.unravel_index(run[0].index, shape)
+        region = {dim: slice(int(i), int(i) + 1) for dim, i in zip(dims[:-1], first[:-1],
+                                                                    strict=True)}
+        region[dims[-1]] = slice(int(first[-1]), int(first[-1]) + len(run))
+        block = (1,) * (len(dims) - 1) + (len(run),)
+        data = xr.Dataset({name: (dims, values.reshape(block)) for name, values in
+                           columns.items()})
         data.to_zarr(self.path, region=region, mode="r+", consolidated=False)
 
 
-def _encoding(names: Sequence[str]) -> dict[str, dict[str, Any]]:
-    return {name: {"chunks": (1,)} for name in names}
+def _encoding(names: Sequence[str], ndim: int) -> dict[str, dict[str, Any]]:
+    return {name: {"chunks": (1,) * ndim} for name in names}
 
 
 def _create(path: Path, sweep: Sweep) -> None:
@@ -564,17 +610,18 @@ def _create(path: Path, sweep: Sweep) -> None:
     try:
         template.to_zarr(
             tmp, mode="w-", compute=False, consolidated=False, zarr_format=3,
-            encoding=_encoding(list(template.data_vars)),
+            encoding=_encoding(list(template.data_vars), len(sweep.shape)),
         )
+        _consolidate(tmp)
         tmp.rename(path)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
 
 
-def _repair(path: Path, sweep: Sweep, broken: Sequence[str]) -> None:
+def _repair(path: Path, sweep: Sweep, broken: Sequence[str], attrs: dict[str, Any]) -> None:
     """Rebuild variables whose metadata is missing or damaged: coordinates from the sweep,
-    data variables empty."""
+    data variables empty; the group keeps its attributes `attrs`."""
     if not broken:
         return
     template = _template(sweep)
@@ -585,17 +632,19 @@ def _repair(path: Path, sweep: Sweep, broken: Sequence[str]) -> None:
     for name in broken:
         if name in template.coords and name not in rebuilt:
             rebuilt[name] = template[name].variable
-    rebuilt.attrs = template.attrs  # the group's, rewritten unchanged (same sweep)
+    rebuilt.attrs = attrs  # the group's, rewritten unchanged
     # Data variables are lazy, so only their metadata is written; coordinates are numpy
     # arrays, whose values compute=False writes too.
     rebuilt.to_zarr(
         path, mode="a", compute=False, consolidated=False, zarr_format=3,
-        encoding=_encoding([n for n in broken if n in template.data_vars]),
+        encoding=_encoding([n for n in broken if n in template.data_vars], len(sweep.shape)),
     )
+    _consolidate(path)
 
 
 def open_sweep(path: str | PathLike[str]) -> xr.Dataset:
-    """Load a sweep store into memory, one entry per point.
+    """Load a sweep store into memory: a grid sweep on its axes (one dimension per swept
+    key, with the axis values, units and long_name), a zip sweep along ``point``.
 
     ``done`` is True only for verified points (see :func:`read_mask`); unreadable chunks
     read as their variable's fill value, and the values of points that are not done are
@@ -616,59 +665,21 @@ def open_sweep(path: str | PathLike[str]) -> xr.Dataset:
             "rerun the sweep to rebuild them and recompute their points"
         )
     # chunks=None: lazily indexed arrays read by Zarr itself, not dask (whose default
-    # scheduler may be a cluster client of this process).
+    # scheduler may be a cluster client of this process). consolidated=False: each
+    # variable's own metadata, as checked above.
     data = xr.open_zarr(path, consolidated=False, chunks=None)
+    shapes = _layout(attrs)[1]
     for name in list(data.data_vars):
         try:
             data[name].load()
         except Exception:  # damaged chunks: the codec's error type varies
-            values, _ = _readable(_arrays(path, [name], complete.size)[0][name])
-            data[name] = data[name].copy(data=values)
+            values, _ = _readable(_arrays(path, {name: shapes[name]})[0][name])
+            data[name] = data[name].copy(data=values.reshape(shapes[name]))
     try:
         data = data.load()
     except Exception as exc:  # a damaged coordinate chunk
         raise SweepError(
             f"{path} has unreadable coordinates ({_brief(exc)}); rerun the sweep to rebuild them"
         ) from None
-    data["done"] = data["done"].copy(data=complete)
+    data["done"] = data["done"].copy(data=complete.reshape(shapes["done"]))
     return data
-
-
-def as_grid(data: xr.Dataset) -> xr.Dataset:
-    """A grid sweep's dataset with its points laid out on the axes.
-
-    Parameters
-    ----------
-    data
-        A grid sweep as returned by :func:`open_sweep`.
-
-    Returns
-    -------
-    xarray.Dataset
-        Every variable along ``point`` is reshaped to the axes' dimensions, named
-        by the axis keys and indexed by the axis values.
-
-    Raises
-    ------
-    SweepError
-        The sweep is not a grid.
-    """
-    if data.attrs.get("sweep_mode") != "grid":
-        raise SweepError(
-            f"sweep_mode = {data.attrs.get('sweep_mode')!r} is invalid for as_grid: must be 'grid'"
-        )
-    keys = json.loads(data.attrs["sweep_axes"])
-    shape = tuple(json.loads(data.attrs["sweep_shape"]))
-    # The axis values along each dimension are those of the points where the other
-    # axes are at their first value, i.e. strides through the C-ordered points.
-    strides = strides_of(shape)
-    coords = {
-        key: (key, data[key].values[: stride * length : stride], data[key].attrs)
-        for key, length, stride in zip(keys, shape, strides, strict=True)
-    }
-    variables = {
-        name: (keys, var.values.reshape(shape), var.attrs)
-        for name, var in data.data_vars.items()
-        if var.dims == (DIM,)
-    }
-    return xr.Dataset(variables, coords=coords, attrs=data.attrs)

@@ -1,0 +1,112 @@
+"""Saying so while the simulation kernel compiles.
+
+numba compiles the kernel on its first call in a fresh installation (about a minute) and
+caches it on disk, so later processes load it in a second or two. :func:`compile_notice`
+wraps that first call: when the kernel is neither in memory nor in numba's cache it
+prints what is happening on stderr, with a spinner and the seconds elapsed when stderr is
+a terminal, and the time it took at the end.
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any, TextIO
+
+__all__ = ["COMPILE_SECONDS", "compile_notice", "needs_compiling", "warm_kernel"]
+
+#: Typical time to compile the kernel [s]: 44-67 s measured on a loaded 2-core machine,
+#: 118 s on one under heavier load; benchmarks/bench_simulate.py measures it on yours.
+COMPILE_SECONDS = 90
+_FRAMES = "|/-\\"
+_TICK = 0.25  # [s] between spinner frames
+
+
+def needs_compiling(dispatcher: Any) -> bool:
+    """Whether calling a numba dispatcher will compile it: it has no compiled signature in
+    this process and numba's on-disk cache has no index for it.
+
+    A cache index that numba then finds stale (another numba version) still counts as
+    cached here; that is a rare upgrade path, and the run then compiles without notice.
+    """
+    if getattr(dispatcher, "signatures", None):
+        return False
+    cache = getattr(dispatcher, "_cache", None)
+    index = getattr(getattr(cache, "_cache_file", None), "_index_path", None)
+    return index is None or not Path(index).exists()
+
+
+@contextmanager
+def compile_notice(dispatcher: Any, show: bool = True,
+                   stream: TextIO | None = None) -> Iterator[None]:
+    """Print a notice on `stream` while the body compiles `dispatcher`, if it will.
+
+    Parameters
+    ----------
+    dispatcher
+        The numba dispatcher the body calls first.
+    show
+        False: say nothing (the body still runs).
+    stream
+        Where to write [default: sys.stderr].
+    """
+    if not show or not needs_compiling(dispatcher):
+        yield
+        return
+    out = stream if stream is not None else sys.stderr
+    line = f"compiling the simulation kernel, once: about {COMPILE_SECONDS} s"
+    live = out.isatty()
+    start = time.perf_counter()
+    done = threading.Event()
+
+    def spin() -> None:
+        frame = 0
+        while not done.wait(_TICK):
+            elapsed = time.perf_counter() - start
+            out.write(f"\r{line} {_FRAMES[frame % len(_FRAMES)]} {elapsed:.0f} s ")
+            out.flush()
+            frame += 1
+
+    spinner = threading.Thread(target=spin, daemon=True)
+    if live:
+        spinner.start()
+    else:
+        out.write(line + "\n")
+        out.flush()
+
+    def stop(ending: str) -> None:
+        done.set()
+        if live:
+            spinner.join()
+            out.write("\r" + ending.ljust(len(line) + 8) + "\n")
+        elif ending:
+            out.write(ending + "\n")
+        out.flush()
+
+    try:
+        yield
+    except BaseException:
+        stop("")
+        raise
+    stop(f"compiled the simulation kernel in {time.perf_counter() - start:.0f} s; later "
+         "runs load it")
+
+
+def warm_kernel(show: bool = False) -> None:
+    """Compile or load the simulation kernel now, with a run of 1 ms of simulated time.
+
+    Parameters
+    ----------
+    show
+        Print the notice of :func:`compile_notice` if the kernel compiles.
+    """
+    from fivdisc._kernels import integrate
+    from fivdisc.case import Case
+    from fivdisc.simulate import simulate
+
+    with compile_notice(integrate.run, show=show):
+        simulate(Case(simulation={"duration": 1e-3, "output_rate": 1000.0}))
