@@ -43,14 +43,14 @@ import tomllib
 
 def fragile(result):
     """Number of switches; fails on purpose for the fastest disc."""
-    time.sleep(0.3)  # slow enough to interrupt a sweep between points, however fast the solver
+    time.sleep(0.6)  # slow enough to interrupt a sweep between points, however fast the solver
     case = tomllib.loads(result.dataset.attrs["case"])
     if case["speed"]["initial"] >= 20.0:
         raise ValueError("too fast for this test")
     return result.summary().switches
 '''
 
-# 12 points of about 0.4 s each; the user reduction needs whole runs and fails for
+# 12 points of about 0.7 s each; the user reduction needs whole runs and fails for
 # the 3 points with initial = 20.
 SWEEP = """
 mode = "grid"

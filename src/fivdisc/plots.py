@@ -361,13 +361,14 @@ def plot_spectrum(data: xr.Dataset | object, var: str = "phi", probe: int | None
 def _label_peaks(ax: Axes, frequencies: np.ndarray, amplitudes: np.ndarray) -> None:
     """Write each peak's frequency above it, strongest first, leaving out a label that
     would overlap one already written or leave the axes."""
-    renderer = ax.figure.canvas.get_renderer()
-    inside = ax.get_window_extent(renderer)
+    # Without a renderer argument the extents come from the figure's own renderer, which
+    # also exists for figures made without pyplot (their canvas has no get_renderer).
+    inside = ax.get_window_extent()
     written = []
     for f, a in zip(frequencies, amplitudes, strict=True):
         label = ax.annotate(f"{f:.1f}", (f, a), textcoords="offset points", xytext=(0, 5),
                             ha="center", fontsize="x-small")
-        box = label.get_window_extent(renderer)
+        box = label.get_window_extent()
         if any(box.overlaps(other) for other in written) or not (
                 inside.x0 <= box.x0 and box.x1 <= inside.x1 and box.y1 <= inside.y1):
             label.remove()
