@@ -35,6 +35,21 @@ def test_paper_case_stays_within_the_limit():
     res = simulate(Case(simulation={"duration": 0.3}))
     assert res.status == "success"
     assert 0.002 < np.max(np.abs(res.dataset["w"].values)) < Deflection.DIVERGED * 0.002
+    # ... but the summary warns that linear plate theory is stretched.
+    summary = res.summary()
+    assert summary.disc_thickness == 0.002
+    ratio = summary.max_abs_w / 0.002
+    assert f"warning: |w| reached {ratio:.3g} times the disc thickness" in str(summary)
+
+
+def test_small_deflections_get_no_warning():
+    """Two equal pads on opposite faces keep the disc flat: |w| far below h."""
+    pad = {"track_radius": 0.1, "angle": 0.0}
+    res = simulate(Case(sliders=[{**pad, "face": "top"}, {**pad, "face": "bottom"}],
+                        simulation={"duration": 0.05}))
+    summary = res.summary()
+    assert summary.max_abs_w < 0.1 * summary.disc_thickness
+    assert "warning" not in str(summary)
 
 
 def test_cli_reports_divergence_in_one_line(tmp_path):

@@ -205,6 +205,16 @@ def select_slider(ds: xr.Dataset, slider: int = 0) -> xr.Dataset:
     return out
 
 
+def _disc_thickness(ds: xr.Dataset) -> float:
+    """The disc thickness [m] of the case a result was run with (nan if not recorded)."""
+    import tomllib
+
+    try:
+        return float(tomllib.loads(ds.attrs["case"])["disc"]["thickness"])
+    except (KeyError, ValueError, TypeError):
+        return float("nan")
+
+
 @dataclass(frozen=True)
 class SliderSummary:
     """What one slider did in a run (see :class:`Summary`).
@@ -248,6 +258,10 @@ class Summary:
         Largest |w| at the probes [m].
     wall_time : float
         Time the integration took [s], without compiling or loading the kernel.
+    disc_thickness : float
+        The disc's thickness h [m] (nan if the file does not say). Linear plate theory
+        assumes |w| small against h: the printed summary warns when ``max_abs_w``
+        exceeds it (runs end as diverged beyond 25 h, see ``simulate``).
     """
 
     status: str
@@ -257,6 +271,7 @@ class Summary:
     impacts: int
     max_abs_w: float
     wall_time: float
+    disc_thickness: float = float("nan")
 
     @property
     def separations(self) -> int:
@@ -293,6 +308,10 @@ class Summary:
         peaks = ", ".join(f"{s.peak_normal_force:.6g}" for s in self.sliders)
         out.append(f"peak normal force: {peaks} N, largest |w| at probes: "
                    f"{self.max_abs_w:.6g} m")
+        if self.max_abs_w > self.disc_thickness:
+            out.append(f"warning: |w| reached {self.max_abs_w / self.disc_thickness:.3g} "
+                       "times the disc thickness, beyond the small deflections of linear "
+                       "plate theory")
         out.append(f"wall time: {self.wall_time:.3g} s (integration only, without compiling "
                    "the kernel)")
         return out
@@ -412,6 +431,7 @@ class Result:
             impacts=impacts,
             max_abs_w=float(np.nanmax(w, initial=0.0) if np.isfinite(w).any() else np.nan),
             wall_time=float(ds.attrs.get("wall_time", np.nan)),
+            disc_thickness=_disc_thickness(ds),
         )
 
     def plot(self, kind: str = "timeseries", **options: Any) -> Figure:
