@@ -7,7 +7,8 @@ measured in the same run:
    (``previous.BEFORE_FAMILY``, installed into its own virtual environment), on the
    paper's Fig. 10 case and a stick-slip case (Figs. 8-9), with the results compared;
 2. the speed-up over the scipy baseline (``bench_simulate.against_baseline``);
-3. the cost per step of 2 and 8 sliders against 1 slider (same disc, same span).
+3. the cost per step of 2 and 8 sliders against 1 slider (same disc, same span), in
+   stick-slip and in steady sliding.
 
 Costs per step are the kernel's wall time (``wall_time``, which excludes compilation)
 over its accepted steps, the median of three runs.
@@ -79,18 +80,34 @@ def against_previous() -> None:
               f"steps {n['steps']} vs {b['steps']}")
 
 
+def _spread(base: dict, count: int) -> dict:
+    """``base`` with ``count`` copies of its slider spread around the disc."""
+    case = {k: v for k, v in base.items() if k != "slider"}
+    slider = base.get("slider", {})
+    case["sliders"] = [{**slider, "angle": 2 * np.pi * j / count + 0.05 * j}
+                       for j in range(count)]
+    return case
+
+
 def sliders() -> None:
-    base = {"simulation": {"duration": 2.0, "output_rate": 1000.0}}
-    cases = {}
-    for count in (1, 2, 8):
-        sliders = [{"angle": 2 * np.pi * j / count + 0.05 * j} for j in range(count)]
-        cases[str(count)] = {**base, "sliders": sliders}
-    costs = per_step(cases)
-    one = costs["1"]["cost"]
-    for count in ("1", "2", "8"):
-        c = costs[count]
-        print(f"{count} slider(s): {c['cost'] * 1e6:6.2f} us per step ({c['steps']} steps), "
-              f"{c['cost'] / one:.2f} x one slider")
+    """Cost per step of 1, 2 and 8 sliders: in stick-slip (Figs. 8-9 parameters, 2 s;
+    every slider adds its switches, each located by extra evaluations) and in steady
+    sliding (Fig. 4 parameters, 10 s: the integration alone)."""
+    import tomllib
+
+    from fivdisc import examples
+
+    fig04 = tomllib.loads(examples.path("fig04").read_text())
+    fig04["simulation"] = {**fig04.get("simulation", {}), "duration": 10.0,
+                           "output_rate": 100.0}
+    bases = {"stick-slip": {"simulation": {"duration": 2.0, "output_rate": 1000.0}},
+             "steady sliding": fig04}
+    for label, base in bases.items():
+        costs = per_step({str(count): _spread(base, count) for count in (1, 2, 8)})
+        one = costs["1"]["cost"]
+        for count, c in costs.items():
+            print(f"{label:14s} {count} slider(s): {c['cost'] * 1e6:6.2f} us per step "
+                  f"({c['steps']} steps), {c['cost'] / one:.2f} x one slider")
 
 
 def main() -> None:
