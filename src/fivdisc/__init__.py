@@ -115,6 +115,7 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
+    """The module's names, with the public ones not yet imported (tab completion)."""
     return sorted({*globals(), *__all__})
 
 
