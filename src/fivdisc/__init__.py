@@ -12,34 +12,36 @@ The public API::
 Plotting lives in :mod:`fivdisc.plots`, parameter sweeps in :mod:`fivdisc.sweep` and the
 paper's cases in :mod:`fivdisc.paper`; they import matplotlib or dask only when used. The
 example cases that ship with fivdisc are in :mod:`fivdisc.examples`.
+
+The names of ``__all__`` are imported on first use, so that ``import fivdisc`` and the
+command line start without numba, xarray and scipy.
 """
 
-from importlib.metadata import version as _version
+import sys
+from importlib import import_module
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
 
-from fivdisc.analysis import (
-    Equilibrium,
-    LinearStability,
-    classify,
-    dominant_frequency,
-    energy_balance,
-    find_peaks,
-    linear_stability,
-    perturbation_test,
-    separation_stats,
-    sliding_equilibrium,
-    spectrum,
-    stability_map,
-    stft,
-)
-from fivdisc.case import Case, load_case
-from fivdisc.errors import CaseError, FivdiscError, ModeError, SimulationError
-from fivdisc.model import Model, build_model
-from fivdisc.plate import AnnularPlate, PlateMode
-from fivdisc.result import Result, Summary, open_result
-from fivdisc.simulate import simulate
-from fivdisc.speed import SpeedProfile
+if TYPE_CHECKING:
+    from fivdisc.analysis.energy import energy_balance
+    from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium
+    from fivdisc.analysis.spectra import classify, dominant_frequency, find_peaks, spectrum, stft
+    from fivdisc.analysis.stability import (
+        LinearStability,
+        linear_stability,
+        perturbation_test,
+        stability_map,
+    )
+    from fivdisc.analysis.trajectories import separation_stats
+    from fivdisc.case import Case, load_case
+    from fivdisc.errors import CaseError, FivdiscError, ModeError, SimulationError
+    from fivdisc.model import Model, build_model
+    from fivdisc.plate import AnnularPlate, PlateMode
+    from fivdisc.result import Result, Summary, open_result
+    from fivdisc.simulate import simulate
+    from fivdisc.speed import SpeedProfile
 
-__version__ = _version("fivdisc")
+    __version__: str
 
 __all__ = [
     "AnnularPlate",
@@ -72,3 +74,63 @@ __all__ = [
     "stability_map",
     "stft",
 ]
+
+# Name of __all__ -> the module that defines it (the imports above, for type checkers).
+_HOMES = {
+    name: module
+    for module, names in {
+        "fivdisc.analysis.energy": ("energy_balance",),
+        "fivdisc.analysis.equilibrium": ("Equilibrium", "sliding_equilibrium"),
+        "fivdisc.analysis.spectra": (
+            "classify", "dominant_frequency", "find_peaks", "spectrum", "stft"
+        ),
+        "fivdisc.analysis.stability": (
+            "LinearStability", "linear_stability", "perturbation_test", "stability_map"
+        ),
+        "fivdisc.analysis.trajectories": ("separation_stats",),
+        "fivdisc.case": ("Case", "load_case"),
+        "fivdisc.errors": ("CaseError", "FivdiscError", "ModeError", "SimulationError"),
+        "fivdisc.model": ("Model", "build_model"),
+        "fivdisc.plate": ("AnnularPlate", "PlateMode"),
+        "fivdisc.result": ("Result", "Summary", "open_result"),
+        "fivdisc.simulate": ("simulate",),
+        "fivdisc.speed": ("SpeedProfile",),
+    }.items()
+    for name in names
+}
+
+
+def __getattr__(name: str) -> Any:
+    """Import a public name on first use and keep it, so later look-ups are plain."""
+    if name == "__version__":
+        from importlib.metadata import version
+
+        value = version("fivdisc")
+    elif name in _HOMES:
+        value = getattr(import_module(_HOMES[name]), name)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    """The module's names, with the public ones not yet imported (tab completion)."""
+    return sorted({*globals(), *__all__})
+
+
+class _Package(ModuleType):
+    """fivdisc's module type: the function :func:`simulate` keeps its name on the package.
+
+    The import system binds a submodule, once imported, to the package's attribute of the
+    same name; the module ``fivdisc.simulate``, imported by whatever needs it first, would
+    then hide the function ``fivdisc.simulate`` that it defines.
+    """
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if isinstance(value, ModuleType) and _HOMES.get(name) == value.__name__:
+            value = getattr(value, name)
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package

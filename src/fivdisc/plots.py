@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, ParamSpec, TypeVar
 import numpy as np
 import xarray as xr
 
+from fivdisc import _plot_kinds
 from fivdisc.analysis.spectra import (
     AnalysisError,
     as_dataset,
@@ -59,8 +60,9 @@ Window = tuple[float | None, float | None] | None
 P = ParamSpec("P")
 R = TypeVar("R")
 
+# Defined apart, for the command line to list them without importing this module.
 #: The kinds of figure of a simulation result (``fivdisc plot --kind``).
-KINDS = ("timeseries", "spectrogram", "spectrum", "phase", "friction", "normal-force")
+KINDS = _plot_kinds.KINDS
 # Default spectrogram segments: at least this many per record, and frequency bins at
 # most this fraction of the frequency range shown.
 _SEGMENTS_PER_RECORD = 100

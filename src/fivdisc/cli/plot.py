@@ -4,12 +4,15 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
-import numpy as np
 
+from fivdisc._plot_kinds import KINDS
 from fivdisc.errors import FivdiscError
-from fivdisc.plots import KINDS
+
+if TYPE_CHECKING:
+    import numpy as np
 
 _USES_VAR = ("timeseries", "spectrogram", "spectrum")
 # Variables each kind of plot reads, besides --var.

@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import click
-import numpy as np
 
 from fivdisc.cli._case import CASE
 from fivdisc.errors import FivdiscError
@@ -34,6 +33,8 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
     equations. With both: computes the largest growth rate over the grid and the
     stability boundary, and writes it with -o.
     """
+    import numpy as np
+
     from fivdisc.analysis.stability import linear_stability, parse_range, stability_map
     from fivdisc.case import Case, load_case
     from fivdisc.extras import require

@@ -8,7 +8,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import click
-import numpy as np
 
 from fivdisc.cli._case import CASE, default_output
 from fivdisc.errors import FivdiscError
@@ -89,6 +88,8 @@ def _quiet_dask() -> None:
 
 def _verify(store: Path) -> None:
     """Report the health of a sweep store; exit 1 if it is damaged."""
+    import numpy as np
+
     from fivdisc.sweep import verify_store
 
     health = verify_store(store)

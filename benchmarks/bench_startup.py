@@ -1,0 +1,82 @@
+"""Start-up time of fresh processes: ``import fivdisc``, the command line's help, and the
+whole Fig. 10 command, side by side with the interpreter's own start in the same run.
+
+Run ``python benchmarks/bench_startup.py`` (``--repeat N`` processes per command, default
+15; ``--no-fig10`` leaves out the slow Fig. 10 command). The fivdisc on ``sys.path`` is
+timed: set ``PYTHONPATH=src`` to time a clone. It prints, per command, the median wall time
+of its fresh processes [s], its ratio to the interpreter's start (``python -c pass``) and
+to ``python -c "import numpy"``, and the target of issue 11 (item 3). The commands take
+turns, so that a change in the machine's load during the run falls on all of them alike;
+each runs once before the timing (compiled bytecode, the kernel's cache, the file cache).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+# The console script `fivdisc` runs exactly this; through the interpreter being timed, so
+# that no installed copy of fivdisc stands in for the one on sys.path.
+_CLI = "from fivdisc.cli import main; main()"
+
+
+def _commands(workdir: Path, fig10: bool) -> list[tuple[str, list[str], float | None]]:
+    """(label, argv, target [s] or None) of each command timed."""
+    python = sys.executable
+    commands = [
+        ('python -c "pass"', [python, "-c", "pass"], None),
+        ('python -c "import numpy"', [python, "-c", "import numpy"], None),
+        ('python -c "import fivdisc"', [python, "-c", "import fivdisc"], 0.4),
+        ("fivdisc --help", [python, "-c", _CLI, "--help"], 0.3),
+        ("fivdisc simulate --help", [python, "-c", _CLI, "simulate", "--help"], 0.3),
+    ]
+    if fig10:
+        out = str(workdir / "fig10.nc")
+        commands.append(("fivdisc simulate fig10 -o fig10.nc",
+                         [python, "-c", _CLI, "simulate", "fig10", "-o", out, "--no-progress"],
+                         2.0))
+    return commands
+
+
+def _seconds(argv: list[str], workdir: Path) -> float:
+    start = time.perf_counter()
+    subprocess.run(argv, check=True, stdout=subprocess.DEVNULL, cwd=workdir)
+    return time.perf_counter() - start
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=15, help="processes per command")
+    parser.add_argument("--no-fig10", dest="fig10", action="store_false",
+                        help="leave out fivdisc simulate fig10 (about 2 s a process)")
+    args = parser.parse_args()
+    # One core per process, as in the other benchmarks.
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    with tempfile.TemporaryDirectory() as tmp:
+        workdir = Path(tmp)
+        commands = _commands(workdir, args.fig10)
+        for _, argv, _ in commands:
+            _seconds(argv, workdir)
+        times: list[list[float]] = [[] for _ in commands]
+        for _ in range(args.repeat):
+            for (_, argv, _), samples in zip(commands, times, strict=True):
+                samples.append(_seconds(argv, workdir))
+    medians = [statistics.median(samples) for samples in times]
+    interpreter, numpy = medians[0], medians[1]
+    print(f"fresh processes, median of {args.repeat} each ({sys.executable})")
+    print(f"{'command':<36} {'median [s]':>10} {'/ pass':>8} {'/ numpy':>8} {'target [s]':>11}")
+    for (label, _, target), median in zip(commands, medians, strict=True):
+        goal = f"{target:.1f}" if target is not None else ""
+        print(f"{label:<36} {median:>10.3f} {median / interpreter:>8.1f} "
+              f"{median / numpy:>8.2f} {goal:>11}")
+
+
+if __name__ == "__main__":
+    main()

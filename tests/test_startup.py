@@ -1,0 +1,83 @@
+"""``import fivdisc`` and the command line's help start light (issue 11, item 3): the
+public names are imported on first use, the commands import their machinery when they run.
+
+Each check runs in a fresh process, where nothing else has imported the heavy modules yet.
+How long the start takes is measured by ``benchmarks/bench_startup.py``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import os
+import subprocess
+import sys
+from importlib.metadata import version
+from pathlib import Path
+
+import pytest
+
+import fivdisc
+
+HEAVY = ("scipy.optimize", "xarray", "numba", "matplotlib", "dask")
+
+# Runs CODE (which may end the process, as click does after --help), then prints which
+# of HEAVY were imported, as the last line of stdout.
+_PROBE = """
+import json, sys
+try:
+{code}
+finally:
+    print(json.dumps([m for m in {heavy!r} if m in sys.modules]))
+"""
+# What the console script `fivdisc` runs.
+_CLI = "    from fivdisc.cli import main\n    main()"
+
+
+def _run(code: str, *args: str) -> subprocess.CompletedProcess:
+    """A fresh interpreter running `code` with `args`, on the fivdisc under test."""
+    source = str(Path(fivdisc.__file__).parents[1])
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        [source, *filter(None, [os.environ.get("PYTHONPATH")])])}
+    return subprocess.run([sys.executable, "-c", code, *args], env=env, capture_output=True,
+                          text=True, timeout=120)
+
+
+@pytest.mark.parametrize(("code", "args", "shows"), [
+    ("    import fivdisc", (), ""),
+    (_CLI, ("--help",), "Usage: fivdisc [OPTIONS] COMMAND"),
+    (_CLI, ("simulate", "--help"), "Usage: fivdisc simulate [OPTIONS] CASE_FILE"),
+], ids=["import fivdisc", "fivdisc --help", "fivdisc simulate --help"])
+def test_start_imports_no_heavy_module(code, args, shows):
+    out = _run(_PROBE.format(code=code, heavy=HEAVY), *args)
+    assert out.returncode == 0, out.stderr
+    assert shows in out.stdout
+    assert json.loads(out.stdout.splitlines()[-1]) == []
+
+
+@pytest.mark.parametrize("name", sorted(set(fivdisc.__all__) - {"__version__"}))
+def test_public_name_is_the_object_of_its_home_module(name):
+    obj = getattr(fivdisc, name)
+    assert obj is getattr(importlib.import_module(obj.__module__), name)
+    assert name in dir(fivdisc)
+
+
+def test_version_is_the_installed_one():
+    assert "__version__" in dir(fivdisc)
+    assert fivdisc.__version__ == version("fivdisc")
+
+
+def test_an_unknown_name_is_an_attribute_error():
+    with pytest.raises(AttributeError, match="module 'fivdisc' has no attribute 'simulation'"):
+        fivdisc.simulation  # noqa: B018
+    assert not hasattr(fivdisc, "__wrapped__")
+
+
+def test_simulate_stays_the_function_when_its_module_is_imported_first():
+    """The import system binds the module fivdisc.simulate to the package's attribute of
+    that name when something imports the module before fivdisc.simulate is looked up."""
+    code = ("import sys, fivdisc, fivdisc.simulate\n"
+            "from fivdisc import simulate\n"
+            "assert fivdisc.simulate is simulate is sys.modules['fivdisc.simulate'].simulate\n")
+    out = _run(code)
+    assert out.returncode == 0, out.stderr
