@@ -128,7 +128,7 @@ def _piece(pieces, x, right):
     return max(lo - 1, 0)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def kinetic_friction(opts, table, r, s, v):
     """Kinetic friction coefficient at relative speed ``v`` [rad/s] in slip with sign ``s``.
 
@@ -230,10 +230,21 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
         dy[i] = y[half + i]
 
     lmax = int(opts[O_LMAX])
+    aux = r_aux
+    # The last slider's values stay in these locals: with one slider they give its
+    # normal force in closed form below. Phases, signs and slider constants are read
+    # into locals once: to the compiler every store to wk or dy may change them.
+    known = zero
+    smu = zero
+    fphi = zero
+    f = zero
+    phj = SLIP
     for j in range(ns):
+        phj = ph[j]
+        sj = sg[j]
         phi = y[n + j]
         phid = y[half + n + j]
-        if ph[j] == STICK:
+        if phj == STICK:
             phid = phid * 0.0 + om
         # cos(l psi), sin(l psi) by the Chebyshev recurrence: two trig calls per slider.
         psi = sl[S_THETA, j] + phi
@@ -279,21 +290,17 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
             s_gg += gi * gi * minv
             s_ggp += gi * gpi * minv
         wcd += phid * gpq
-        aux = r_aux
         wk[aux + A_WC, j] = wc
         wk[aux + A_WCD, j] = wcd
         wk[aux + A_V, j] = om - phid
         wk[aux + A_GPQ, j] = gpq
         wk[aux + A_GPQD, j] = gpqd
         wk[aux + A_L2GQ, j] = l2gq
-        wk[aux + A_SGF, j] = s_gf
-        wk[aux + A_SGG, j] = s_gg
-        wk[aux + A_SGGP, j] = s_ggp
         wk[aux + A_PHID, j] = phid
         wk[aux + A_N, j] = zero
         wk[aux + A_F, j] = zero
         dy[n + j] = phid
-        if ph[j] == SEPARATION:
+        if phj == SEPARATION:
             zj = y[n + ns + j]
             zdj = y[half + n + ns + j]
             dy[half + n + j] = (-sl[S_CPHI, j] * phid - sl[S_KPHI, j] * phi) / sl[S_INERTIA, j]
@@ -304,25 +311,81 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
         dy[n + ns + j] = zero
         dy[half + n + ns + j] = zero
         # The part of N that does not depend on the unknown accelerations.
-        wk[aux + A_KNOWN, j] = (
+        known = (
             sl[S_N0, j]
             + sl[S_SMASS, j] * (2.0 * phid * gpqd - phid * phid * l2gq)
             + sl[S_SCZ, j] * wcd
             + sl[S_SKZ, j] * wc
         )
-        if ph[j] == SLIP:
-            wk[aux + A_SMU, j] = sg[j] * kinetic_friction(opts, mdl.table, sl[S_RADIUS, j],
-                                                          sg[j], om - phid)
-            wk[aux + A_FPHI, j] = -sl[S_CPHI, j] * phid - sl[S_KPHI, j] * phi
+        if phj == SLIP:
+            smu = sj * kinetic_friction(opts, mdl.table, sl[S_RADIUS, j], sj, om - phid)
+            fphi = -sl[S_CPHI, j] * phid - sl[S_KPHI, j] * phi
+            wk[aux + A_SMU, j] = smu
         else:
             # Stick: phi'' = Omegadot, friction is the reaction of the in-plane oscillator.
-            wk[aux + A_F, j] = (sl[S_INERTIA, j] * omd + sl[S_CPHI, j] * om
-                                + sl[S_KPHI, j] * phi) / sl[S_RADIUS, j]
+            f = (sl[S_INERTIA, j] * omd + sl[S_CPHI, j] * om + sl[S_KPHI, j] * phi) / (
+                sl[S_RADIUS, j])
+            wk[aux + A_F, j] = f
+        if ns > 1:
+            wk[aux + A_KNOWN, j] = known
+            wk[aux + A_SGF, j] = s_gf
+            wk[aux + A_SGG, j] = s_gg
+            wk[aux + A_SGGP, j] = s_ggp
+            wk[aux + A_FPHI, j] = fphi
 
-    # One equation per slider for its normal force: N_j = known_j + sigma_j m_j (g_j.q''
-    # + g'_j.q phi_j''), with q'' = M^-1 (F + sum_k sigma_k (-N_k g_k + h_k f_k g'_k)) and,
-    # in slip, phi_j'' = (F_phi + r s mu N_j) / I. A flying slider's row is N_j = 0.
-    aux = r_aux
+    if ns == 1:
+        _one_slider(n, half, phj, known, smu, fphi, f, gpq, s_gf, s_gg, s_ggp, y[n], omd,
+                    zero, sl, disc, r_gp, r_fq, aux, wk, dy)
+    else:
+        _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, wk, dy)
+
+    if y.shape[0] > n_dynamic(mdl):
+        _powers(y, ph, om, omd, mdl, wk, dy)
+
+
+@njit(cache=True, inline="always")
+def _one_slider(n, half, phj, known, smu, fphi, f, gpq, s_gf, s_gg, s_ggp, phi, omd,
+                zero, sl, disc, r_gp, r_fq, aux, wk, dy):
+    """Normal force and accelerations with a single slider: the one equation of
+    :func:`_contacts` in closed form (the same operations in the same order, so the same
+    numbers), with the slider's values passed in registers."""
+    if phj == SEPARATION:
+        for i in range(n):
+            dy[half + i] = wk[r_fq, i] * disc[D_MINV, i]
+        return
+    m = sl[S_MASS, 0]
+    sm = sl[S_SMASS, 0]
+    inertia = sl[S_INERTIA, 0]
+    if phj == SLIP:
+        nf = (known + sm * (s_gf + zero) + sm * gpq * fphi / inertia) / (
+            1.0 + m * (s_gg - sl[S_HH, 0] * smu * s_ggp)
+            - sm * gpq * sl[S_RADIUS, 0] * smu / inertia)
+        sn = sl[S_SIGMA, 0] * nf
+        c = sl[S_HH, 0] * smu
+        for i in range(n):
+            dy[half + i] = (wk[r_fq, i] - sn * (wk[0, i] - c * wk[r_gp, i])) * disc[D_MINV, i]
+        f = smu * nf
+        dy[half + n] = (fphi + sl[S_RADIUS, 0] * f) / inertia
+    else:
+        nf = (known + sm * (s_gf + sl[S_SHH, 0] * f * s_ggp + zero) + sm * gpq * omd) / (
+            1.0 + m * s_gg)
+        sn = sl[S_SIGMA, 0] * nf
+        c = sl[S_SHH, 0] * f
+        for i in range(n):
+            dy[half + i] = (wk[r_fq, i] + c * wk[r_gp, i] - sn * wk[0, i]) * disc[D_MINV, i]
+        dy[half + n] = omd + phi * 0.0
+    wk[aux + A_N, 0] = nf
+    wk[aux + A_F, 0] = f
+
+
+@njit(cache=True)
+def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, wk, dy):
+    """Normal forces and accelerations of several sliders.
+
+    One equation per slider for its normal force: N_j = known_j + sigma_j m_j (g_j.q''
+    + g'_j.q phi_j''), with q'' = M^-1 (F + sum_k sigma_k (-N_k g_k + h_k f_k g'_k)) and,
+    in slip, phi_j'' = (F_phi + r s mu N_j) / I. A flying slider's row is N_j = 0.
+    """
     for j in range(ns):
         row = r_sys + j
         for k in range(ns):
@@ -395,9 +458,6 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
                 sl[S_INERTIA, j])
         else:
             dy[half + n + j] = omd + y[n + j] * 0.0
-
-    if y.shape[0] > n_dynamic(mdl):
-        _powers(y, ph, om, omd, mdl, wk, dy)
 
 
 @njit(cache=True)
