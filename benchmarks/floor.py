@@ -6,6 +6,10 @@ model's slip equations at a generic state (so the step sizes resemble the real r
 no events, no contact solve, no output, and returns the median wall time per accepted
 step [s] and the steps taken. Anything the real kernel spends beyond this is the price of
 its right-hand side, events and output.
+
+Run ``python benchmarks/floor.py``: it prints, for the paper's Fig. 10 case (one slider,
+7 modal coordinates), the kernel's cost per accepted step without output and with the
+10 kHz output, each as a ratio to the floor measured in the same run.
 """
 
 from __future__ import annotations
@@ -109,3 +113,22 @@ def floor_cost(model, duration: float, rtol: float = 1e-6, atol: float = 1e-9,
         steps = _dopri_linear(jac, start.copy(), duration, rtol, atol)
         costs.append((time.perf_counter() - t0) / steps)
     return float(np.median(costs)), steps
+
+
+def main() -> None:
+    from bench_family import CASES, per_step
+    from fivdisc import Case, build_model
+
+    fig10 = CASES["fig10"]
+    quiet = {**fig10, "simulation": {**fig10["simulation"], "output_rate": 0.1}}
+    kernel = per_step({"no output": quiet, "10 kHz output": fig10})
+    floor, steps = floor_cost(build_model(Case(**fig10)), 35.0)
+    print(f"floor (linear DOPRI5, same state size): {floor * 1e6:.2f} us per step "
+          f"({steps} steps)")
+    for label, c in kernel.items():
+        print(f"kernel, {label:14s}: {c['cost'] * 1e6:.2f} us per step ({c['steps']} steps)"
+              f" -> {c['cost'] / floor:.2f} x floor")
+
+
+if __name__ == "__main__":
+    main()

@@ -302,6 +302,14 @@ class Deflection:
         if not (np.all(np.isfinite(q)) and np.all(np.isfinite(phi))):
             self.largest = np.inf
             return True
+        # |w| under slider j is at most sum_i |R_i(r_j) q_i| (|cos|, |sin| <= 1): when that
+        # bound is within the limit, the mode shapes (Bessel functions, the costly part)
+        # need not be evaluated at the sliders' angles.
+        bound = np.abs(model.kernel.shape) @ np.abs(q)
+        probes = np.abs(model.probe_shapes @ q)
+        if max(np.max(bound, initial=0.0), np.max(probes, initial=0.0)) <= self.thickness:
+            self.largest = max(self.largest, float(np.max(probes, initial=0.0)))
+            return False
         w = np.max(np.abs(self._w(q, phi)), initial=0.0)
         self.largest = max(self.largest, float(w))
         return bool(w > self.thickness)
