@@ -10,7 +10,6 @@ its ``units`` and a ``long_name``, with the paper's symbol in ``symbol``.
 from __future__ import annotations
 
 import datetime
-from importlib.metadata import version
 from typing import Any
 
 from fivdisc.case import describe_key
@@ -41,7 +40,9 @@ def global_attrs(title: str, producer: str) -> dict[str, str]:
     producer
         What made it, for ``history``, e.g. ``"fivdisc.simulate"``.
     """
-    fivdisc = f"fivdisc {version('fivdisc')}"
+    import fivdisc as package  # its version is looked up once per process
+
+    fivdisc = f"fivdisc {package.__version__}"
     now = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
     return {
         "Conventions": CONVENTIONS,

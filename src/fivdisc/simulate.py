@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import time as _time
 from collections.abc import Callable, Mapping
-from importlib.metadata import version
 
 import numpy as np
 
@@ -247,13 +246,15 @@ def simulate(
         np.concatenate(ev_times) if ev_times else np.empty(0),
         np.concatenate(ev_rows) if ev_rows else np.empty((0, kern.N_EVI), dtype=np.int64),
     )
+    import fivdisc as package  # its version is looked up once per process
+
     attrs = {
         "status": name,
         "message": message,
         "end_time": float(t_end),
         "impact": int(sim.impact),
         "case": case.to_toml(),
-        "fivdisc_version": version("fivdisc"),
+        "fivdisc_version": package.__version__,
         "wall_time": wall,
         "n_steps": int(ist[kern.I_STEPS]),
         "n_rejected": int(ist[kern.I_REJECTED]),
