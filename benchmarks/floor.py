@@ -22,8 +22,9 @@ from numba import njit
 from fivdisc._kernels.dopri5 import A, E
 from fivdisc._kernels.dynamics import complex_step_jacobian
 
-_BETA = 0.04
-_EXPO1 = 0.2 - 0.75 * _BETA
+# The kernel's own step-control constants: the floor must take the steps the kernel would
+# (its PI controller below repeats the kernel's lines on purpose, without events).
+from fivdisc._kernels.integrate import _BETA, _EXPO1
 
 
 @njit(cache=True)
