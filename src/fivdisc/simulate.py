@@ -8,30 +8,19 @@ from collections.abc import Callable, Mapping
 import numpy as np
 
 from fivdisc._kernels import integrate as kern
-from fivdisc._kernels import layout as lay
+from fivdisc._kernels import slots
 from fivdisc.case import Case
 from fivdisc.compilation import compile_notice
 from fivdisc.errors import SimulationError
+from fivdisc.integration import STATUS, ZENO_COUNT, ZENO_DT, Integration
 from fivdisc.limits import check_simulation
 from fivdisc.model import Model, build_model
 from fivdisc.result import EVENT_KINDS, PHASE_NAMES, Result, build_dataset
 from fivdisc.speed import SpeedProfile
 
-_STATUS = {
-    kern.ST_DONE: "success",
-    kern.ST_STOPPED: "stopped",
-    kern.ST_NONFINITE: "nonfinite",
-    kern.ST_UNDERFLOW: "step_size_underflow",
-    kern.ST_ZENO: "endless_switching",
-    kern.ST_MAX_SWITCHES: "max_switches",
-}
 # Failures in which a state beyond the plate theory's range means the model diverged.
 _BLOW_UPS = ("nonfinite", "step_size_underflow")
-_EVENT_BUFFER = 1 << 15
 _CHUNKS = 200
-# Switches closer than this, this many times in a row, are taken as Zeno/chattering.
-_ZENO_DT = 1e-10
-_ZENO_COUNT = 1000
 
 
 def initial_state(model: Model, initial=None) -> np.ndarray:
@@ -151,54 +140,14 @@ def simulate(
             )
     model = build_model(case, speed)
     y0 = initial_state(model, initial)
-    n_acc = lay.N_ENERGY if sim.energy_balance else 0
-    y = np.concatenate([y0, np.zeros(n_acc)])
-
-    n_out = int(np.floor(sim.duration * sim.output_rate + 1e-9)) + 1
-    ns = y.size
-    n_sl = model.n_sliders
-    # Rows past the last written sample are cut off, so they need no fill.
-    out_y = np.empty((n_out, ns))
-    out_aux = np.empty((n_out, 4 * n_sl + 1))
-    ctl = np.zeros(kern.N_CONTROL)
-    ctl[kern.C_RTOL] = sim.rtol
-    ctl[kern.C_ATOL] = sim.atol
-    ctl[kern.C_MAX_STEP] = sim.max_step
-    ctl[kern.C_T_FINAL] = sim.duration
-    ctl[kern.C_OUT_DT] = 1.0 / sim.output_rate
-    ctl[kern.C_MAX_SWITCHES] = sim.max_switches
-    ctl[kern.C_ZENO_DT] = _ZENO_DT
-    ctl[kern.C_ZENO_COUNT] = _ZENO_COUNT
-    ctl[kern.C_STOP_MASK] = sum(1 << EVENT_KINDS.index(k) for k in set(stop_on))
-    fst = np.zeros(kern.N_FSTATE)
-    fst[kern.F_LAST_SWITCH] = -np.inf
-    ist = np.zeros(kern.N_ISTATE, dtype=np.int64)
-    ph = np.full(n_sl, lay.SLIP, dtype=np.int64)
-    sg = np.ones(n_sl, dtype=np.int64)
-    k = np.zeros((7, ns))
-    ev_prev = np.zeros(3 * n_sl)
-    ev_t = np.empty(_EVENT_BUFFER)
-    ev_i = np.empty((_EVENT_BUFFER, kern.N_EVI), dtype=np.int64)
-    breaks = np.unique(model.speed.breakpoints[model.speed.breakpoints < sim.duration])
-    mdl = model.kernel_args
-    ev_times: list[np.ndarray] = []
-    ev_rows: list[np.ndarray] = []
-
-    def advance(target: float) -> int:
-        status = kern.run(target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y,
-                          out_aux, ev_t, ev_i)
-        n_ev = ist[kern.I_EVENTS]
-        if n_ev:
-            ev_times.append(ev_t[:n_ev].copy())
-            ev_rows.append(ev_i[:n_ev].copy())
-            ist[kern.I_EVENTS] = 0
-        return status
+    run = Integration(model, y0, duration=sim.duration, output_rate=sim.output_rate,
+                      stop_on=stop_on, energy=sim.energy_balance)
 
     # A first call with target 0 only sets up the start: it compiles or loads the kernel
     # before the progress bar starts, so the bar's rate and estimate are the integrator's
     # (and the wall time excludes the compilation, announced with the bar).
     with compile_notice(kern.run, show=progress):
-        advance(0.0)
+        run.advance(0.0)
     bar = None
     if progress:
         from tqdm import tqdm
@@ -206,23 +155,19 @@ def simulate(
         bar = tqdm(total=sim.duration, unit="s", unit_scale=False, desc="simulating",
                    bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s [{elapsed}<{remaining}]")
     start = _time.perf_counter()
-    status = kern.ST_RUNNING
+    status = slots.ST_RUNNING
     interrupted = False
     limit = Deflection(model)
     try:
         # The kernel's step-size controller restarts at each return (the saved outputs
         # of the paper's cases follow this grid), so the grid is fixed, not adaptive.
         for chunk in range(1, _CHUNKS + 1):
-            target = sim.duration * chunk / _CHUNKS
-            while True:
-                status = advance(target)
-                if status != kern.ST_RUNNING or fst[kern.F_T] >= target:
-                    break
+            status = run.run_to(sim.duration * chunk / _CHUNKS)
             if bar is not None:
-                bar.update(fst[kern.F_T] - bar.n)
-            if limit.exceeded(out_y, out_aux, int(ist[kern.I_OUT_NEXT]), y, fst[kern.F_T]):
+                bar.update(run.t - bar.n)
+            if limit.exceeded(run.out_y, run.out_aux, run.n_samples, run.y, run.t):
                 break
-            if status != kern.ST_RUNNING:
+            if status != slots.ST_RUNNING:
                 break
     except KeyboardInterrupt:
         interrupted = True
@@ -231,21 +176,20 @@ def simulate(
             bar.close()
     wall = _time.perf_counter() - start
 
-    t_end = fst[kern.F_T]
+    t_end = run.t
+    ph = run.ph
+    y = run.y
     phases = ", ".join(PHASE_NAMES[p] for p in ph)
-    name = _STATUS.get(status, "unknown")
+    name = STATUS.get(status, "unknown")
     if interrupted:
         name, message = "interrupted", f"interrupted at t = {t_end:.9g} s in {phases}"
     elif limit.when is not None or (name in _BLOW_UPS and limit.beyond(y)):
         name, message = "diverged", limit.message(t_end)
     else:
         message = _message(name, t_end, phases, sim)
-    n_done = int(ist[kern.I_OUT_NEXT])
+    n_done = run.n_samples
     times = np.minimum(np.arange(n_done) / sim.output_rate, sim.duration)
-    events = (
-        np.concatenate(ev_times) if ev_times else np.empty(0),
-        np.concatenate(ev_rows) if ev_rows else np.empty((0, kern.N_EVI), dtype=np.int64),
-    )
+    ist = run.ist
     import fivdisc as package  # its version is looked up once per process
 
     attrs = {
@@ -256,15 +200,16 @@ def simulate(
         "case": case.to_toml(),
         "fivdisc_version": package.__version__,
         "wall_time": wall,
-        "n_steps": int(ist[kern.I_STEPS]),
-        "n_rejected": int(ist[kern.I_REJECTED]),
-        "n_rhs": int(ist[kern.I_RHS]),
-        "n_rhs_events": int(ist[kern.I_EVAL_EVENTS]),
-        "n_switches": int(ist[kern.I_SWITCHES]),
+        "n_steps": int(ist[slots.I_STEPS]),
+        "n_rejected": int(ist[slots.I_REJECTED]),
+        "n_rhs": int(ist[slots.I_RHS]),
+        "n_rhs_events": int(ist[slots.I_EVAL_EVENTS]),
+        "n_switches": int(ist[slots.I_SWITCHES]),
         "final_phase": ph.copy(),
         "final_state": y.copy(),
     }
-    ds = build_dataset(model, out_y[:n_done], out_aux[:n_done], times, events, attrs)
+    ds = build_dataset(model, run.out_y[:n_done], run.out_aux[:n_done], times, run.events(),
+                       attrs)
     return Result(ds)
 
 
@@ -358,7 +303,7 @@ def _message(name: str, t: float, phase: str, sim) -> str:
         "or check the parameters",
         "step_size_underflow": f"step size underflow {where}; try looser simulation.rtol/atol",
         "endless_switching": f"endless switching (Zeno/chattering) {where}: "
-        f"{_ZENO_COUNT} switches less than {_ZENO_DT} s apart",
+        f"{ZENO_COUNT} switches less than {ZENO_DT} s apart",
         "max_switches": f"simulation.max_switches = {sim.max_switches} reached {where}",
     }.get(name, f"ended {where}")
 

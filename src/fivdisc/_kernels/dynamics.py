@@ -95,9 +95,9 @@ def speed_at(t, speed, right):
 
     At a knot, ``right`` selects the right limit (start of a step) or the left
     limit (inside or at the end of a step), so a kink is seen from the side the
-    step lies on.
+    step lies on. A complex ``t`` gives the time derivatives in the imaginary part.
     """
-    k = _piece(speed, t, right)
+    k = _piece(speed, t.real, right)
     tau = t - speed[k, 0]
     c0 = speed[k, 1]
     c1 = speed[k, 2]

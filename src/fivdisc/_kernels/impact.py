@@ -10,7 +10,8 @@ compressive impulses solve the linear complementarity problem
 
 A contact that would need a tensile impulse is released. With a single contact the
 problem has the closed form of the paper's Eqs. 54-56, used as such. Positions and
-phidot never jump.
+phidot never jump. The maps take real or complex states (decisions on real parts), so
+that their Jacobians come from the complex step.
 """
 
 from __future__ import annotations
@@ -116,7 +117,7 @@ def _solve_active(a, b, x, act, m):
             k += 1
     if k == 0:
         return
-    sub = np.empty((k, k + 1))
+    sub = np.empty((k, k + 1), b.dtype)
     for r in range(k):
         sub[r, k] = b[idx[r]]
         for c in range(k):
@@ -132,11 +133,11 @@ def solve_lcp(dmat, gam, forced, lam, m):
     principal pivoting, finite for the positive definite D). ``forced[i]`` makes contact
     i bilateral (``w_i = 0``, any sign of ``lam_i``). Returns ``w``."""
     act = np.ones(m, np.bool_)
-    w = np.empty(m)
-    neg = np.empty(m)
+    w = np.empty(m, gam.dtype)
+    neg = np.empty(m, gam.dtype)
     scale = 0.0
     for i in range(m):
-        scale = max(scale, abs(gam[i]))
+        scale = max(scale, abs(gam[i].real))
     tol_w = 1e-13 * scale
     for _ in range(4 * (1 << m) + 4):
         for i in range(m):
@@ -144,7 +145,7 @@ def solve_lcp(dmat, gam, forced, lam, m):
         _solve_active(dmat, neg, lam, act, m)
         lam_scale = 0.0
         for i in range(m):
-            lam_scale = max(lam_scale, abs(lam[i]))
+            lam_scale = max(lam_scale, abs(lam[i].real))
         tol_l = 1e-13 * lam_scale
         flip = -1
         for i in range(m):
@@ -153,10 +154,10 @@ def solve_lcp(dmat, gam, forced, lam, m):
                 acc += dmat[i, k] * lam[k]
             w[i] = acc
         for i in range(m):
-            if act[i] and not forced[i] and lam[i] < -tol_l:
+            if act[i] and not forced[i] and lam[i].real < -tol_l:
                 flip = i
                 break
-            if not act[i] and w[i] < -tol_w:
+            if not act[i] and w[i].real < -tol_w:
                 flip = i
                 break
         if flip < 0:
@@ -184,9 +185,9 @@ def contact_impact(members, count, y, mdl, wk, forced, w_out):
     mass = mdl.slider[S_MASS]
     u_minus = y.copy()
     before = _kinetic(y, mdl, members, count)
-    dmat = np.zeros((count, count))
-    gam = np.empty(count)
-    lam = np.empty(count)
+    dmat = np.zeros((count, count), y.dtype)
+    gam = np.empty(count, y.dtype)
+    lam = np.empty(count, y.dtype)
     for a in range(count):
         ja = members[a]
         for b in range(count):

@@ -1,0 +1,236 @@
+"""Tangent (variational) dynamics of the non-smooth flow, carried across every switch.
+
+Tangent vectors ``v`` (rows of ``V``, over the dynamic state without the energy
+accumulators) follow ``dv/dt = J(t, y) v`` inside each phase, integrated by the same
+Dormand-Prince stages as the state, so a step maps them by the exact derivative of the
+step the state takes; the step size is controlled by the state alone, and a run with
+tangents takes exactly the steps of a run without. ``J v`` is the complex-step derivative
+of the phase's right-hand side: exact to rounding, with no step to choose.
+
+At a switch at time ``t_s`` where event function ``h`` of the old phase crosses zero,
+with the old field ``f-`` and, after the jump map ``x+ = G(x-, t)``, the new field
+``f+``, a tangent vector ``v`` becomes (Mueller 1995; Leine and Nijmeijer 2004)
+
+    dtau = -(grad h . v) / (grad h . f- + dh/dt)
+    v+ = DG (v + f- dtau) + G_t dtau - f+ dtau
+
+which is ``S v`` with the saltation matrix ``S``. ``DG w + G_t dtau`` is computed by
+running the switch itself (:mod:`fivdisc._kernels.switch`) on the complex state
+``x- + i eps w`` at the complex time ``t_s + i eps dtau``: the same branches as the real
+switch, its imaginary part the derivative of every state change the switch makes (the
+stick speed ``phidot = Omega(t)``, a separating slider's start from the disc's surface,
+the impact map). A kink of the speed profile is a switch in time alone (dtau = 0).
+
+Coordinates that are not free in the current phases are slaved and their tangent rows
+are kept at zero: ``z_j``, ``zdot_j`` of a slider in contact, ``phidot_j`` of a sticking
+one. A direction the flow collapses (onto the stick manifold, by a plastic impact) so
+has zero image, and a monodromy matrix shows it as a zero multiplier.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from fivdisc._kernels.dopri5 import A, C, dense_coefficients, dense_eval
+from fivdisc._kernels.dynamics import evaluate, event_values, new_work
+from fivdisc._kernels.layout import A_WC, A_WCD, SEPARATION, STICK, n_dynamic, sizes, work_rows
+from fivdisc._kernels.slots import N_EVI, N_FSTATE, N_ISTATE
+from fivdisc._kernels.switch import MODE_EVENT, _switch
+
+# Imaginary part of the complex step, for a direction of unit max-norm: far below the
+# state's scale so the second-order term is below rounding, far above underflow.
+_STEP = 1e-30
+
+
+@njit(cache=True)
+def new_tangents(mdl, y, n_vectors):
+    """Tangent vectors ``V`` (zero) and their stage derivatives ``KV`` for ``run``."""
+    nd = n_dynamic(mdl)
+    return np.zeros((n_vectors, nd)), np.zeros((n_vectors, 7, nd))
+
+
+@njit(cache=True)
+def scratch(mdl, y, n_vectors):
+    """Work arrays of the tangent integration (complex ones for the complex step); slots
+    11 and 12 keep the state and slip signs before a switch."""
+    nd = n_dynamic(mdl)
+    n_ev = 3 * sizes(mdl)[1]
+    yc = np.empty(nd, np.complex128)
+    return (yc, np.empty(nd, np.complex128), new_work(mdl, yc), np.empty((7, nd), np.complex128),
+            np.empty(n_ev, np.complex128), np.empty((n_vectors, nd)), np.empty(nd),
+            np.empty((5, nd)), np.empty(nd), np.empty(nd), new_work(mdl, y), np.empty(nd),
+            np.empty(sizes(mdl)[1], np.int64))
+
+
+@njit(cache=True)
+def _norm_inf(v):
+    acc = 0.0
+    for i in range(v.shape[0]):
+        acc = max(acc, abs(v[i]))
+    return acc
+
+
+@njit(cache=True)
+def jvp(t, y, v, ph, sg, right, mdl, sc, out):
+    """``out = J(t, y) v``: the derivative of the right-hand side of phases ``ph`` along
+    ``v`` (complex step, exact to rounding)."""
+    yc, dyc, wkc = sc[0], sc[1], sc[2]
+    nd = out.shape[0]
+    scale = _norm_inf(v)
+    if scale == 0.0:
+        for i in range(nd):
+            out[i] = 0.0
+        return
+    h = _STEP / scale
+    for i in range(nd):
+        yc[i] = complex(y[i], h * v[i])
+    evaluate(t, yc, ph, sg, right, mdl, wkc, dyc)
+    for i in range(nd):
+        out[i] = dyc[i].imag / h
+
+
+@njit(cache=True)
+def stage(st, t, hs, y, ph, sg, mdl, V, KV, sc):
+    """Stage ``st`` of every tangent vector at the stage's state ``y`` (time
+    ``t + C[st] hs``), in the order of operations of the state's stage; the last stage's
+    combination, the tangent at the step's end, is kept in the scratch."""
+    vn, vs = sc[5], sc[6]
+    nd = V.shape[1]
+    for r in range(V.shape[0]):
+        for i in range(nd):
+            vs[i] = V[r, i]
+        for j in range(st):
+            a = hs * A[st, j]
+            if a != 0.0:
+                for i in range(nd):
+                    vs[i] += a * KV[r, j, i]
+        jvp(t + C[st] * hs, y, vs, ph, sg, False, mdl, sc, KV[r, st])
+        if st == 6:
+            for i in range(nd):
+                vn[r, i] = vs[i]
+
+
+@njit(cache=True)
+def accept(V, KV, sc):
+    """The step is taken: tangents move to its end, the last stage is the next first."""
+    vn = sc[5]
+    for r in range(V.shape[0]):
+        for i in range(V.shape[1]):
+            V[r, i] = vn[r, i]
+            KV[r, 0, i] = KV[r, 6, i]
+
+
+@njit(cache=True)
+def interpolate(theta, hs, V, KV, sc):
+    """Tangents at fraction ``theta`` of the step (the state's dense output formula)."""
+    vn, rc = sc[5], sc[7]
+    for r in range(V.shape[0]):
+        dense_coefficients(V[r], vn[r], KV[r], hs, rc)
+        dense_eval(rc, theta, V[r])
+
+
+@njit(cache=True)
+def slave(ph, mdl, v):
+    """Zero the rows of coordinates that are not free in phases ``ph``."""
+    n, ns, half = sizes(mdl)
+    for j in range(ns):
+        if ph[j] != SEPARATION:
+            v[n + ns + j] = 0.0
+            v[half + n + ns + j] = 0.0
+            if ph[j] == STICK:
+                v[half + n + j] = 0.0
+
+
+@njit(cache=True)
+def prepare(t, y, ph, sg, mdl, V, KV):
+    """Make tangents ``V`` given at a state between steps ready for ``run``: slaved rows
+    zeroed, first stages evaluated."""
+    sc = scratch(mdl, y, V.shape[0])
+    for r in range(V.shape[0]):
+        slave(ph, mdl, V[r])
+        jvp(t, y, V[r], ph, sg, True, mdl, sc, KV[r, 0])
+
+
+@njit(cache=True)
+def _event_rate(e, t, y, ph, sg, mdl, sc, v, dt):
+    """Derivative of event function ``e`` along ``(v, dt)`` in (state, time)."""
+    yc, dyc, wkc, evc = sc[0], sc[1], sc[2], sc[4]
+    nd = v.shape[0]
+    scale = max(_norm_inf(v), abs(dt), 1.0)
+    h = _STEP / scale
+    for i in range(nd):
+        yc[i] = complex(y[i], h * v[i])
+    tc = complex(t, h * dt)
+    evaluate(tc, yc, ph, sg, False, mdl, wkc, dyc)
+    event_values(ph, sg, yc, mdl, wkc, evc)
+    return evc[e].imag / h
+
+
+@njit(cache=True)
+def saltation(mode, e, t, ypre, ph_pre, sg_pre, ev_start, y, ph, sg, fplus, mdl, V, KV, sc):
+    """Map the tangents across the switch that took the state from ``ypre`` (phases
+    ``ph_pre``, signs ``sg_pre``) to ``y`` (phases ``ph``) at time ``t``: event ``e`` for
+    ``mode`` ``MODE_EVENT``, else a switch at a fixed time (a kink). ``fplus`` is the
+    new phases' right-hand side at ``y``. ``ev_start`` are the event values at the start
+    of the step, as the switch had them."""
+    yc, dyc, wkc, kc, evc = sc[0], sc[1], sc[2], sc[3], sc[4]
+    fm, wkr, w = sc[8], sc[10], sc[9]
+    nd = V.shape[1]
+    n_sl = ph.shape[0]
+    ev_t = np.empty(8 * n_sl + 8)
+    ev_i = np.empty((ev_t.shape[0], N_EVI), np.int64)
+    ist = np.zeros(N_ISTATE, np.int64)
+    fst = np.full(N_FSTATE, np.inf)
+    hdot = 1.0
+    if mode == MODE_EVENT:
+        evaluate(t, ypre, ph_pre, sg_pre, False, mdl, wkr, fm)
+        hdot = _event_rate(e, t, ypre, ph_pre, sg_pre, mdl, sc, fm, 1.0)
+    else:
+        fm[:] = 0.0
+    phs = ph_pre.copy()
+    sgs = sg_pre.copy()
+    for r in range(V.shape[0]):
+        dtau = 0.0
+        if mode == MODE_EVENT:
+            dtau = -_event_rate(e, t, ypre, ph_pre, sg_pre, mdl, sc, V[r], 0.0) / hdot
+        for i in range(nd):
+            w[i] = V[r, i] + fm[i] * dtau
+        scale = max(_norm_inf(w), abs(dtau), 1.0)
+        h = _STEP / scale
+        for i in range(nd):
+            yc[i] = complex(ypre[i], h * w[i])
+        for j in range(n_sl):
+            phs[j] = ph_pre[j]
+            sgs[j] = sg_pre[j]
+        ist[:] = 0
+        _switch(mode, e, complex(t, h * dtau), yc, phs, sgs, ph_pre, ev_start, mdl, wkc, dyc,
+                kc, evc, ev_t, ev_i, ist, fst)
+        for i in range(nd):
+            V[r, i] = yc[i].imag / h - fplus[i] * dtau
+        slave(ph, mdl, V[r])
+        jvp(t, y, V[r], ph, sg, True, mdl, sc, KV[r, 0])
+
+
+@njit(cache=True)
+def unslaved(t, y, ph, sg, mdl, V):
+    """Tangents with the slaved rows filled in: ``z_j``, ``zdot_j`` of a slider in
+    contact follow the disc's surface under it (the values a run's output carries),
+    ``phidot_j`` of a sticking one is Omega(t), fixed at fixed t."""
+    n, ns, half = sizes(mdl)
+    nd = V.shape[1]
+    out = V.copy()
+    sc = scratch(mdl, y, 1)
+    yc, dyc, wkc = sc[0], sc[1], sc[2]
+    aux = work_rows(ns)[3]
+    for r in range(V.shape[0]):
+        scale = max(_norm_inf(V[r]), 1.0)
+        h = _STEP / scale
+        for i in range(nd):
+            yc[i] = complex(y[i], h * V[r, i])
+        evaluate(t, yc, ph, sg, False, mdl, wkc, dyc)
+        for j in range(ns):
+            if ph[j] != SEPARATION:
+                out[r, n + ns + j] = wkc[aux + A_WC, j].imag / h
+                out[r, half + n + ns + j] = wkc[aux + A_WCD, j].imag / h
+    return out

@@ -1,0 +1,186 @@
+"""One integration of a model, advanced call by call: the kernel's whole state between calls.
+
+:func:`fivdisc.simulate` drives one to write a :class:`~fivdisc.result.Result`; the
+nonlinear-dynamics analyses (:mod:`fivdisc.analysis.orbits`,
+:mod:`fivdisc.analysis.lyapunov`) drive them with tangent vectors.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fivdisc._kernels import integrate as kern
+from fivdisc._kernels import layout as lay
+from fivdisc._kernels import slots
+from fivdisc._kernels import tangent as tan
+from fivdisc.model import Model
+from fivdisc.result import EVENT_KINDS
+
+_EVENT_BUFFER = 1 << 15
+# Switches closer than this, this many times in a row, are taken as Zeno/chattering.
+ZENO_DT = 1e-10
+ZENO_COUNT = 1000
+
+STATUS = {
+    slots.ST_RUNNING: "running",
+    slots.ST_DONE: "success",
+    slots.ST_STOPPED: "stopped",
+    slots.ST_NONFINITE: "nonfinite",
+    slots.ST_UNDERFLOW: "step_size_underflow",
+    slots.ST_ZENO: "endless_switching",
+    slots.ST_MAX_SWITCHES: "max_switches",
+}
+
+
+class Integration:
+    """The integrator of ``model`` from state ``y0`` at t = 0 to ``duration``.
+
+    Parameters
+    ----------
+    model : Model
+        The model (its case gives tolerances, step and switch limits).
+    y0 : ndarray
+        Initial state, ``2 (n + 2 S)`` values.
+    duration : float
+        End time [s]; the last step lands on it exactly.
+    output_rate : float
+        Output samples per second [Hz]; 0 records none.
+    stop_on : tuple of str
+        Event kinds that end the run early.
+    energy : bool
+        Integrate the energy accumulators too.
+    rtol, atol : float, optional
+        Override the case's tolerances.
+    """
+
+    def __init__(self, model: Model, y0: np.ndarray, *, duration: float,
+                 output_rate: float = 0.0, stop_on: tuple[str, ...] = (),
+                 energy: bool = False, rtol: float | None = None,
+                 atol: float | None = None) -> None:
+        sim = model.case.simulation
+        self.model = model
+        self.duration = duration
+        n_acc = lay.N_ENERGY if energy else 0
+        self.y = np.concatenate([np.asarray(y0, dtype=float), np.zeros(n_acc)])
+        size = self.y.size
+        n_sl = model.n_sliders
+        n_out = int(np.floor(duration * output_rate + 1e-9)) + 1 if output_rate > 0 else 0
+        # Rows past the last written sample are cut off, so they need no fill.
+        self.out_y = np.empty((n_out, size))
+        self.out_aux = np.empty((n_out, 4 * n_sl + 1))
+        ctl = np.zeros(slots.N_CONTROL)
+        ctl[slots.C_RTOL] = sim.rtol if rtol is None else rtol
+        ctl[slots.C_ATOL] = sim.atol if atol is None else atol
+        ctl[slots.C_MAX_STEP] = sim.max_step
+        ctl[slots.C_T_FINAL] = duration
+        ctl[slots.C_OUT_DT] = 1.0 / output_rate if output_rate > 0 else np.inf
+        ctl[slots.C_MAX_SWITCHES] = sim.max_switches
+        ctl[slots.C_ZENO_DT] = ZENO_DT
+        ctl[slots.C_ZENO_COUNT] = ZENO_COUNT
+        ctl[slots.C_STOP_MASK] = sum(1 << EVENT_KINDS.index(k) for k in set(stop_on))
+        self.ctl = ctl
+        self.fst = np.zeros(slots.N_FSTATE)
+        self.fst[slots.F_LAST_SWITCH] = -np.inf
+        self.ist = np.zeros(slots.N_ISTATE, dtype=np.int64)
+        self.ph = np.full(n_sl, lay.SLIP, dtype=np.int64)
+        self.sg = np.ones(n_sl, dtype=np.int64)
+        self.k = np.zeros((7, size))
+        self.ev_prev = np.zeros(3 * n_sl)
+        self.ev_t = np.empty(_EVENT_BUFFER)
+        self.ev_i = np.empty((_EVENT_BUFFER, slots.N_EVI), dtype=np.int64)
+        bp = model.speed.breakpoints
+        self.breaks = np.unique(bp[bp < duration])
+        self.mdl = model.kernel_args
+        self.ev_times: list[np.ndarray] = []
+        self.ev_rows: list[np.ndarray] = []
+        self.tan: tuple[np.ndarray, np.ndarray] | None = None
+        self.status = slots.ST_RUNNING
+
+    @property
+    def t(self) -> float:
+        """Time reached [s]."""
+        return float(self.fst[slots.F_T])
+
+    @property
+    def state(self) -> np.ndarray:
+        """The dynamic state reached (without energy accumulators), slaved coordinates as
+        the kernel holds them."""
+        return self.y[: self.model.state_size].copy()
+
+    @property
+    def status_name(self) -> str:
+        return STATUS.get(self.status, "unknown")
+
+    @property
+    def n_samples(self) -> int:
+        return int(self.ist[slots.I_OUT_NEXT])
+
+    def advance(self, target: float) -> int:
+        """Integrate until ``t >= target`` (or the end, a failure, a full event buffer);
+        returns the kernel's status. The first call (any target) also chooses the phases
+        at the start."""
+        status = kern.run(target, self.mdl, self.ctl, self.fst, self.ist, self.y, self.ph,
+                          self.sg, self.k, self.ev_prev, self.breaks, self.out_y, self.out_aux,
+                          self.ev_t, self.ev_i, self.tan)
+        n_ev = self.ist[slots.I_EVENTS]
+        if n_ev:
+            self.ev_times.append(self.ev_t[:n_ev].copy())
+            self.ev_rows.append(self.ev_i[:n_ev].copy())
+            self.ist[slots.I_EVENTS] = 0
+        self.status = status
+        return status
+
+    def run_to(self, target: float) -> int:
+        """Advance until ``target`` is reached or the run ends."""
+        while True:
+            status = self.advance(target)
+            if status != slots.ST_RUNNING or self.t >= target:
+                return status
+
+    def events(self) -> tuple[np.ndarray, np.ndarray]:
+        """Times and integer rows (kind, from, to, slider) of the switches so far."""
+        if not self.ev_times:
+            return np.empty(0), np.empty((0, slots.N_EVI), dtype=np.int64)
+        return np.concatenate(self.ev_times), np.concatenate(self.ev_rows)
+
+    def set_tangents(self, vectors: np.ndarray) -> None:
+        """Carry tangent vectors (rows, over the dynamic state) from the current state on.
+
+        Rows of coordinates that are not free in the current phases (``z``, ``zdot`` of a
+        slider in contact, ``phidot`` of a sticking one) are ignored. Needs the start
+        done (one :meth:`advance`).
+        """
+        if self.ist[slots.I_STARTED] == 0:
+            raise RuntimeError("set_tangents needs the start done: call advance first")
+        vectors = np.atleast_2d(np.asarray(vectors, dtype=float))
+        nd = self.model.state_size
+        if vectors.ndim != 2 or vectors.shape[1] != nd:
+            raise ValueError(
+                f"tangent vectors have shape {vectors.shape}: must be (k, {nd}), rows over "
+                "the dynamic state"
+            )
+        if self.tan is None or self.tan[0].shape != vectors.shape:
+            self.tan = tan.new_tangents(self.mdl, self.y, vectors.shape[0])
+        v, kv = self.tan
+        v[:] = vectors
+        tan.prepare(self.t, self.y, self.ph, self.sg, self.mdl, v, kv)
+
+    def tangents(self, slaved: bool = True) -> np.ndarray:
+        """Current tangent vectors (rows); with ``slaved``, the rows of coordinates that
+        follow the contact (``z``, ``zdot`` in contact) are filled in as the output
+        carries them, else they are zero as integrated."""
+        if self.tan is None:
+            raise RuntimeError("no tangent vectors are carried: call set_tangents first")
+        if not slaved:
+            return self.tan[0].copy()
+        return tan.unslaved(self.t, self.y, self.ph, self.sg, self.mdl, self.tan[0])
+
+    def free(self) -> np.ndarray:
+        """Mask of the coordinates that are free in the current phases."""
+        mask = np.ones(self.model.state_size)
+        tan.slave(self.ph, self.mdl, mask)
+        return mask.astype(bool)
+
+    def rhs(self) -> np.ndarray:
+        """The current phases' right-hand side at the current state (dynamic part)."""
+        return self.k[0, : self.model.state_size].copy()
