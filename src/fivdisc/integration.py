@@ -51,12 +51,16 @@ class Integration:
         Integrate the energy accumulators too.
     rtol, atol : float, optional
         Override the case's tolerances.
+    phases : array of int, optional
+        Phase of each slider at the start (``layout.SLIP``, ``STICK``, ``SEPARATION``);
+        a slider in contact takes the phase its state allows, one given as separated
+        starts flying from its own ``z``, ``zdot``. Default: all in contact.
     """
 
     def __init__(self, model: Model, y0: np.ndarray, *, duration: float,
                  output_rate: float = 0.0, stop_on: tuple[str, ...] = (),
                  energy: bool = False, rtol: float | None = None,
-                 atol: float | None = None) -> None:
+                 atol: float | None = None, phases: np.ndarray | None = None) -> None:
         sim = model.case.simulation
         self.model = model
         self.duration = duration
@@ -83,6 +87,8 @@ class Integration:
         self.fst[slots.F_LAST_SWITCH] = -np.inf
         self.ist = np.zeros(slots.N_ISTATE, dtype=np.int64)
         self.ph = np.full(n_sl, lay.SLIP, dtype=np.int64)
+        if phases is not None:
+            self.ph[:] = phases
         self.sg = np.ones(n_sl, dtype=np.int64)
         self.k = np.zeros((7, size))
         self.ev_prev = np.zeros(3 * n_sl)
@@ -147,11 +153,9 @@ class Integration:
         """Carry tangent vectors (rows, over the dynamic state) from the current state on.
 
         Rows of coordinates that are not free in the current phases (``z``, ``zdot`` of a
-        slider in contact, ``phidot`` of a sticking one) are ignored. Needs the start
-        done (one :meth:`advance`).
+        slider in contact, ``phidot`` of a sticking one) are ignored. Given before the
+        first :meth:`advance`, they are carried across the start's choice of phases.
         """
-        if self.ist[slots.I_STARTED] == 0:
-            raise RuntimeError("set_tangents needs the start done: call advance first")
         vectors = np.atleast_2d(np.asarray(vectors, dtype=float))
         nd = self.model.state_size
         if vectors.ndim != 2 or vectors.shape[1] != nd:
@@ -163,7 +167,8 @@ class Integration:
             self.tan = tan.new_tangents(self.mdl, self.y, vectors.shape[0])
         v, kv = self.tan
         v[:] = vectors
-        tan.prepare(self.t, self.y, self.ph, self.sg, self.mdl, v, kv)
+        if self.ist[slots.I_STARTED]:
+            tan.prepare(self.t, self.y, self.ph, self.sg, self.mdl, v, kv)
 
     def tangents(self, slaved: bool = True) -> np.ndarray:
         """Current tangent vectors (rows); with ``slaved``, the rows of coordinates that

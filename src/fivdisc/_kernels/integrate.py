@@ -206,8 +206,9 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
     phase and slip sign); returns the status.
 
     ``tan``, if given, is ``(V, KV)`` of :func:`tangent.new_tangents`: tangent vectors
-    carried along (rows of ``V``) with their stage derivatives, made ready by
-    :func:`tangent.prepare` after the start. Without it no tangent code is compiled in.
+    carried along (rows of ``V``) with their stage derivatives: given at the start, they
+    are carried across it; given later, :func:`tangent.prepare` makes them ready. Without
+    it no tangent code is compiled in.
     """
     ns = y.shape[0]
     nd = n_dynamic(mdl)
@@ -236,9 +237,16 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
     t = fst[F_T]
     h = fst[F_H]
     if ist[I_STARTED] == 0:
+        if tan is not None:
+            ph_start = ph.copy()
+            ypre[:] = y[:nd]
+            sgpre[:] = sg
         _switch(MODE_START, -1, t, y, ph, sg, ph, ev_prev, mdl, wk, dy, k, ev_prev, ev_t, ev_i,
                 ist, fst)
         _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
+        if tan is not None:
+            tangent.saltation(MODE_START, -1, t, ypre, ph_start, sgpre, ev_prev, y, ph, sg,
+                              k[0], mdl, tv, tk, tsc)
         if h <= 0.0:
             h = _initial_step(t, y, k[0], ph, sg, mdl, wk, ctl, ytmp, dy, nd)
         if ist[I_OUT_NEXT] == 0 and out_y.shape[0] > 0:
