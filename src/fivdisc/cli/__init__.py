@@ -43,12 +43,13 @@ def cli() -> None:
 
 
 def _register() -> None:
-    from fivdisc.cli import examples, modes, plot, reproduce, simulate, stability, sweep
+    from fivdisc.cli import dynamics, examples, modes, plot, reproduce, simulate, stability, sweep
 
     cli.add_command(modes.modes)
     cli.add_command(simulate.simulate)
     cli.add_command(plot.plot)
     cli.add_command(stability.stability)
+    cli.add_command(dynamics.orbit)
     cli.add_command(sweep.sweep)
     cli.add_command(sweep.separation_map)
     cli.add_command(reproduce.reproduce)

@@ -1,0 +1,46 @@
+"""``fivdisc orbit`` and ``fivdisc lyapunov``: periodic orbits with their Floquet
+multipliers, and Lyapunov exponents."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from fivdisc.cli._case import CASE
+
+_NC = click.Path(dir_okay=False, path_type=Path)
+
+
+@click.command()
+@click.argument("case_file", type=CASE)
+@click.option("--period", type=float, help="A guess of the period [s] (default: the first "
+              "close return after the transient).")
+@click.option("--transient", type=float, help="Transient run before the search [s] "
+              "(default: the case's simulation.duration).")
+@click.option("--rtol", type=float, default=1e-12, show_default=True,
+              help="Integration tolerance of the shooting runs (sets the multipliers' "
+              "accuracy).")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print period, multipliers, verdict and residual as JSON.")
+@click.option("-o", "--output", type=_NC, help="Write the orbit to a netCDF file (.nc).")
+def orbit(case_file: Path, period: float | None, transient: float | None, rtol: float,
+          as_json: bool, output: Path | None) -> None:
+    """Periodic orbit of CASE_FILE (constant speed) and its Floquet multipliers.
+
+    Runs the case for its duration (or --transient), finds the first return of the
+    trajectory and refines the orbit by Newton shooting with the exact monodromy matrix
+    (saltation matrices at every switch). CASE_FILE is a TOML file or a packaged example.
+    """
+    from fivdisc.analysis.orbits import periodic_orbit
+    from fivdisc.case import load_case
+    from fivdisc.files import check_output, write_atomic
+
+    case = load_case(case_file)
+    out = check_output(output, "-o", (".nc",), inputs=[case_file]) if output else None
+    res = periodic_orbit(case, period=period, transient=transient, rtol=rtol)
+    click.echo(res.to_json() if as_json else str(res))
+    if out is not None:
+        ds = res.to_dataset()
+        ds.attrs["case"] = case.to_toml()
+        write_atomic(out, ds.to_netcdf)

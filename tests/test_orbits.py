@@ -1,0 +1,144 @@
+"""Periodic orbits and Floquet multipliers against closed forms and finite differences."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from fivdisc._kernels import layout as lay
+from fivdisc.analysis.orbits import periodic_orbit
+from fivdisc.case import Case
+from fivdisc.cli import cli
+from fivdisc.errors import FivdiscError
+from fivdisc.integration import Integration
+from fivdisc.model import build_model
+
+MU_S, MU_K, OMEGA = 0.8, 0.5, 1.0
+# One axisymmetric disc mode (l = 0): its slope under the slider is zero, so the slider's
+# in-plane motion does not act on the disc, and the normal force is constant once the
+# disc mode has settled. Constant kinetic friction and no in-plane damping make the
+# slider the textbook stick-slip oscillator.
+RIGID = Case(
+    disc={"modes": [[0, 0]]},
+    slider={"rotational_damping": 0.0, "normal_damping": 5.0},
+    friction={"static": MU_S, "kinetic_max": MU_K, "kinetic_min": MU_K, "decay": 0.0},
+    speed={"value": OMEGA},
+)
+LIGHT = Case(disc={"density": 720.0, "modes": [[0, 0]]},
+             slider={"mass": 1.0, "normal_damping": 20.0}, speed={"value": 1.0})
+
+
+def _rigid_disc_closed_form():
+    """Period of the stick-slip cycle and the disc mode's multipliers, by hand.
+
+    Normal force: N = N0 / (1 + k_z g^2 / K) (disc mode K q = -N g, slider spring
+    N = N0 + k_z g q). Stick: phi rises at Omega from phi_k - d to phi_k + d, where
+    phi_k = r mu_k N / k_phi is the centre of the slip oscillation and
+    d = r (mu_s - mu_k) N / k_phi (slip starts at r mu_s N = k_phi phi); it lasts 2 d / Omega.
+    Slip: I phi'' = -k_phi (phi - phi_k), from (phi_k + d, Omega) until phidot = Omega
+    again at phi_k - d: with A = sqrt(d^2 + (Omega / w)^2), w = sqrt(k_phi / I), it
+    lasts (pi + 2 arcsin(Omega / (A w))) / w. The disc mode obeys
+    (M + m g^2) q'' + c_z g^2 q' + (K + k_z g^2) q = -g N0 whatever the slider does.
+    """
+    model = build_model(RIGID)
+    kern = model.kernel
+    g = kern.shape[0, 0]
+    mass_modal = 1.0 / kern.disc[lay.D_MINV, 0]
+    stiff_modal = kern.disc[lay.D_KD, 0]
+    m, kz, cz, n0 = (kern.slider[row, 0] for row in (lay.S_MASS, lay.S_KZ, lay.S_CZ, lay.S_N0))
+    inertia, kphi, r = (kern.slider[row, 0] for row in (lay.S_INERTIA, lay.S_KPHI, lay.S_RADIUS))
+    normal = n0 / (1.0 + kz * g * g / stiff_modal)
+    w = np.sqrt(kphi / inertia)
+    d = r * (MU_S - MU_K) * normal / kphi
+    amp = np.hypot(d, OMEGA / w)
+    period = 2.0 * d / OMEGA + (np.pi + 2.0 * np.arcsin(OMEGA / (amp * w))) / w
+    lam = np.roots([mass_modal + m * g * g, cz * g * g, stiff_modal + kz * g * g])
+    return period, np.exp(lam * period)
+
+
+def test_rigid_disc_stick_slip_orbit():
+    """Period to 1e-9; multipliers: 1 (flow), the disc mode's exp(lambda T) (to 1e-6, the
+    accuracy the default tolerance is chosen for), and zeros: the stick collapse and the
+    slider's z, zdot (slaved in contact)."""
+    period, disc = _rigid_disc_closed_form()
+    orbit = periodic_orbit(RIGID, transient=4.0)
+    assert orbit.verdict == "stable"
+    assert orbit.period == pytest.approx(period, rel=1e-9)
+    mult = orbit.multipliers
+    assert mult[orbit.trivial] == pytest.approx(1.0, abs=1e-8)
+    others = np.delete(mult, orbit.trivial)
+    big = others[np.abs(others) > 0.5]
+    assert big.size == 2
+    assert np.sort_complex(big) == pytest.approx(np.sort_complex(disc), abs=1e-6)
+    small = others[np.abs(others) <= 0.5]
+    assert small.size == 3
+    assert np.all(np.abs(small) < 1e-10)
+
+
+def _return_map_jacobian(model, x0, phases, period, free):
+    """Richardson-extrapolated central differences of the flow map over ``period``
+    (see test_tangent for the steps and why they reach 1e-7 of the largest entry)."""
+    def flow(x):
+        run = Integration(model, x, duration=period, output_rate=1.0 / period, rtol=1e-12,
+                          atol=1e-19, phases=phases)
+        run.run_to(period)
+        return run.out_y[1, : model.state_size].copy()
+
+    jac = np.zeros((model.state_size, model.state_size))
+    for j in np.flatnonzero(free):
+        scale = max(abs(x0[j]), 1e-3 * np.max(np.abs(x0)))
+        d = []
+        for e in (1e-3, 5e-4, 2.5e-4):
+            xp, xm = x0.copy(), x0.copy()
+            xp[j] += e * scale
+            xm[j] -= e * scale
+            d.append((flow(xp) - flow(xm)) / (2 * e * scale))
+        r1 = (4 * d[1] - d[0]) / 3
+        r2 = (4 * d[2] - d[1]) / 3
+        jac[:, j] = (16 * r2 - r1) / 15
+    return jac
+
+
+def test_multipliers_match_finite_differences_of_the_return_map():
+    """The saltation-based monodromy's eigenvalues against those of a monodromy from
+    finite differences of the flow map over one period, on a stick-slip orbit of a light
+    disc (exponential friction, damped slider): moduli to 1e-6."""
+    orbit = periodic_orbit(LIGHT, transient=2.0)
+    assert orbit.verdict == "stable"
+    model = build_model(LIGHT)
+    run = Integration(model, orbit.state, duration=1.0, phases=orbit.phases)
+    run.advance(0.0)
+    fd = _return_map_jacobian(model, orbit.state, orbit.phases, orbit.period, run.free())
+    ref = np.sort(np.abs(np.linalg.eigvals(fd)))
+    assert np.sort(orbit.moduli) == pytest.approx(ref, abs=1e-6)
+
+
+def test_orbit_needs_constant_speed():
+    case = RIGID.replace({"speed": {"profile": "decelerating", "initial": 1.0,
+                                    "duration": 10.0}})
+    with pytest.raises(FivdiscError, match="constant disc speed"):
+        periodic_orbit(case)
+    with pytest.raises(FivdiscError, match="period = -1"):
+        periodic_orbit(RIGID, period=-1.0)
+
+
+def test_orbit_command_json_and_netcdf(tmp_path):
+    path = tmp_path / "rigid.toml"
+    path.write_text(RIGID.replace({"simulation.duration": 4.0}).to_toml())
+    out = tmp_path / "orbit.nc"
+    res = CliRunner().invoke(cli, ["orbit", str(path), "--json", "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    data = json.loads(res.output)
+    period, _ = _rigid_disc_closed_form()
+    assert data["period"] == pytest.approx(period, rel=1e-9)
+    assert data["verdict"] == "stable"
+    assert data["residual"] < 1e-8
+    assert {"real", "imag", "modulus"} <= set(data["multipliers"][0])
+    import xarray as xr
+
+    with xr.open_dataset(out) as ds:
+        assert ds.attrs["period"] == pytest.approx(period, rel=1e-9)
+        assert ds["monodromy"].shape == (6, 6)
