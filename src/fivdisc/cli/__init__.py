@@ -50,6 +50,7 @@ def _register() -> None:
     cli.add_command(plot.plot)
     cli.add_command(stability.stability)
     cli.add_command(dynamics.orbit)
+    cli.add_command(dynamics.lyapunov)
     cli.add_command(sweep.sweep)
     cli.add_command(sweep.separation_map)
     cli.add_command(reproduce.reproduce)

@@ -44,3 +44,39 @@ def orbit(case_file: Path, period: float | None, transient: float | None, rtol: 
         ds = res.to_dataset()
         ds.attrs["case"] = case.to_toml()
         write_atomic(out, ds.to_netcdf)
+
+
+@click.command()
+@click.argument("case_file", type=CASE)
+@click.option("--n", "count", type=int, default=1, show_default=True,
+              help="How many exponents (largest first).")
+@click.option("--transient", type=float,
+              help="Simulated time before the measurement [s] (default: a fifth of the "
+              "case's simulation.duration).")
+@click.option("--duration", type=float,
+              help="Length of the measurement [s] (default: simulation.duration).")
+@click.option("--interval", type=float, default=0.01, show_default=True,
+              help="Re-orthonormalisation interval [s].")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print the exponents [1/s] and their uncertainty as JSON.")
+@click.option("-o", "--output", type=_NC,
+              help="Write the exponents and their running estimates to netCDF (.nc).")
+def lyapunov(case_file: Path, count: int, transient: float | None, duration: float | None,
+             interval: float, as_json: bool, output: Path | None) -> None:
+    """Lyapunov exponents of CASE_FILE by the QR method on the tangent dynamics.
+
+    The tangent vectors are carried across every switch by its saltation matrix.
+    CASE_FILE is a TOML file or a packaged example.
+    """
+    from fivdisc.analysis.lyapunov import lyapunov as compute
+    from fivdisc.case import load_case
+    from fivdisc.files import check_output, write_atomic
+
+    case = load_case(case_file)
+    out = check_output(output, "-o", (".nc",), inputs=[case_file]) if output else None
+    res = compute(case, n=count, transient=transient, duration=duration, interval=interval)
+    click.echo(res.to_json() if as_json else str(res))
+    if out is not None:
+        ds = res.to_dataset()
+        ds.attrs["case"] = case.to_toml()
+        write_atomic(out, ds.to_netcdf)

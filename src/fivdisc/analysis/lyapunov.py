@@ -1,0 +1,220 @@
+"""Lyapunov exponents of the non-smooth flow by the QR (Benettin) method.
+
+``n`` tangent vectors are carried with the state (:mod:`fivdisc._kernels.tangent`: the
+variational equations inside each phase, saltation matrices at every switch) and
+re-orthonormalised every ``interval`` seconds: ``V = Q R``; the logarithms of ``|R_ii|``
+summed over the run and divided by its length are the exponents, largest first.
+
+The orthonormalisation uses the energy norm (:func:`fivdisc.analysis.orbits.energy_scales`),
+so that the result does not depend on the units of the coordinates over a finite run.
+Only coordinates that are free in the current phases carry tangent components: a
+direction collapsed by sticking or by a plastic impact has exponent -inf, and at most as
+many exponents as free coordinates exist.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+
+import numpy as np
+
+from fivdisc.case import Case
+from fivdisc.errors import FivdiscError
+from fivdisc.integration import Integration, tangent_step
+from fivdisc.model import build_model
+
+__all__ = ["LyapunovSpectrum", "lyapunov"]
+
+# Blocks of the run whose exponents give the uncertainty (their spread).
+_BLOCKS = 10
+
+
+@dataclass(frozen=True)
+class LyapunovSpectrum:
+    """The first ``n`` Lyapunov exponents of a run, from :func:`lyapunov`.
+
+    Attributes
+    ----------
+    exponents : ndarray
+        ``(n,)`` exponents [1/s], largest first.
+    uncertainty : ndarray
+        ``(n,)`` standard error of each [1/s]: the spread of the exponents of ten equal
+        blocks of the run divided by sqrt(10); an estimate of how far the finite-time
+        value may be from the limit, not a bound.
+    times : ndarray
+        ``(m,)`` times of the re-orthonormalisations [s], from the start of the
+        measurement (after the transient).
+    running : ndarray
+        ``(m, n)`` running estimates [1/s] at those times.
+    transient, duration, interval : float
+        Length of the transient, of the measurement and the re-orthonormalisation
+        interval [s].
+    """
+
+    exponents: np.ndarray
+    uncertainty: np.ndarray
+    times: np.ndarray
+    running: np.ndarray
+    transient: float
+    duration: float
+    interval: float
+
+    @property
+    def largest(self) -> float:
+        """The largest exponent [1/s]."""
+        return float(self.exponents[0])
+
+    def to_dict(self) -> dict:
+        """Exponents [1/s] (largest first) and their uncertainty as plain JSON types
+        (-inf, for a collapsed direction, as ``null``)."""
+        def plain(values):
+            return [float(v) if np.isfinite(v) else None for v in values]
+
+        return {"exponents": plain(self.exponents), "uncertainty": plain(self.uncertainty),
+                "transient": self.transient, "duration": self.duration,
+                "interval": self.interval}
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), indent=2)
+
+    def to_dataset(self):
+        """The spectrum and its running estimates as an :class:`xarray.Dataset`."""
+        import xarray as xr
+
+        return xr.Dataset(
+            {
+                "exponent": ("index", self.exponents,
+                             {"long_name": "Lyapunov exponent", "units": "s-1"}),
+                "uncertainty": ("index", self.uncertainty,
+                                {"long_name": "standard error of the exponent",
+                                 "units": "s-1"}),
+                "running": (("time", "index"), self.running,
+                            {"long_name": "running estimate of the exponent",
+                             "units": "s-1"}),
+            },
+            coords={"index": np.arange(self.exponents.size),
+                    "time": ("time", self.times, {"long_name": "time after the transient",
+                                                  "units": "s"})},
+            attrs={"transient": self.transient, "duration": self.duration,
+                   "interval": self.interval, "time_units": "s"},
+        )
+
+    def __str__(self) -> str:
+        lines = [f"Lyapunov exponents over {self.duration:g} s after a {self.transient:g} s "
+                 f"transient (QR every {self.interval:g} s) [1/s]:"]
+        for i, (e, u) in enumerate(zip(self.exponents, self.uncertainty, strict=True)):
+            lines.append(f"  lambda_{i + 1} = {e:+.6g} +- {u:.2g}")
+        return "\n".join(lines)
+
+
+def lyapunov(
+    case: Case,
+    n: int = 1,
+    *,
+    transient: float | None = None,
+    duration: float | None = None,
+    interval: float = 0.01,
+    initial=None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    seed: int = 0,
+) -> LyapunovSpectrum:
+    """The first ``n`` Lyapunov exponents of a case's trajectory.
+
+    Parameters
+    ----------
+    case : Case
+        The case; any speed profile (for a varying speed the exponents are those of
+        the finite run).
+    n : int
+        How many exponents, at most the number of coordinates free after the transient.
+    transient : float, optional
+        Simulated time before the measurement starts [s]; default a fifth of the case's
+        ``simulation.duration``.
+    duration : float, optional
+        Length of the measurement [s]; default the case's ``simulation.duration``.
+    interval : float
+        Re-orthonormalisation interval [s]. Shorter keeps the vectors well apart when
+        the exponents differ widely; the exponents do not depend on it otherwise.
+    initial : optional
+        Initial state, as for :func:`fivdisc.simulate`.
+    rtol, atol : float, optional
+        Integration tolerances (default the case's). The step is also capped at
+        :func:`fivdisc.integration.tangent_step`, so that the tangent dynamics is
+        resolved where the state alone would allow long steps.
+    seed : int
+        Seed of the random initial tangent vectors.
+
+    Returns
+    -------
+    LyapunovSpectrum
+    """
+    sim = case.simulation
+    transient = 0.2 * sim.duration if transient is None else transient
+    duration = sim.duration if duration is None else duration
+    checks = (("transient", transient, transient >= 0), ("duration", duration, duration > 0),
+              ("interval", interval, interval > 0 and interval <= duration))
+    for name, value, ok in checks:
+        if not ok:
+            allowed = "<= duration" if name == "interval" and interval > 0 else (
+                ">= 0" if name == "transient" else "> 0")
+            raise FivdiscError(f"{name} = {value!r} is invalid: must be {allowed} [s]")
+    if not isinstance(n, (int, np.integer)) or n < 1:
+        raise FivdiscError(f"n = {n!r} is invalid: must be an integer >= 1")
+    from fivdisc.analysis.orbits import energy_scales
+    from fivdisc.simulate import initial_state
+
+    model = build_model(case)
+    cap = tangent_step(model)
+    if sim.max_step > 0:
+        cap = min(cap, sim.max_step)
+    run = Integration(model, initial_state(model, initial), duration=transient + duration,
+                      rtol=rtol, atol=atol, max_step=cap)
+    run.advance(0.0)
+    if transient > 0:
+        run.run_to(transient)
+        _check(run, "the transient")
+    free = run.free()
+    if n > free.sum():
+        raise FivdiscError(f"n = {n} is invalid: must be at most {int(free.sum())}, the "
+                           "number of coordinates free after the transient")
+    sc = energy_scales(model)
+    rng = np.random.default_rng(seed)
+    basis = rng.standard_normal((model.state_size, n)) * free[:, None]
+    q, _ = np.linalg.qr(basis)
+    run.set_tangents((q * sc[:, None]).T)
+    t0 = run.t
+    steps = int(np.ceil(duration / interval - 1e-9))
+    logs = np.zeros((steps, n))
+    times = np.zeros(steps)
+    for k in range(steps):
+        run.run_to(min(t0 + (k + 1) * interval, transient + duration))
+        _check(run, "the measurement")
+        q, r = np.linalg.qr(run.tangents(slaved=False).T / sc[:, None])
+        diag = np.abs(np.diag(r))
+        with np.errstate(divide="ignore"):
+            logs[k] = np.log(diag)
+        signs = np.where(np.diag(r) < 0, -1.0, 1.0)
+        run.set_tangents(((q * signs) * sc[:, None]).T)
+        times[k] = run.t - t0
+    # Over a finite run the QR order need not be the order of the values: sort.
+    order = np.argsort(-logs.sum(axis=0), kind="stable")
+    logs = logs[:, order]
+    exponents = logs.sum(axis=0) / times[-1]
+    running = np.cumsum(logs, axis=0) / times[:, None]
+    blocks = np.array_split(np.arange(steps), min(_BLOCKS, steps))
+    edges = np.r_[0.0, times]
+    with np.errstate(invalid="ignore"):
+        rates = np.array([logs[b].sum(axis=0) / (edges[b[-1] + 1] - edges[b[0]])
+                          for b in blocks])
+        uncertainty = (rates.std(axis=0, ddof=1) / np.sqrt(len(blocks)) if len(blocks) > 1
+                       else np.full(n, np.nan))
+    return LyapunovSpectrum(exponents, uncertainty, times, running, float(transient),
+                            float(duration), float(interval))
+
+
+def _check(run: Integration, what: str) -> None:
+    if run.status_name not in ("running", "success"):
+        raise FivdiscError(f"lyapunov: the run ended with {run.status_name} at "
+                           f"t = {run.t:.9g} s during {what}")
