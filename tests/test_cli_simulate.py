@@ -60,10 +60,9 @@ def test_bad_case_file_is_one_line(tmp_path):
 def test_endless_switching_stops_with_status(monkeypatch):
     # No physical case here chatters (the phase choice prevents it), so the guard is
     # exercised by declaring any 5 consecutive switches less than 1 s apart "endless".
-    # The module, not the function fivdisc.simulate that shadows it on the package.
-    sim_module = importlib.import_module("fivdisc.simulate")
-    monkeypatch.setattr(sim_module, "_ZENO_DT", 1.0)
-    monkeypatch.setattr(sim_module, "_ZENO_COUNT", 5)
+    integration = importlib.import_module("fivdisc.integration")
+    monkeypatch.setattr(integration, "ZENO_DT", 1.0)
+    monkeypatch.setattr(integration, "ZENO_COUNT", 5)
     res = simulate(Case(simulation={"duration": 0.5}))
     assert res.status == "endless_switching"
     assert "endless switching" in res.message and "t = " in res.message

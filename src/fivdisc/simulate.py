@@ -7,12 +7,13 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
+from fivdisc import integration
 from fivdisc._kernels import integrate as kern
 from fivdisc._kernels import slots
 from fivdisc.case import Case
 from fivdisc.compilation import compile_notice
 from fivdisc.errors import SimulationError
-from fivdisc.integration import STATUS, ZENO_COUNT, ZENO_DT, Integration
+from fivdisc.integration import STATUS, Integration
 from fivdisc.limits import check_simulation
 from fivdisc.model import Model, build_model
 from fivdisc.result import EVENT_KINDS, PHASE_NAMES, Result, build_dataset
@@ -303,7 +304,7 @@ def _message(name: str, t: float, phase: str, sim) -> str:
         "or check the parameters",
         "step_size_underflow": f"step size underflow {where}; try looser simulation.rtol/atol",
         "endless_switching": f"endless switching (Zeno/chattering) {where}: "
-        f"{ZENO_COUNT} switches less than {ZENO_DT} s apart",
+        f"{integration.ZENO_COUNT} switches less than {integration.ZENO_DT} s apart",
         "max_switches": f"simulation.max_switches = {sim.max_switches} reached {where}",
     }.get(name, f"ended {where}")
 
