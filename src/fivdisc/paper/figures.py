@@ -337,6 +337,28 @@ def _analysis_window(ds: xr.Dataset, length: float = 10.0) -> tuple[float, float
     return 1.0, end
 
 
+# Lyapunov exponents of a constant-speed run: three, over the analysis window.
+_EXPONENTS = 3
+_PAPER_LABEL = {8: "quasi-periodic", 13: "periodic"}
+
+
+def _lyapunov_row(pc: PaperCase, ds: xr.Dataset, t0: float, t1: float) -> Row:
+    """The spectral label of phi over [t0, t1] against the Lyapunov exponents of the
+    same stretch (QR method with the saltation matrices at every switch)."""
+    from fivdisc.analysis.lyapunov import lyapunov
+    from fivdisc.analysis.regimes import cross_check
+
+    spectral = ms.periodicity(ds, "phi", None, t0, t1).kind
+    spec = lyapunov(pc.case, n=_EXPONENTS, transient=t0, duration=t1 - t0)
+    regime = cross_check(spectral, spec)
+    paper = _PAPER_LABEL.get(pc.figure, "")
+    verdict = (_verdict(regime.lyapunov == paper, partly=regime.consistent) if paper else "")
+    return Row(pc.figure, f"Lyapunov exponents ({_EXPONENTS}, {t0:g}-{t1:g} s) against the "
+               "spectral label of phi", paper or "(not stated)",
+               regime.summary + "; exponents " + ", ".join(f"{e:+.3g}" for e in spec.exponents)
+               + " 1/s", verdict=verdict)
+
+
 def _per_window(ds: xr.Dataset, var: str, probe: int | None = None,
                 width: float = _WINDOW, until: float | None = None) -> list[tuple[float, float]]:
     """(window start [s], dominant frequency [Hz]) per window of `width` s, up to `until`."""
@@ -668,6 +690,8 @@ def _spectra_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
                                  verdict=_verdict(abs(freq["C01"] - 181.0) < _FREQ_TOL
                                                   and abs(freq["D02"] - 290.5) < _FREQ_TOL)))
         table += _constant_rows(pc, ds, var, probe)
+        if pc.figure in (8, 13):
+            table.append(_lyapunov_row(pc, ds, *_analysis_window(ds)))
     else:
         table = _decelerating_rows(pc, ds, runs.get(_reference(pc.case)), var, probe)
         if pc.figure == 15:
@@ -926,6 +950,8 @@ def _responses_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]
         for var, probe in (("phi", None), ("w", 1)):
             table.append(Row(pc.figure, f"strongest line of {var} per 5 s", "(time-frequency plot)",
                              _window_text(_per_window(ds, var, probe))))
+        if pc.figure in (20, 21):
+            table.append(_lyapunov_row(pc, ds, 1.0, min(11.0, end)))
     elif profile == "decelerating":
         ref = runs.get(_counterpart(pc).case)
         _, r_dec = ms.ridge(ds, "phi")
