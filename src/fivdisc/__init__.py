@@ -8,6 +8,8 @@ The public API::
     print(result.summary())
     result.to_netcdf("run.nc"); fivdisc.open_result("run.nc") == result
     print(fivdisc.linear_stability(case))               # constant-speed cases
+    print(fivdisc.periodic_orbit(case))                 # Floquet multipliers
+    print(fivdisc.lyapunov(case, n=3))                  # Lyapunov exponents
 
 Plotting lives in :mod:`fivdisc.plots`, parameter sweeps in :mod:`fivdisc.sweep` and the
 paper's cases in :mod:`fivdisc.paper`; they import matplotlib or dask only when used. The
@@ -25,6 +27,8 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from fivdisc.analysis.energy import energy_balance
     from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium
+    from fivdisc.analysis.lyapunov import LyapunovSpectrum, lyapunov
+    from fivdisc.analysis.orbits import PeriodicOrbit, periodic_orbit
     from fivdisc.analysis.spectra import classify, dominant_frequency, find_peaks, spectrum, stft
     from fivdisc.analysis.stability import (
         LinearStability,
@@ -50,8 +54,10 @@ __all__ = [
     "Equilibrium",
     "FivdiscError",
     "LinearStability",
+    "LyapunovSpectrum",
     "ModeError",
     "Model",
+    "PeriodicOrbit",
     "PlateMode",
     "Result",
     "SimulationError",
@@ -65,7 +71,9 @@ __all__ = [
     "find_peaks",
     "linear_stability",
     "load_case",
+    "lyapunov",
     "open_result",
+    "periodic_orbit",
     "perturbation_test",
     "separation_stats",
     "simulate",
@@ -81,6 +89,8 @@ _HOMES = {
     for module, names in {
         "fivdisc.analysis.energy": ("energy_balance",),
         "fivdisc.analysis.equilibrium": ("Equilibrium", "sliding_equilibrium"),
+        "fivdisc.analysis.lyapunov": ("LyapunovSpectrum", "lyapunov"),
+        "fivdisc.analysis.orbits": ("PeriodicOrbit", "periodic_orbit"),
         "fivdisc.analysis.spectra": (
             "classify", "dominant_frequency", "find_peaks", "spectrum", "stft"
         ),

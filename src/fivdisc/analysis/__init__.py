@@ -1,7 +1,11 @@
-"""Analyses of the slider-on-disc system: equilibrium, stability, spectra, trajectories."""
+"""Analyses of the slider-on-disc system: equilibrium, stability, spectra, trajectories,
+periodic orbits, Lyapunov exponents."""
 
 from fivdisc.analysis.energy import energy_balance
 from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium
+from fivdisc.analysis.lyapunov import LyapunovSpectrum, lyapunov
+from fivdisc.analysis.orbits import PeriodicOrbit, periodic_orbit
+from fivdisc.analysis.regimes import Regime, cross_check
 from fivdisc.analysis.spectra import (
     Periodicity,
     Spectrum,
@@ -28,15 +32,21 @@ from fivdisc.analysis.trajectories import (
 __all__ = [
     "Equilibrium",
     "LinearStability",
+    "LyapunovSpectrum",
+    "PeriodicOrbit",
     "Periodicity",
     "PerturbationTest",
+    "Regime",
     "Spectrum",
     "classify",
+    "cross_check",
     "dominant_frequency",
     "energy_balance",
     "find_peaks",
     "friction_trajectory",
     "linear_stability",
+    "lyapunov",
+    "periodic_orbit",
     "perturbation_test",
     "phase_portrait",
     "separation_intervals",
