@@ -29,6 +29,8 @@ from fivdisc.model import Model, build_model
 __all__ = ["PeriodicOrbit", "periodic_orbit"]
 
 VERDICTS = ("stable", "unstable", "not converged")
+# Halvings of a Newton step that does not reduce the residual before giving up.
+_HALVINGS = 6
 
 
 @dataclass(frozen=True)
@@ -315,30 +317,46 @@ def periodic_orbit(
     phases = (np.full(model.n_sliders, lay.SLIP) if phases is None
               else np.asarray(phases, dtype=np.int64))
 
-    residual = np.inf
-    shot = None
-    iterations = 0
     sc = energy_scales(model)
-    while iterations < max_iterations:
+
+    def attempt(x: np.ndarray, t: float) -> tuple[_Shot, float, np.ndarray]:
+        shot = _shoot(model, x, phases, t, rtol, atol_run)
+        free = _free(model, x, phases)
+        gap = (shot.end - x)[free] / sc[free]
+        return shot, float(np.linalg.norm(gap) / (np.linalg.norm(shot.rate_start / sc) * t)), free
+
+    shot, residual, free = attempt(x0, period)
+    iterations = 0
+    while residual >= tol and iterations < max_iterations:
         iterations += 1
-        shot = _shoot(model, x0, phases, period, rtol, atol_run)
-        free = _free(model, x0, phases)
-        gap = (shot.end - x0)[free] / sc[free]
-        residual = float(np.linalg.norm(gap) / (np.linalg.norm(shot.rate_start / sc) * period))
-        if residual < tol:
-            break
         # Newton on (x0 / sc, T): [M - I, f(end); f(x0)^T, 0] (dx, dT) = (-gap, 0).
         m = int(free.sum())
+        gap = (shot.end - x0)[free] / sc[free]
         jac = np.zeros((m + 1, m + 1))
         jac[:m, :m] = shot.monodromy[np.ix_(free, free)] * (sc[free][None, :] / sc[free][:, None])
         jac[:m, :m] -= np.eye(m)
         jac[:m, m] = shot.rate_end[free] / sc[free]
         jac[m, :m] = shot.rate_start[free] / sc[free]
         step = np.linalg.lstsq(jac, np.r_[-gap, 0.0], rcond=None)[0]
-        x0 = x0.copy()
-        x0[free] += step[:m] * sc[free]
-        period = float(period + step[m])
-        if not period > 0:
+        # The flow map is smooth only while the switch sequence stays the same: a step
+        # that adds or removes a switch may not reduce the residual, so it is halved
+        # until it does.
+        for halving in range(_HALVINGS):
+            frac = 0.5**halving
+            trial_t = period + frac * step[m]
+            if not trial_t > 0:
+                continue
+            trial_x = x0.copy()
+            trial_x[free] += frac * step[:m] * sc[free]
+            try:
+                trial = attempt(trial_x, trial_t)
+            except FivdiscError:
+                continue
+            if trial[1] < residual:
+                x0, period = trial_x, float(trial_t)
+                shot, residual, free = trial
+                break
+        else:
             break
     converged = residual < tol
     assert shot is not None
