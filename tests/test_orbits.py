@@ -142,3 +142,24 @@ def test_orbit_command_json_and_netcdf(tmp_path):
     with xr.open_dataset(out) as ds:
         assert ds.attrs["period"] == pytest.approx(period, rel=1e-9)
         assert ds["monodromy"].shape == (6, 6)
+
+
+def test_paper_fig13_orbit_sits_just_outside_the_unit_circle():
+    """The paper's Fig. 13 case (undamped disc, constant 2 pi rad/s): the shooting converges
+    on a periodic orbit whose leading multipliers lie within 1e-3 of the unit circle.
+    Whether they are inside or outside is a statement only if the moduli do not move with
+    the integration tolerance: at rtol 1e-11 and 1e-12 they agree to 1e-7, a thousand
+    times closer than their distance from 1."""
+    from fivdisc.paper.cases import FIGURES
+
+    case = FIGURES[13].case
+    orbit = periodic_orbit(case, transient=5.0, window=0.05)
+    assert orbit.residual < 1e-8
+    again = periodic_orbit(case, guess=orbit.state, period=orbit.period, phases=orbit.phases,
+                           rtol=1e-11)
+    assert again.period == pytest.approx(orbit.period, rel=1e-9)
+    lead = np.sort(orbit.moduli)[::-1][:4]
+    assert np.sort(again.moduli)[::-1][:4] == pytest.approx(lead, abs=1e-7)
+    assert abs(orbit.largest - 1.0) < 1e-3
+    assert abs(orbit.largest - 1.0) > 1e-5
+    assert orbit.verdict == ("unstable" if orbit.largest > 1.0 else "stable")
