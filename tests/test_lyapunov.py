@@ -119,7 +119,7 @@ def test_lyapunov_command(tmp_path):
     path.write_text(RIGID.to_toml())
     out = tmp_path / "lyap.nc"
     res = CliRunner().invoke(cli, ["lyapunov", str(path), "--n", "2", "--transient", "1",
-                                   "--duration", "2", "--json", "-o", str(out)])
+                                   "--duration", "2", "--json", "--no-progress", "-o", str(out)])
     assert res.exit_code == 0, res.output
     data = json.loads(res.output)
     assert len(data["exponents"]) == 2 and len(data["uncertainty"]) == 2

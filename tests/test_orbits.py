@@ -129,7 +129,7 @@ def test_orbit_command_json_and_netcdf(tmp_path):
     path = tmp_path / "rigid.toml"
     path.write_text(RIGID.replace({"simulation.duration": 4.0}).to_toml())
     out = tmp_path / "orbit.nc"
-    res = CliRunner().invoke(cli, ["orbit", str(path), "--json", "-o", str(out)])
+    res = CliRunner().invoke(cli, ["orbit", str(path), "--json", "--no-progress", "-o", str(out)])
     assert res.exit_code == 0, res.output
     data = json.loads(res.output)
     period, _ = _rigid_disc_closed_form()

@@ -17,11 +17,15 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, TextIO
 
-__all__ = ["COMPILE_SECONDS", "compile_notice", "needs_compiling", "warm_kernel"]
+__all__ = ["COMPILE_SECONDS", "TANGENT_COMPILE_SECONDS", "compile_notice", "needs_compiling",
+           "warm_kernel"]
 
 #: Typical time to compile the kernel [s]: 44-67 s measured on a loaded 2-core machine,
 #: 118 s on one under heavier load; benchmarks/bench_simulate.py measures it on yours.
 COMPILE_SECONDS = 90
+#: Typical time to compile the kernel with tangent vectors (orbits, Lyapunov exponents),
+#: once more after the plain one [s]: 80-120 s measured on a 2-core machine.
+TANGENT_COMPILE_SECONDS = 120
 _FRAMES = "|/-\\"
 _TICK = 0.25  # [s] between spinner frames
 
@@ -41,8 +45,9 @@ def needs_compiling(dispatcher: Any) -> bool:
 
 
 @contextmanager
-def compile_notice(dispatcher: Any, show: bool = True,
-                   stream: TextIO | None = None) -> Iterator[None]:
+def compile_notice(dispatcher: Any, show: bool = True, stream: TextIO | None = None,
+                   what: str = "simulation kernel",
+                   seconds: float = COMPILE_SECONDS) -> Iterator[None]:
     """Print a notice on `stream` while the body compiles `dispatcher`, if it will.
 
     Parameters
@@ -53,12 +58,14 @@ def compile_notice(dispatcher: Any, show: bool = True,
         False: say nothing (the body still runs).
     stream
         Where to write [default: sys.stderr].
+    what, seconds
+        What compiles, and about how long it takes [s].
     """
     if not show or not needs_compiling(dispatcher):
         yield
         return
     out = stream if stream is not None else sys.stderr
-    line = f"compiling the simulation kernel, once: about {COMPILE_SECONDS} s"
+    line = f"compiling the {what}, once: about {seconds:.0f} s"
     live = out.isatty()
     start = time.perf_counter()
     done = threading.Event()
@@ -92,8 +99,19 @@ def compile_notice(dispatcher: Any, show: bool = True,
     except BaseException:
         stop("")
         raise
-    stop(f"compiled the simulation kernel in {time.perf_counter() - start:.0f} s; later "
-         "runs load it")
+    stop(f"compiled the {what} in {time.perf_counter() - start:.0f} s; later runs load it")
+
+
+@contextmanager
+def tangent_notice(show: bool = True) -> Iterator[None]:
+    """:func:`compile_notice` for the kernel with tangent vectors: its first use compiles
+    a second version of the kernel (and of its helpers, such as
+    ``fivdisc._kernels.tangent.prepare``, compiled only for it)."""
+    from fivdisc._kernels import tangent
+
+    with compile_notice(tangent.prepare, show=show, what="kernel with tangent vectors",
+                        seconds=TANGENT_COMPILE_SECONDS):
+        yield
 
 
 def warm_kernel(show: bool = False) -> None:

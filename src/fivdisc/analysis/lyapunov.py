@@ -119,6 +119,7 @@ def lyapunov(
     rtol: float | None = None,
     atol: float | None = None,
     seed: int = 0,
+    progress: bool = False,
 ) -> LyapunovSpectrum:
     """The first ``n`` Lyapunov exponents of a case's trajectory.
 
@@ -145,6 +146,9 @@ def lyapunov(
         resolved where the state alone would allow long steps.
     seed : int
         Seed of the random initial tangent vectors.
+    progress : bool
+        Show a progress bar over the measurement, and a notice when the kernel with
+        tangent vectors compiles (first use).
 
     Returns
     -------
@@ -183,21 +187,30 @@ def lyapunov(
     rng = np.random.default_rng(seed)
     basis = rng.standard_normal((model.state_size, n)) * free[:, None]
     q, _ = np.linalg.qr(basis)
-    run.set_tangents((q * sc[:, None]).T)
     t0 = run.t
     steps = int(np.ceil(duration / interval - 1e-9))
     logs = np.zeros((steps, n))
     times = np.zeros(steps)
-    for k in range(steps):
-        run.run_to(min(t0 + (k + 1) * interval, transient + duration))
-        _check(run, "the measurement")
-        q, r = np.linalg.qr(run.tangents(slaved=False).T / sc[:, None])
-        diag = np.abs(np.diag(r))
-        with np.errstate(divide="ignore"):
-            logs[k] = np.log(diag)
-        signs = np.where(np.diag(r) < 0, -1.0, 1.0)
-        run.set_tangents(((q * signs) * sc[:, None]).T)
-        times[k] = run.t - t0
+    from fivdisc.compilation import tangent_notice
+
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=steps, desc="Lyapunov exponents", unit="QR")
+    try:
+        # The first interval compiles the kernel with tangents in a fresh installation.
+        with tangent_notice(show=progress):
+            run.set_tangents((q * sc[:, None]).T)
+            _interval(run, 0, logs, times, t0, interval, transient + duration, sc)
+        for k in range(steps):
+            if k:
+                _interval(run, k, logs, times, t0, interval, transient + duration, sc)
+            if bar is not None:
+                bar.update()
+    finally:
+        if bar is not None:
+            bar.close()
     # Over a finite run the QR order need not be the order of the values: sort.
     order = np.argsort(-logs.sum(axis=0), kind="stable")
     logs = logs[:, order]
@@ -212,6 +225,20 @@ def lyapunov(
                        else np.full(n, np.nan))
     return LyapunovSpectrum(exponents, uncertainty, times, running, float(transient),
                             float(duration), float(interval))
+
+
+def _interval(run: Integration, k: int, logs: np.ndarray, times: np.ndarray, t0: float,
+              interval: float, end: float, sc: np.ndarray) -> None:
+    """Integrate the k-th interval, then re-orthonormalise (energy norm) and keep the
+    logarithms of the stretching factors."""
+    run.run_to(min(t0 + (k + 1) * interval, end))
+    _check(run, "the measurement")
+    q, r = np.linalg.qr(run.tangents(slaved=False).T / sc[:, None])
+    with np.errstate(divide="ignore"):
+        logs[k] = np.log(np.abs(np.diag(r)))
+    signs = np.where(np.diag(r) < 0, -1.0, 1.0)
+    run.set_tangents(((q * signs) * sc[:, None]).T)
+    times[k] = run.t - t0
 
 
 def _check(run: Integration, what: str) -> None:

@@ -244,6 +244,7 @@ def periodic_orbit(
     atol: float | None = None,
     tol: float = 1e-8,
     max_iterations: int = 30,
+    progress: bool = False,
 ) -> PeriodicOrbit:
     """Find a periodic orbit of a constant-speed case by shooting.
 
@@ -276,6 +277,8 @@ def periodic_orbit(
         Convergence: scaled residual ``|phi_T(x0) - x0|`` below this.
     max_iterations : int
         Newton iterations before giving up (verdict ``"not converged"``).
+    progress : bool
+        Say so on stderr when the kernel with tangent vectors compiles (first use).
 
     Returns
     -------
@@ -325,7 +328,10 @@ def periodic_orbit(
         gap = (shot.end - x)[free] / sc[free]
         return shot, float(np.linalg.norm(gap) / (np.linalg.norm(shot.rate_start / sc) * t)), free
 
-    shot, residual, free = attempt(x0, period)
+    from fivdisc.compilation import tangent_notice
+
+    with tangent_notice(show=progress):
+        shot, residual, free = attempt(x0, period)
     iterations = 0
     while residual >= tol and iterations < max_iterations:
         iterations += 1

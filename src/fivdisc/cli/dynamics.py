@@ -24,8 +24,10 @@ _NC = click.Path(dir_okay=False, path_type=Path)
 @click.option("--json", "as_json", is_flag=True,
               help="Print period, multipliers, verdict and residual as JSON.")
 @click.option("-o", "--output", type=_NC, help="Write the orbit to a netCDF file (.nc).")
+@click.option("--progress/--no-progress", default=True, show_default=True,
+              help="Say so while the kernel with tangent vectors compiles (first use).")
 def orbit(case_file: Path, period: float | None, transient: float | None, rtol: float,
-          as_json: bool, output: Path | None) -> None:
+          as_json: bool, output: Path | None, progress: bool) -> None:
     """Periodic orbit of CASE_FILE (constant speed) and its Floquet multipliers.
 
     Runs the case for its duration (or --transient), finds the first return of the
@@ -38,7 +40,8 @@ def orbit(case_file: Path, period: float | None, transient: float | None, rtol: 
 
     case = load_case(case_file)
     out = check_output(output, "-o", (".nc",), inputs=[case_file]) if output else None
-    res = periodic_orbit(case, period=period, transient=transient, rtol=rtol)
+    res = periodic_orbit(case, period=period, transient=transient, rtol=rtol,
+                         progress=progress)
     click.echo(res.to_json() if as_json else str(res))
     if out is not None:
         ds = res.to_dataset()
@@ -61,8 +64,10 @@ def orbit(case_file: Path, period: float | None, transient: float | None, rtol: 
               help="Print the exponents [1/s] and their uncertainty as JSON.")
 @click.option("-o", "--output", type=_NC,
               help="Write the exponents and their running estimates to netCDF (.nc).")
+@click.option("--progress/--no-progress", default=True, show_default=True,
+              help="Show a progress bar (on stderr).")
 def lyapunov(case_file: Path, count: int, transient: float | None, duration: float | None,
-             interval: float, as_json: bool, output: Path | None) -> None:
+             interval: float, as_json: bool, output: Path | None, progress: bool) -> None:
     """Lyapunov exponents of CASE_FILE by the QR method on the tangent dynamics.
 
     The tangent vectors are carried across every switch by its saltation matrix.
@@ -74,7 +79,8 @@ def lyapunov(case_file: Path, count: int, transient: float | None, duration: flo
 
     case = load_case(case_file)
     out = check_output(output, "-o", (".nc",), inputs=[case_file]) if output else None
-    res = compute(case, n=count, transient=transient, duration=duration, interval=interval)
+    res = compute(case, n=count, transient=transient, duration=duration, interval=interval,
+                  progress=progress)
     click.echo(res.to_json() if as_json else str(res))
     if out is not None:
         ds = res.to_dataset()
