@@ -170,7 +170,7 @@ def test_a_store_of_an_older_format_is_refused(store: Path) -> None:
     data = json.loads(meta.read_text())
     del data["attributes"]["store_format"]
     meta.write_text(json.dumps(data))
-    with pytest.raises(SweepError, match="store format 1, this version writes 3"):
+    with pytest.raises(SweepError, match="store format 1, this version writes 4"):
         verify_store(store)
 
 

@@ -5,7 +5,8 @@ import path, ``"package.module:function"``, and are called with the run's
 :class:`~fivdisc.result.Result`, returning a real number (stored as float64).
 
 A reduction that is final once some event has happened (``separated`` after the
-first separation) lets the run stop there; see :func:`stop_events`.
+first separation) lets the run stop there; see :func:`stop_events`. Sections
+(:class:`fivdisc.sweep.sections.Section`) keep many values per run and need it whole.
 """
 
 from __future__ import annotations
@@ -14,16 +15,20 @@ import importlib
 import math
 import numbers
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
-from functools import cache
-from typing import Any
+from dataclasses import dataclass, replace
+from functools import cache, partial
+from typing import TYPE_CHECKING, Any
 
 from fivdisc.case import Case
 from fivdisc.errors import FivdiscError, nearest
 from fivdisc.result import Result
 
+if TYPE_CHECKING:
+    from fivdisc.sweep.sections import Section
+
 __all__ = [
     "BUILTIN",
+    "LyapunovSettings",
     "Reduction",
     "RunFailed",
     "SweepError",
@@ -122,6 +127,49 @@ def _max_growth_rate(result: Result | None, case: Case) -> float:
     return linear_stability(case).max_growth_rate
 
 
+@dataclass(frozen=True)
+class LyapunovSettings:
+    """How the ``largest_lyapunov`` reduction measures (``[reduce.largest_lyapunov]``).
+
+    The exponent is measured from `transient` for `duration` (see
+    :func:`fivdisc.lyapunov`), in a run of its own that carries a tangent
+    vector.
+
+    Attributes
+    ----------
+    transient
+        Simulated time before the measurement [s]; None: a fifth of the point's
+        ``simulation.duration``. A sweep with sections defaults it to their largest
+        ``after``.
+    duration
+        Length of the measurement [s]; None: until the point's ``simulation.duration``,
+        the window the sections see.
+    interval
+        Re-orthonormalisation interval [s].
+    """
+
+    transient: float | None = None
+    duration: float | None = None
+    interval: float = 0.01
+
+    def window(self, case: Case) -> tuple[float, float]:
+        """(transient, duration) [s] of the measurement for `case`."""
+        end = case.simulation.duration
+        transient = 0.2 * end if self.transient is None else self.transient
+        duration = end - transient if self.duration is None else self.duration
+        return transient, duration
+
+
+def _largest_lyapunov(result: Result | None, case: Case,
+                      settings: LyapunovSettings | None = None) -> float:
+    from fivdisc.analysis.lyapunov import lyapunov
+
+    settings = settings or LyapunovSettings()
+    transient, duration = settings.window(case)
+    return lyapunov(case, n=1, transient=transient, duration=duration,
+                    interval=settings.interval).largest
+
+
 def _builtin(
     name: str,
     func: Callable[[Result | None, Case], Any],
@@ -189,6 +237,14 @@ BUILTIN: dict[str, Reduction] = {
             "largest real part of the linearised system's eigenvalues (constant speed)",
             needs_run=False,
         ),
+        _builtin(
+            "largest_lyapunov",
+            _largest_lyapunov,
+            "1/s",
+            "largest Lyapunov exponent, over a run of its own with a tangent vector "
+            "(settings: [reduce.largest_lyapunov])",
+            needs_run=False,
+        ),
     )
 }
 
@@ -197,6 +253,7 @@ BUILTIN: dict[str, Reduction] = {
 _NEEDS_MODULE = {
     "dominant_frequency": "fivdisc.analysis.spectra",
     "max_growth_rate": "fivdisc.analysis.stability",
+    "largest_lyapunov": "fivdisc.analysis.lyapunov",
 }
 
 
@@ -233,7 +290,7 @@ def _user(spec: str) -> Reduction:
 
 
 @cache
-def _resolve(keep: tuple[str, ...]) -> tuple[Reduction, ...]:
+def _resolve(keep: tuple[str, ...], lyapunov: LyapunovSettings | None) -> tuple[Reduction, ...]:
     reductions = []
     for spec in keep:
         if ":" in spec:
@@ -252,7 +309,10 @@ def _resolve(keep: tuple[str, ...]) -> tuple[Reduction, ...]:
                     f"reduce.keep: reduction '{spec}' needs {_NEEDS_MODULE[spec]}, which cannot "
                     f"be imported ({exc})"
                 ) from None
-        reductions.append(BUILTIN[spec])
+        reduction = BUILTIN[spec]
+        if spec == "largest_lyapunov" and lyapunov is not None:
+            reduction = replace(reduction, func=partial(_largest_lyapunov, settings=lyapunov))
+        reductions.append(reduction)
     seen: dict[str, str] = {}
     for r in reductions:
         if r.name in seen or r.name in ("error", "done"):
@@ -264,8 +324,16 @@ def _resolve(keep: tuple[str, ...]) -> tuple[Reduction, ...]:
     return tuple(reductions)
 
 
-def resolve(keep: Sequence[str]) -> tuple[Reduction, ...]:
+def resolve(keep: Sequence[str], lyapunov: LyapunovSettings | None = None
+            ) -> tuple[Reduction, ...]:
     """The reductions named in `keep`, checked (user functions are imported).
+
+    Parameters
+    ----------
+    keep
+        Reduction names, as in ``reduce.keep``.
+    lyapunov
+        Settings of ``largest_lyapunov`` (default: :class:`LyapunovSettings`'s).
 
     Raises
     ------
@@ -276,7 +344,7 @@ def resolve(keep: Sequence[str]) -> tuple[Reduction, ...]:
     for spec in keep:
         if not isinstance(spec, str):
             raise SweepError(f"reduce.keep entry {spec!r} is invalid: must be a string")
-    return _resolve(tuple(keep))
+    return _resolve(tuple(keep), lyapunov)
 
 
 def stop_events(reductions: Sequence[Reduction]) -> tuple[str, ...]:
@@ -295,8 +363,13 @@ def stop_events(reductions: Sequence[Reduction]) -> tuple[str, ...]:
     return tuple(sorted(kinds))
 
 
-def evaluate(case: Case, keep: Sequence[str]) -> dict[str, bool | float]:
-    """Simulate one case (if any kept reduction needs it) and reduce the run.
+def evaluate(
+    case: Case,
+    keep: Sequence[str],
+    sections: Sequence[Section] = (),
+    lyapunov: LyapunovSettings | None = None,
+) -> dict[str, Any]:
+    """Simulate one case (if any kept reduction or section needs it) and reduce the run.
 
     Parameters
     ----------
@@ -304,11 +377,17 @@ def evaluate(case: Case, keep: Sequence[str]) -> dict[str, bool | float]:
         The point's case.
     keep
         Reduction names, as in ``reduce.keep``.
+    sections
+        Sections whose values to take from the run.
+    lyapunov
+        Settings of ``largest_lyapunov``.
 
     Returns
     -------
     dict
-        Stored name -> value.
+        Stored name -> value: a bool or float per reduction; per section its
+        ``(max_points,)`` values (NaN padded) and, under its ``count_name``, how many
+        are valid.
 
     Raises
     ------
@@ -319,10 +398,13 @@ def evaluate(case: Case, keep: Sequence[str]) -> dict[str, bool | float]:
     # Imported here: the simulator loads numba, which validating a sweep does not need.
     from fivdisc.simulate import simulate
 
-    reductions = resolve(keep)
+    reductions = resolve(keep, lyapunov)
     result = None
-    if any(r.needs_run for r in reductions):
-        result = simulate(case, stop_on=stop_events(reductions))
+    if sections or any(r.needs_run for r in reductions):
+        result = simulate(case, stop_on=() if sections else stop_events(reductions))
         if not result.ok:
             raise RunFailed(f"simulation {result.status}: {result.message}")
-    return {r.name: r(result, case) for r in reductions}
+    values: dict[str, Any] = {r.name: r(result, case) for r in reductions}
+    for section in sections:
+        values[section.name], values[section.count_name] = section(result)
+    return values

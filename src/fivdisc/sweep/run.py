@@ -14,7 +14,7 @@ import signal
 import threading
 import time
 from collections import deque
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor
 from concurrent.futures import wait as wait_local
 from concurrent.futures.process import BrokenProcessPool
@@ -27,7 +27,8 @@ from typing import Any
 from fivdisc.case import Case
 from fivdisc.compilation import warm_kernel
 from fivdisc.errors import FivdiscError
-from fivdisc.sweep.reductions import SweepError, evaluate
+from fivdisc.sweep.reductions import LyapunovSettings, SweepError, evaluate
+from fivdisc.sweep.sections import Section
 from fivdisc.sweep.spec import Sweep
 from fivdisc.sweep.store import PointOutcome, SweepStore, store_lock
 
@@ -72,10 +73,17 @@ class SweepReport:
     wall_time: float
 
 
-def run_point(index: int, case: Case, keep: tuple[str, ...]) -> PointOutcome:
-    """Compute one point; a failure is returned as the outcome's error, not raised."""
+def run_point(
+    index: int,
+    case: Case,
+    keep: tuple[str, ...],
+    sections: Sequence[Section] = (),
+    lyapunov: LyapunovSettings | None = None,
+) -> PointOutcome:
+    """Compute one point (see :func:`~fivdisc.sweep.reductions.evaluate`); a failure is
+    returned as the outcome's error, not raised."""
     try:
-        return PointOutcome(index, evaluate(case, keep))
+        return PointOutcome(index, evaluate(case, keep, sections, lyapunov))
     except FivdiscError as exc:
         return PointOutcome(index, None, str(exc))
     except Exception as exc:  # a user reduction or the solver may raise anything
@@ -113,8 +121,8 @@ class _LocalPool:
             initargs=(os.getpid(),),
         )
 
-    def submit(self, index: int, case: Case, keep: tuple[str, ...]) -> Any:
-        return self._pool.submit(run_point, index, case, keep)
+    def submit(self, index: int, case: Case, *work: Any) -> Any:
+        return self._pool.submit(run_point, index, case, *work)
 
     def wait(self, futures: Iterable[Any], timeout: float | None) -> set[Any]:
         return wait_local(futures, timeout=timeout, return_when=FIRST_COMPLETED).done
@@ -194,9 +202,9 @@ class _DaskPool:
         reason = " ".join(str(exc).split()[:12]) or type(exc).__name__
         return ClusterLost(f"lost the Dask cluster at {self.address} ({reason})")
 
-    def submit(self, index: int, case: Case, keep: tuple[str, ...]) -> Any:
+    def submit(self, index: int, case: Case, *work: Any) -> Any:
         try:
-            return self._client.submit(run_point, index, case, keep, pure=False)
+            return self._client.submit(run_point, index, case, *work, pure=False)
         except Exception as exc:  # a closed client raises several types
             raise self._lost(exc) from None
 
@@ -303,6 +311,8 @@ def run_sweep(
                 if pool is None:
                     # Compiled here once (with a notice), the workers load it from the cache.
                     warm_kernel(show=progress)
+                    if spec.lyapunov is not None:
+                        _warm_tangent_kernel(show=progress)
                     pool = _LocalPool(workers or os.cpu_count() or 1)
                 try:
                     _drive(pool, spec, target, todo, already, failed, progress)
@@ -328,6 +338,18 @@ def run_sweep(
     )
 
 
+def _warm_tangent_kernel(show: bool) -> None:
+    """Compile or load the kernel with tangent vectors (``largest_lyapunov`` needs it) now,
+    with an exponent over 1 ms of simulated time."""
+    from fivdisc.analysis.lyapunov import lyapunov
+    from fivdisc.case import Case
+    from fivdisc.compilation import tangent_notice
+
+    with tangent_notice(show=show):
+        lyapunov(Case(simulation={"duration": 1e-3}), transient=0.0, duration=1e-3,
+                 interval=1e-3)
+
+
 def _drive(
     pool: _LocalPool | _DaskPool,
     sweep: Sweep,
@@ -340,7 +362,8 @@ def _drive(
     """Keep the pool fed, and store results as they come back."""
     from tqdm import tqdm
 
-    keep = tuple(sweep.keep)
+    # What every point computes, as run_point takes it (picklable, for the workers).
+    work = (tuple(sweep.keep), sweep.sections, sweep.lyapunov)
     ahead = _AHEAD_PER_WORKER * pool.workers
     running: dict[Any, int] = {}
     unstored: list[PointOutcome] = []
@@ -367,7 +390,7 @@ def _drive(
             while todo or running:
                 while todo and len(running) < ahead:
                     index = todo.popleft()
-                    running[pool.submit(index, sweep.cases[index], keep)] = index
+                    running[pool.submit(index, sweep.cases[index], *work)] = index
                 due = last_write + _WRITE_INTERVAL - time.monotonic()
                 finished = pool.wait(running, max(due, 0.0) if unstored else None)
                 unstored += [pool.outcome(f, running.pop(f)) for f in finished]

@@ -11,6 +11,12 @@ A sweep file is TOML::
     "simulation.duration" = "speed.duration"
     [reduce]
     keep = ["separated", "first_separation_time"]
+    [[reduce.section]]                   # optional: values at a section, many per point
+    variable = "phi_dot"
+    at = "maxima"                        # or a kind of switch: "stick", "slip", ...
+    after = 2.0                          # transient [s]
+    [reduce.largest_lyapunov]            # optional: settings of that reduction
+    transient = 2.0
 
 Points are numbered in C order (the first axis varies slowest). Building a
 :class:`Sweep` validates everything, including the case of every point, so a sweep
@@ -26,7 +32,7 @@ import math
 import re
 import tomllib
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from os import PathLike
 from pathlib import Path
 from typing import Any, Literal
@@ -37,14 +43,24 @@ from fivdisc.case import Case, is_case_key, keys_like, load_case
 from fivdisc.errors import CaseError, nearest
 from fivdisc.files import read_text
 from fivdisc.limits import check_memory, check_simulation, simulation_bytes
-from fivdisc.sweep.reductions import Reduction, SweepError, resolve, stop_events
+from fivdisc.sweep.reductions import (
+    LyapunovSettings,
+    Reduction,
+    SweepError,
+    resolve,
+    stop_events,
+)
+from fivdisc.sweep.sections import Section
 
 __all__ = ["Sweep", "SweepError", "load_sweep", "parse_range"]
 
 FORMAT = "fivdisc-sweep/1"
 MODES = ("grid", "zip")
 _FILE_KEYS = ("base", "mode", "axes", "link", "reduce")
-_REDUCE_KEYS = ("keep",)
+_REDUCE_KEYS = ("keep", "section", "largest_lyapunov")
+_LYAPUNOV_KEYS = ("transient", "duration", "interval")
+# Names the store gives its own variables.
+_RESERVED = ("error", "checksum", "done")
 _RANGE = re.compile(r"^\s*([^:]+):([^:]+):([^:]+)\s*$")
 _INTEGER = re.compile(r"^\s*[+-]?\d+\s*$")
 # Memory per axis value while parsing (the values, as floats and as Python objects), and
@@ -140,17 +156,27 @@ class Sweep:
         all of the same length, walked together.
     keep
         Reductions stored per point: built-in names (see
-        :data:`fivdisc.sweep.reductions.BUILTIN`) or ``"package.module:function"``.
+        :data:`fivdisc.sweep.reductions.BUILTIN`) or ``"package.module:function"``; may
+        be empty when there are `sections`.
     link
         Dotted key -> dotted key whose value it copies at every point, after the
         axes are applied (e.g. ``{"simulation.duration": "speed.duration"}``).
     source
         File the sweep was read from, prefixed to error messages; None otherwise.
+    sections
+        Sections whose values are stored per point (``[[reduce.section]]``):
+        :class:`~fivdisc.sweep.sections.Section` objects or tables of their keywords.
+    lyapunov
+        Settings of the ``largest_lyapunov`` reduction (``[reduce.largest_lyapunov]``):
+        a table with ``transient``, ``duration``, ``interval`` [s], or
+        :class:`~fivdisc.sweep.reductions.LyapunovSettings`; only with that reduction
+        kept. Without them, or without a transient, the transient is the sections'
+        largest ``after``.
 
     Raises
     ------
     SweepError
-        Invalid axes, mode, link or reductions.
+        Invalid axes, mode, link, reductions, sections or Lyapunov settings.
     CaseError
         The case of some point is invalid (the message names the point).
     """
@@ -161,6 +187,8 @@ class Sweep:
     keep: Sequence[str] = ("separated",)
     link: Mapping[str, str] = field(default_factory=dict)
     source: str | None = None
+    sections: Sequence[Section | Mapping[str, Any]] = ()
+    lyapunov: LyapunovSettings | Mapping[str, Any] | None = None
     reductions: tuple[Reduction, ...] = field(init=False, repr=False, compare=False)
     cases: tuple[Case, ...] = field(init=False, repr=False, compare=False)
 
@@ -211,19 +239,39 @@ class Sweep:
                 )
         set_(self, "link", link)
 
-        if isinstance(self.keep, str) or not self.keep:
+        if isinstance(self.sections, str | Mapping) or not isinstance(self.sections, Sequence):
+            raise SweepError(
+                f"reduce.section = {self.sections!r} is invalid: must be an array of tables, "
+                "[[reduce.section]]"
+            )
+        set_(self, "sections", tuple(Section.from_table(table, f"reduce.section[{i}]")
+                                     for i, table in enumerate(self.sections)))
+        if isinstance(self.keep, str) or not isinstance(self.keep, Sequence) or (
+                not self.keep and not self.sections):
             raise SweepError(
                 f"reduce.keep = {self.keep!r} is invalid: must be a non-empty list of reductions"
+                " (it may be empty when there are [[reduce.section]] tables)"
             )
         set_(self, "keep", tuple(self.keep))
-        set_(self, "reductions", resolve(self.keep))
+        set_(self, "lyapunov", self._lyapunov_settings())
+        set_(self, "reductions", resolve(self.keep, self.lyapunov))
+        self._check_names()
         check_memory(
             _POINT_BYTES * self.n_points,
             f"a sweep of {self.n_points} points ({' x '.join(map(str, self.shape))})",
             "use fewer values per axis, or split the sweep",
         )
+        if self.sections:
+            # Padded values of every point, as open_sweep loads them.
+            check_memory(
+                8 * self.n_points * sum(s.max_points for s in self.sections),
+                f"the sections' values of {self.n_points} points "
+                f"(max_points = {', '.join(str(s.max_points) for s in self.sections)})",
+                "lower max_points, or use fewer points",
+            )
         set_(self, "cases", tuple(self._point_case(i) for i in range(self.n_points)))
         check_simulation(max(self.cases, key=simulation_bytes))
+        self._check_cases()
         # Keep the values as validated (e.g. 6 -> 6.0) so that equal sweeps have equal
         # definitions however their values were spelt.
         strides = strides_of(self.shape) if self.mode == "grid" else (1,) * len(axes)
@@ -249,6 +297,82 @@ class Sweep:
                         f"reduce.keep: 'max_growth_rate' needs a constant disc speed, but point "
                         f"{i} ({self._describe(i)}) has speed.profile = '{case.speed.profile}'"
                     )
+
+    def _lyapunov_settings(self) -> LyapunovSettings | None:
+        """The settings of ``largest_lyapunov``, validated, defaults from the sections."""
+        raw = self.lyapunov
+        kept = "largest_lyapunov" in self.keep
+        if raw is not None and not kept:
+            raise SweepError(
+                "reduce.largest_lyapunov sets the reduction 'largest_lyapunov', which "
+                "reduce.keep does not list: add it to keep, or remove the table"
+            )
+        if not kept:
+            return None
+        if raw is None:
+            raw = {}
+        elif isinstance(raw, LyapunovSettings):
+            raw = asdict(raw)
+        elif not isinstance(raw, Mapping):
+            raise SweepError(f"reduce.largest_lyapunov = {raw!r} is invalid: must be a table "
+                             f"with {', '.join(_LYAPUNOV_KEYS)}")
+        where = "reduce.largest_lyapunov"
+        valid = [f"{where}.{k}" for k in _LYAPUNOV_KEYS]
+        for key in raw:
+            if key not in _LYAPUNOV_KEYS:
+                raise SweepError(f"unknown key '{where}.{key}'{nearest(f'{where}.{key}', valid)}")
+        values: dict[str, float | None] = {}
+        for key, rule, ok in (("transient", ">= 0", lambda v: v >= 0),
+                              ("duration", "> 0", lambda v: v > 0),
+                              ("interval", "> 0", lambda v: v > 0)):
+            value = raw.get(key)
+            if value is None:
+                continue
+            if (isinstance(value, bool) or not isinstance(value, int | float)
+                    or not math.isfinite(value) or not ok(value)):
+                raise SweepError(f"{where}.{key} = {value!r} is invalid: must be a number "
+                                 f"{rule} [s]")
+            values[key] = float(value)
+        if "transient" not in values and self.sections:
+            values["transient"] = max(s.after for s in self.sections)
+        return LyapunovSettings(**values)
+
+    def _check_names(self) -> None:
+        """No two stored variables share a name."""
+        seen = {r.name: f"reduction '{r.spec}'" for r in self.reductions}
+        seen |= {name: "the sweep's own variable" for name in _RESERVED}
+        for section in self.sections:
+            for name in (section.name, section.count_name):
+                if name in seen:
+                    raise SweepError(
+                        f"{section.where} would be stored as '{name}', as {seen[name]} is: "
+                        f"give it another name ({section.where}.name)"
+                    )
+                seen[name] = section.where
+
+    def _check_cases(self) -> None:
+        """Sections and Lyapunov settings that every point's case allows."""
+        for i, case in enumerate(self.cases):
+            for section in self.sections:
+                problem = section.problem(case)
+                if problem is not None:
+                    raise SweepError(f"point {i} ({self._describe(i)}): {problem}")
+            if self.lyapunov is None:
+                continue
+            transient, duration = self.lyapunov.window(case)
+            where = "reduce.largest_lyapunov"
+            if duration <= 0:
+                raise SweepError(
+                    f"point {i} ({self._describe(i)}): {where}.transient = {transient:g} is "
+                    f"invalid: must be < simulation.duration = {case.simulation.duration:g} s "
+                    f"(or set {where}.duration)"
+                )
+            if self.lyapunov.interval > duration:
+                raise SweepError(
+                    f"point {i} ({self._describe(i)}): {where}.interval = "
+                    f"{self.lyapunov.interval:g} is invalid: must be <= the measurement's "
+                    f"duration, {duration:g} s"
+                )
 
     # --- points --------------------------------------------------------------------------
 
@@ -292,8 +416,9 @@ class Sweep:
 
     @property
     def stop_on(self) -> tuple[str, ...]:
-        """Event kinds that end a run early because every kept value is then decided."""
-        return stop_events(self.reductions)
+        """Event kinds that end a run early because every kept value is then decided
+        (none with sections, which need the whole run)."""
+        return () if self.sections else stop_events(self.reductions)
 
     @property
     def definition(self) -> str:
@@ -306,6 +431,11 @@ class Sweep:
             "link": [[t, o] for t, o in self.link.items()],
             "keep": list(self.keep),
         }
+        # Only when present: the sweeps that have neither keep the hash they had before.
+        if self.sections:
+            data["sections"] = [s.to_dict() for s in self.sections]
+        if self.lyapunov is not None:
+            data["largest_lyapunov"] = asdict(self.lyapunov)
         return json.dumps(data, sort_keys=True, separators=(",", ":"), allow_nan=False)
 
     @property
@@ -369,14 +499,21 @@ def _file_fields(data: dict[str, Any], root: Path) -> dict[str, Any]:
         if key not in _REDUCE_KEYS:
             raise SweepError(f"unknown key 'reduce.{key}'"
                              f"{nearest(f'reduce.{key}', [f'reduce.{k}' for k in _REDUCE_KEYS])}")
-    if "keep" not in reduce:
-        raise SweepError("reduce.keep is missing: list the reductions to store")
+    sections = reduce.get("section", [])
+    if isinstance(sections, dict):
+        raise SweepError("reduce.section is a single table: write it as an array of tables, "
+                         "[[reduce.section]] (one per section)")
+    if "keep" not in reduce and not sections:
+        raise SweepError("reduce.keep is missing: list the reductions to store (or add "
+                         "[[reduce.section]] tables)")
     return {
         "base": base,
         "mode": data.get("mode", "grid"),
         "axes": data.get("axes", {}),
         "link": data.get("link", {}),
-        "keep": reduce["keep"],
+        "keep": reduce.get("keep", []),
+        "sections": sections,
+        "lyapunov": reduce.get("largest_lyapunov"),
     }
 
 

@@ -10,6 +10,10 @@ Layout (one Zarr v3 group, written through xarray, with consolidated metadata so
                                                (JSON text if the values are not numbers,
                                                booleans or text); along point for a zip sweep
     data vars   <reduction name>               one per kept reduction (bool or float64)
+                <section name>                 one per section: (<dims>..., <name>_index)
+                                               float64, one point's values NaN padded to
+                                               the section's max_points
+                <section name>_count           how many of them are valid (int32)
                 error                          "" or why the point failed
                 checksum                       hash of the sweep, the point's index, values
                                                and error (0: nothing written)
@@ -17,14 +21,17 @@ Layout (one Zarr v3 group, written through xarray, with consolidated metadata so
     attrs       CF global attributes (Conventions, title, source, history, references),
                 fivdisc_kind = "sweep", sweep_definition, sweep_hash (canonical JSON of the
                 sweep and its SHA-256), sweep_mode, sweep_axes, sweep_shape,
-                sweep_variables, fivdisc_version, store_format
+                sweep_variables (the checksummed ones, in order), sweep_sections (JSON:
+                every section's settings), fivdisc_version, store_format (format 3 is
+                this layout without sections and sweep_sections; it is read as such)
 
 Points are numbered in C order over the axes (the first axis varies slowest). Every data
-variable has chunks of one point, so writing a point touches only its own chunk files
-(each replaced atomically by Zarr's local store). Values, ``error`` and ``checksum`` are
-written before ``done``. A point is complete only if its ``done`` chunk says so and its
-values read back to its checksum: Zarr reads a lost chunk file as the fill value, so
-without the checksum a deleted chunk would pass for data.
+variable has chunks of one point (a section's: all values of one point), so writing a
+point touches only its own chunk files (each replaced atomically by Zarr's local
+store). Values, ``error`` and ``checksum`` are written before ``done``. A point is
+complete only if its ``done`` chunk says so and its values read back to its checksum:
+Zarr reads a lost chunk file as the fill value, so without the checksum a deleted chunk
+would pass for data.
 
 One coordinator writes a store at a time: :func:`store_lock` holds a lock file next
 to the store (``STORE.lock``, through ``filelock``) and records its holder in
@@ -74,7 +81,9 @@ __all__ = [
 
 DIM = "point"
 #: Version of the layout above; stores of another version are refused.
-STORE_FORMAT = 3
+STORE_FORMAT = 4
+# Format 3 is format 4 without sections (and without the sweep_sections attribute).
+_READABLE_FORMATS = (3, STORE_FORMAT)
 _STRING = np.dtypes.StringDType()
 _BRIEF_CHARS = 160
 
@@ -88,13 +97,14 @@ class PointOutcome:
     index
         The point's index.
     values
-        Stored name -> value of every kept reduction; None if the point failed.
+        Stored name -> value of every kept reduction, and per section its values
+        (``(max_points,)``, NaN padded) and their count; None if the point failed.
     error
         "" for success, else why the point failed.
     """
 
     index: int
-    values: dict[str, bool | float] | None
+    values: dict[str, Any] | None
     error: str = ""
 
 
@@ -130,6 +140,23 @@ def dims_of(sweep: Sweep) -> tuple[str, ...]:
     return tuple(sweep.axes) if sweep.mode == "grid" else (DIM,)
 
 
+def checksummed(sweep: Sweep) -> list[str]:
+    """The variables a point's checksum covers, in order: the reductions, each section's
+    values and count, then ``error``."""
+    names = [r.name for r in sweep.reductions]
+    for section in sweep.sections:
+        names += [section.name, section.count_name]
+    return [*names, "error"]
+
+
+def _variable_dims(sweep: Sweep) -> dict[str, tuple[str, ...]]:
+    """Dimensions of every data variable (the sweep's, and a section's own last)."""
+    dims = dims_of(sweep)
+    names = {name: dims for name in [*checksummed(sweep), "checksum", "done"]}
+    names |= {s.name: (*dims, s.dim) for s in sweep.sections}
+    return names
+
+
 def _coordinate(values: Sequence[Any]) -> np.ndarray:
     """Axis values as an array: numbers, booleans or text as such, anything else as JSON."""
     if all(isinstance(v, bool) for v in values):
@@ -157,6 +184,14 @@ def _template(sweep: Sweep) -> xr.Dataset:
         )
         for r in sweep.reductions
     }
+    for s in sweep.sections:
+        data[s.name] = (
+            (*dims, s.dim),
+            da.full((*shape, s.max_points), np.nan, chunks=(*chunks, s.max_points)),
+            s.attrs(),
+        )
+        data[s.count_name] = (dims, da.zeros(shape, dtype=np.int32, chunks=chunks),
+                              s.count_attrs())
     data["error"] = (
         dims,
         da.from_array(np.full(shape, "", dtype=_STRING), chunks=chunks),
@@ -191,7 +226,8 @@ def _template(sweep: Sweep) -> xr.Dataset:
         "sweep_mode": sweep.mode,
         "sweep_axes": json.dumps(list(sweep.axes)),
         "sweep_shape": json.dumps(list(shape)),
-        "sweep_variables": json.dumps([*(r.name for r in sweep.reductions), "error"]),
+        "sweep_variables": json.dumps(checksummed(sweep)),
+        "sweep_sections": json.dumps([s.to_dict() for s in sweep.sections]),
         "fivdisc_version": version("fivdisc"),
         "store_format": STORE_FORMAT,
     }
@@ -217,7 +253,9 @@ def _checksum(digest: str, index: int, row: Sequence[Any]) -> int:
     """
     h = hashlib.blake2b(f"{digest}:{index}".encode(), digest_size=8)
     for value in row:
-        if isinstance(value, bool | np.bool_):
+        if isinstance(value, np.ndarray):  # a section's values: one NaN for every NaN
+            token = np.where(np.isnan(value), np.nan, value).astype("<f8").tobytes()
+        elif isinstance(value, bool | np.bool_):
             token = b"T" if value else b"F"
         elif isinstance(value, float | np.floating):
             token = b"nan" if math.isnan(value) else struct.pack("<d", float(value))
@@ -243,7 +281,7 @@ def _read_attrs(path: Path) -> dict[str, Any]:
         ) from None
     if "sweep_hash" not in attrs:
         raise SweepError(f"{path} exists and is not a fivdisc sweep store")
-    if attrs.get("store_format") != STORE_FORMAT:
+    if attrs.get("store_format") not in _READABLE_FORMATS:
         raise SweepError(
             f"{path} was written by another version of fivdisc (store format "
             f"{attrs.get('store_format', 1)}, this version writes {STORE_FORMAT}); write to "
@@ -258,25 +296,28 @@ def _differences(stored: str, current: str) -> list[str]:
     return [key for key in sorted(set(old) | set(new)) if old.get(key) != new.get(key)]
 
 
-def _readable(array: Any) -> tuple[np.ndarray, np.ndarray]:
-    """(values, readable) of a Zarr array of one-point chunks, chunk by chunk if need be,
-    both flattened in C order (the order of the sweep's points).
+def _readable(array: Any, grid: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
+    """(values, readable) of a Zarr array of one-point chunks over the sweep's `grid`,
+    chunk by chunk if need be, one row per point in C order (the order of the sweep's
+    points): values ``(n_points,)``, or ``(n_points, max_points)`` for a section's.
 
     A chunk cut short or damaged by a crash raises on decoding; Zarr's error types
     vary with the codec, hence the broad except. Unreadable points get the fill value.
     """
+    n = math.prod(grid)
+    rows = (n, *array.shape[len(grid):])
     try:
-        return np.ravel(array[...]), np.ones(array.size, dtype=bool)
+        return np.reshape(array[...], rows), np.ones(n, dtype=bool)
     except Exception:
         values = np.full(array.shape, array.fill_value, dtype=array.dtype)
-        ok = np.zeros(array.shape, dtype=bool)
-        for index in np.ndindex(array.shape):
+        ok = np.zeros(tuple(grid), dtype=bool)
+        for index in np.ndindex(*grid):
             try:
                 values[index] = array[index]
                 ok[index] = True
             except Exception:
                 continue
-        return values.ravel(), ok.ravel()
+        return values.reshape(rows), ok.ravel()
 
 
 def _arrays(path: Path, shapes: dict[str, tuple[int, ...]]) -> tuple[dict[str, Any], list[str]]:
@@ -332,11 +373,13 @@ class StoreHealth:
 
 
 def _layout(attrs: dict[str, Any]) -> tuple[list[str], dict[str, tuple[int, ...]]]:
-    """(checksummed variables: reductions then "error"; every variable -> its shape)."""
+    """(checksummed variables: see :func:`checksummed`; every variable -> its shape)."""
     variables = json.loads(attrs["sweep_variables"])
     keys = json.loads(attrs["sweep_axes"])
     shape = tuple(json.loads(attrs["sweep_shape"]))
     shapes = {name: shape for name in [*variables, "checksum", "done"]}
+    for section in json.loads(attrs.get("sweep_sections", "[]")):
+        shapes[section["name"]] = (*shape, section["max_points"])
     if attrs["sweep_mode"] == "grid":
         shapes |= {key: (length,) for key, length in zip(keys, shape, strict=True)}
     else:
@@ -350,9 +393,10 @@ def _inspect(path: Path, attrs: dict[str, Any]) -> tuple[np.ndarray, np.ndarray,
     The masks are flat, one entry per point."""
     variables, shapes = _layout(attrs)
     arrays, broken = _arrays(path, shapes)
-    n = math.prod(shapes["done"])
+    grid = shapes["done"]
+    n = math.prod(grid)
     if "done" in arrays:
-        done, done_readable = _readable(arrays["done"])
+        done, done_readable = _readable(arrays["done"], grid)
         done = np.asarray(done, dtype=bool)
     else:
         done, done_readable = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
@@ -360,7 +404,7 @@ def _inspect(path: Path, attrs: dict[str, Any]) -> tuple[np.ndarray, np.ndarray,
     columns = {}
     for name in [*variables, "checksum"]:
         if name in arrays:
-            columns[name], ok = _readable(arrays[name])
+            columns[name], ok = _readable(arrays[name], grid)
             readable &= ok
         else:
             readable[:] = False
@@ -550,7 +594,7 @@ class SweepStore:
 
     def errors(self, points: np.ndarray) -> dict[int, str]:
         """Point index -> error message of the failed ones among `points`."""
-        errors, _ = _readable(_open_group(self.path)["error"])
+        errors, _ = _readable(_open_group(self.path)["error"], self.sweep.shape)
         return {int(i): str(errors[i]) for i in np.flatnonzero(points) if errors[i]}
 
     def write(self, outcomes: Sequence[PointOutcome]) -> None:
@@ -569,13 +613,20 @@ class SweepStore:
                 runs[-1].append(outcome)
             else:
                 runs.append([outcome])
-        names = (*(r.name for r in self.sweep.reductions), "error")
+        names = checksummed(self.sweep)
         for run in runs:
             data = {
                 r.name: np.array([r.fill if o.values is None else o.values[r.name] for o in run],
                                  dtype=r.dtype)
                 for r in self.sweep.reductions
             }
+            for s in self.sweep.sections:
+                data[s.name] = np.array(
+                    [s.empty() if o.values is None else o.values[s.name] for o in run],
+                    dtype=np.float64).reshape(len(run), s.max_points)
+                data[s.count_name] = np.array(
+                    [0 if o.values is None else o.values[s.count_name] for o in run],
+                    dtype=np.int32)
             data["error"] = np.array([o.error for o in run], dtype=_STRING)
             data["checksum"] = np.array(
                 [_checksum(self.sweep.digest, o.index, [data[name][j] for name in names])
@@ -594,13 +645,19 @@ class SweepStore:
                                                                     strict=True)}
         region[dims[-1]] = slice(int(first[-1]), int(first[-1]) + len(run))
         block = (1,) * (len(dims) - 1) + (len(run),)
-        data = xr.Dataset({name: (dims, values.reshape(block)) for name, values in
-                           columns.items()})
+        # A section's own dimension is written whole (region names only the sweep's).
+        own = _variable_dims(self.sweep)
+        data = xr.Dataset({name: (own[name], values.reshape(block + values.shape[1:]))
+                           for name, values in columns.items()})
         data.to_zarr(self.path, region=region, mode="r+", consolidated=False)
 
 
-def _encoding(names: Sequence[str], ndim: int) -> dict[str, dict[str, Any]]:
-    return {name: {"chunks": (1,) * ndim} for name in names}
+def _encoding(sweep: Sweep, names: Sequence[str]) -> dict[str, dict[str, Any]]:
+    """Chunks of one point: one value, or a section's values of one point."""
+    ndim = len(sweep.shape)
+    lengths = {s.name: s.max_points for s in sweep.sections}
+    return {name: {"chunks": (1,) * ndim + ((lengths[name],) if name in lengths else ())}
+            for name in names}
 
 
 def _create(path: Path, sweep: Sweep) -> None:
@@ -610,7 +667,7 @@ def _create(path: Path, sweep: Sweep) -> None:
     try:
         template.to_zarr(
             tmp, mode="w-", compute=False, consolidated=False, zarr_format=3,
-            encoding=_encoding(list(template.data_vars), len(sweep.shape)),
+            encoding=_encoding(sweep, list(template.data_vars)),
         )
         _consolidate(tmp)
         tmp.rename(path)
@@ -637,7 +694,7 @@ def _repair(path: Path, sweep: Sweep, broken: Sequence[str], attrs: dict[str, An
     # arrays, whose values compute=False writes too.
     rebuilt.to_zarr(
         path, mode="a", compute=False, consolidated=False, zarr_format=3,
-        encoding=_encoding([n for n in broken if n in template.data_vars], len(sweep.shape)),
+        encoding=_encoding(sweep, [n for n in broken if n in template.data_vars]),
     )
     _consolidate(path)
 
@@ -673,7 +730,8 @@ def open_sweep(path: str | PathLike[str]) -> xr.Dataset:
         try:
             data[name].load()
         except Exception:  # damaged chunks: the codec's error type varies
-            values, _ = _readable(_arrays(path, {name: shapes[name]})[0][name])
+            values, _ = _readable(_arrays(path, {name: shapes[name]})[0][name],
+                                  shapes["done"])
             data[name] = data[name].copy(data=values.reshape(shapes[name]))
     try:
         data = data.load()
