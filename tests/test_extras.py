@@ -54,6 +54,8 @@ COMMANDS = [
     ("distributed", ["sweep", "--verify", "{tmp}/s.zarr"]),
     ("distributed", ["separation-map", "-o", "{tmp}/m.zarr"]),
     ("distributed", ["reproduce", "--all", "-o", "{tmp}"]),
+    ("plot", ["bifurcation", "bifurcation-speed", "-o", "{tmp}/d.png"]),
+    ("distributed", ["bifurcation", "bifurcation-speed", "-o", "{tmp}/d.png"]),
 ]
 
 

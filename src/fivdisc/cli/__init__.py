@@ -53,6 +53,7 @@ def _register() -> None:
     cli.add_command(dynamics.lyapunov)
     cli.add_command(sweep.sweep)
     cli.add_command(sweep.separation_map)
+    cli.add_command(sweep.bifurcation)
     cli.add_command(reproduce.reproduce)
     cli.add_command(examples.examples)
 

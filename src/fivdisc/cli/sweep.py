@@ -1,4 +1,5 @@
-"""``fivdisc sweep SWEEP.toml -o STORE.zarr`` and ``fivdisc separation-map``."""
+"""``fivdisc sweep SWEEP.toml -o STORE.zarr``, ``fivdisc separation-map`` and
+``fivdisc bifurcation``."""
 
 from __future__ import annotations
 
@@ -260,4 +261,66 @@ def separation_map(
                           inputs=[base])
     report = _run(spec, store, scheduler, workers, progress)
     plot_separation_map(report.store, figure)
+    click.echo(f"wrote {figure}")
+
+
+@click.command()
+@click.argument("sweep_file", type=CASE)
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Image of the diagram (format from the suffix) [default: SWEEP_FILE with .png; "
+    "for an example, NAME.png in the working directory].",
+)
+@click.option(
+    "--store",
+    type=click.Path(path_type=Path),
+    help="Zarr store of the sweep [default: the one `fivdisc sweep SWEEP_FILE` writes, "
+    "SWEEP_FILE with .zarr]. Points it lacks are computed first; a complete store is "
+    "only drawn.",
+)
+@click.option(
+    "--section",
+    metavar="NAME",
+    help="The section to draw, by its stored name [default: the sweep file's first "
+    "[[reduce.section]]].",
+)
+@_scheduler_option
+@_workers_option
+@_progress_option
+def bifurcation(
+    sweep_file: Path,
+    output: Path | None,
+    store: Path | None,
+    section: str | None,
+    scheduler: str | None,
+    workers: int | None,
+    progress: bool,
+) -> None:
+    """Draw the bifurcation diagram of a sweep over one key.
+
+    SWEEP_FILE is a sweep file (or the name of a packaged example, e.g.
+    ``fivdisc bifurcation bifurcation-speed -o diagram.png``) with one axis and at least
+    one ``[[reduce.section]]``: the section's values at every point are drawn as dots
+    over the swept key. If the sweep keeps ``largest_lyapunov``, a second panel below
+    shows the exponent. The sweep is run (or resumed) into its store first, as
+    ``fivdisc sweep`` does, so an interrupted run continues when the command is rerun.
+    """
+    from fivdisc.extras import require
+
+    require("distributed", "fivdisc bifurcation")
+    require("plot", "fivdisc bifurcation")
+    from fivdisc.files import ZARR, check_output, figure_suffixes
+    from fivdisc.sweep import load_sweep, plot_bifurcation
+    from fivdisc.sweep.bifurcation import check_diagram
+
+    spec = load_sweep(sweep_file)
+    check_diagram(spec, section)
+    store = check_output(store or default_output(sweep_file, ".zarr"), "--store", ZARR,
+                         inputs=[sweep_file], kind="directory")
+    figure = check_output(output or default_output(sweep_file, ".png"), "-o",
+                          figure_suffixes(), inputs=[sweep_file])
+    report = _run(spec, store, scheduler, workers, progress)
+    plot_bifurcation(report.store, figure, section=section, name=sweep_file.stem)
     click.echo(f"wrote {figure}")
