@@ -6,6 +6,7 @@ wheel installed into a fresh virtual environment, away from the source tree.
 
 from __future__ import annotations
 
+import tomllib
 from pathlib import Path
 
 import pytest
@@ -25,11 +26,12 @@ def _run(*argv: str):
 def test_every_example_loads_and_has_a_one_line_description():
     listing = examples.available()
     assert set(listing) == {p.stem for p in examples.DIRECTORY.glob("*.toml")}
-    assert {"default", "fig10", "fig27_base", "sweep_fig27"} <= set(listing)
+    assert {"default", "fig10", "fig27_base", "sweep_fig27", "bifurcation-speed"} <= set(listing)
     for name, description in listing.items():
         assert description.endswith(".") and "\n" not in description, name
         assert len(description) <= 120, (name, description)
-        if name.startswith("sweep_"):
+        # A sweep file has axes, which no case file has.
+        if "axes" in tomllib.loads(examples.path(name).read_text(encoding="utf-8")):
             load_sweep(examples.path(name))
         else:
             load_case(examples.path(name))
@@ -47,7 +49,8 @@ def test_resolve_prefers_an_existing_file(tmp_path, monkeypatch):
     ("text", "message"),
     [
         ("fig1", r"^'fig1' is neither a file nor a packaged example: nearest: fig10, fig11"),
-        ("zzz", r"must be one of damped-disc, default, fig03a, .*sweep_fig27, two-pads "
+        ("zzz", r"must be one of bifurcation-speed, damped-disc, default, fig03a, "
+                r".*sweep_fig27, two-pads "
                 r"\(`fivdisc examples`"),
         ("nowhere/fig10.toml", r"^file not found: nowhere/fig10.toml$"),
     ],

@@ -3,8 +3,10 @@
 The TOML files beside this module are package data: ``default.toml`` (the paper's Table 1
 with every key written out), ``figNN.toml`` (the paper's figures, written by
 :func:`fivdisc.paper.cases.write_examples`), ``fig27_base.toml`` and ``sweep_fig27.toml``
-(the separation map of Fig. 27). Every command that takes a case accepts an example's
-bare name (``fivdisc simulate fig10``) where no file of that name exists:
+(the separation map of Fig. 27), ``bifurcation-speed.toml`` (a bifurcation diagram over
+the disc speed; a sweep file, as every example with an ``[axes]`` table is). Every command
+that takes a case accepts an example's bare name (``fivdisc simulate fig10``) where no
+file of that name exists:
 
 >>> from fivdisc import examples, load_case
 >>> examples.resolve("fig10").name
