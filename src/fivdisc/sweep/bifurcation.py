@@ -25,7 +25,7 @@ if TYPE_CHECKING:
 
     from fivdisc.sweep.spec import Sweep
 
-__all__ = ["diagram_section", "plot_bifurcation"]
+__all__ = ["check_diagram", "diagram_section", "plot_bifurcation"]
 
 _DPI = 150
 _DOT = 1.5  # marker size of the section values [pt]

@@ -126,12 +126,13 @@ class Section:
     name
         Name of the stored variable (default ``VARIABLE_AT``, with ``_J`` for a slider or
         index J other than 0); its count is stored as ``NAME_count``.
+    where
+        How error messages name the section, e.g. ``"reduce.section[0]"``.
 
     Raises
     ------
     SweepError
-        A value that is not allowed; the message names it (as ``reduce.section[i].KEY``
-        when `where` is that prefix).
+        A value that is not allowed; the message names it as ``WHERE.KEY``.
     """
 
     variable: str
