@@ -31,7 +31,7 @@ from fivdisc.integration import Integration, tangent_step
 from fivdisc.model import build_model
 from fivdisc.simulate import initial_state
 
-SPAN = 2.0  # [s] of simulated time per timed run (item 1)
+SPAN = 10.0  # [s] of simulated time per timed run (item 1)
 MEASURE = 10.0  # [s] of simulated time for the exponent (item 2)
 
 

@@ -557,3 +557,147 @@ def complex_step_jacobian(t, y, ph, sg, mdl):
         for j in range(ns):
             jac[j, i] = dy[j].imag / step
     return jac
+
+
+@njit(cache=True)
+def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
+    """``out = J(t, y) v`` for a single slider: the tangent-linear form of ``evaluate``
+    (forward-mode derivative, operation by operation), using the values ``evaluate``
+    left in ``wk`` at the same ``(t, y)``, phases and ``right``.
+
+    Every intermediate x of ``evaluate`` has its derivative dx along v. The mode shapes
+    move with the slider's angle: dg = g' dpsi and dg' = -l^2 g dpsi. The friction law's
+    slope is -alpha (mu - mu_1) for the exponential law, else the complex step of the law
+    alone. The dynamic state only (no energy
+    accumulators); several sliders use the complex step of ``evaluate`` instead.
+    """
+    disc = mdl.disc
+    sl = mdl.slider
+    opts = mdl.opts
+    n, ns, half = sizes(mdl)
+    r_gp, r_fq, _, aux, _ = work_rows(ns)
+    om, omd = speed_at(t, mdl.speed, right)
+    eps = opts[O_OMDOT]
+    damped = opts[O_DAMPED] != 0.0
+    om2 = om * om
+    phj = ph[0]
+    sj = sg[0]
+    # Disc forces are linear in the state.
+    for i in range(n):
+        p = int(disc[D_PARTNER, i])
+        dfi = -(disc[D_KD, i] - disc[D_ML2, i] * om2) * v[i]
+        if p >= 0:
+            dfi -= disc[D_GYR, i] * (2.0 * om * v[half + p] + eps * omd * v[p] * disc[D_OMD_FIX, i])
+        if damped:
+            dfi -= disc[D_CDAMP, i] * v[half + i]
+            if p >= 0:
+                dfi -= disc[D_CDAMP_OM, i] * om * v[p]
+        out[half + i] = dfi  # the force's derivative, turned into the acceleration's below
+        out[i] = v[half + i]
+    phi = y[n]
+    dpsi = v[n]
+    phid = wk[aux + A_PHID, 0]
+    dphid = 0.0 if phj == STICK else v[half + n]
+    out[n] = dphid
+    if phj == SEPARATION:
+        out[half + n] = (-sl[S_CPHI, 0] * dphid - sl[S_KPHI, 0] * dpsi) / sl[S_INERTIA, 0]
+        out[n + 1] = v[half + n + 1]
+        out[half + n + 1] = (-sl[S_CZ, 0] * v[half + n + 1]
+                             - sl[S_KZ, 0] * v[n + 1]) / sl[S_MASS, 0]
+        for i in range(n):
+            out[half + i] *= disc[D_MINV, i]
+        return
+    out[n + 1] = 0.0
+    out[half + n + 1] = 0.0
+    gpq = wk[aux + A_GPQ, 0]
+    gpqd = wk[aux + A_GPQD, 0]
+    l2gq = wk[aux + A_L2GQ, 0]
+    dwc = 0.0
+    dwcd0 = 0.0
+    dgpq = 0.0
+    dgpqd = 0.0
+    dl2gq = 0.0
+    s_gf = 0.0
+    s_gg = 0.0
+    s_ggp = 0.0
+    ds_gf = 0.0
+    ds_ggp = 0.0
+    for i in range(n):
+        li = disc[D_L, i]
+        minv = disc[D_MINV, i]
+        gi = wk[0, i]
+        gpi = wk[r_gp, i]
+        fi = wk[r_fq, i]
+        l2 = li * li
+        dwc += gi * v[i]
+        dwcd0 += gi * v[half + i] + gpi * y[half + i] * dpsi
+        dgpq += gpi * v[i]
+        dgpqd += gpi * v[half + i] - l2 * gi * y[half + i] * dpsi
+        dl2gq += l2 * (gi * v[i] + gpi * y[i] * dpsi)
+        s_gf += gi * fi * minv
+        s_gg += gi * gi * minv
+        s_ggp += gi * gpi * minv
+        ds_gf += (gpi * dpsi * fi + gi * out[half + i]) * minv
+        ds_ggp += (gpi * gpi - l2 * gi * gi) * minv
+    dwc += gpq * dpsi
+    dgpq -= l2gq * dpsi
+    ds_gg = 2.0 * s_ggp * dpsi
+    ds_ggp *= dpsi
+    dwcd = dwcd0 + dphid * gpq + phid * dgpq
+    sm = sl[S_SMASS, 0]
+    m = sl[S_MASS, 0]
+    inertia = sl[S_INERTIA, 0]
+    r = sl[S_RADIUS, 0]
+    dknown = (sm * (2.0 * (dphid * gpqd + phid * dgpqd) - 2.0 * phid * dphid * l2gq
+                    - phid * phid * dl2gq)
+              + sl[S_SCZ, 0] * dwcd + sl[S_SKZ, 0] * dwc)
+    nf = wk[aux + A_N, 0]
+    if phj == SLIP:
+        smu = wk[aux + A_SMU, 0]
+        vrel = om - phid
+        if opts[O_LAW] == LAW_EXPONENTIAL:
+            # mu' = -alpha (mu - mu_1), from mu = s smu itself.
+            dsmu = opts[O_ALPHA] * (sj * smu - opts[O_MU1]) * r * dphid
+        else:
+            h = 1e-30
+            dsmu = sj * kinetic_friction(opts, mdl.table, r, sj,
+                                         complex(vrel, -h * dphid)).imag / h
+        fphi = -sl[S_CPHI, 0] * phid - sl[S_KPHI, 0] * phi
+        dfphi = -sl[S_CPHI, 0] * dphid - sl[S_KPHI, 0] * dpsi
+        hh = sl[S_HH, 0]
+        den = 1.0 + m * (s_gg - hh * smu * s_ggp) - sm * gpq * r * smu / inertia
+        dnum = dknown + sm * ds_gf + sm * (dgpq * fphi + gpq * dfphi) / inertia
+        dden = (m * (ds_gg - hh * (dsmu * s_ggp + smu * ds_ggp))
+                - sm * r * (dgpq * smu + gpq * dsmu) / inertia)
+        dnf = (dnum - nf * dden) / den
+        sn = sl[S_SIGMA, 0] * nf
+        dsn = sl[S_SIGMA, 0] * dnf
+        c = hh * smu
+        dc = hh * dsmu
+        for i in range(n):
+            gi = wk[0, i]
+            gpi = wk[r_gp, i]
+            dgi = gpi * dpsi
+            dgpi = -disc[D_L, i] * disc[D_L, i] * gi * dpsi
+            out[half + i] = (out[half + i] - dsn * (gi - c * gpi)
+                             - sn * (dgi - dc * gpi - c * dgpi)) * disc[D_MINV, i]
+        df = dsmu * nf + smu * dnf
+        out[half + n] = (dfphi + r * df) / inertia
+        return
+    f = wk[aux + A_F, 0]
+    df = sl[S_KPHI, 0] * dpsi / r
+    shh = sl[S_SHH, 0]
+    dnf = (dknown + sm * (ds_gf + shh * (df * s_ggp + f * ds_ggp)) + sm * dgpq * omd
+           - nf * m * ds_gg) / (1.0 + m * s_gg)
+    sn = sl[S_SIGMA, 0] * nf
+    dsn = sl[S_SIGMA, 0] * dnf
+    c = shh * f
+    dc = shh * df
+    for i in range(n):
+        gi = wk[0, i]
+        gpi = wk[r_gp, i]
+        dgi = gpi * dpsi
+        dgpi = -disc[D_L, i] * disc[D_L, i] * gi * dpsi
+        out[half + i] = (out[half + i] + dc * gpi + c * dgpi - dsn * gi - sn * dgi) * (
+            disc[D_MINV, i])
+    out[half + n] = 0.0

@@ -232,7 +232,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
     if tan is not None:
         tv, tk = tan
         tsc = tangent.scratch(mdl, y, tv.shape[0])
-        ypre, sgpre = tsc[11], tsc[12]
+        tcx, tvn, tvs, ypre, sgpre = tsc[0], tsc[3], tsc[4], tsc[9], tsc[10]
 
     t = fst[F_T]
     h = fst[F_H]
@@ -287,7 +287,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
                         ytmp[i] += a * k[j, i]
             evaluate(t + C[st] * hs, ytmp, ph, sg, False, mdl, wk, k[st])
             if tan is not None:
-                tangent.stage(st, t, hs, ytmp, ph, sg, mdl, tv, tk, tsc)
+                tangent.stage(st, t, hs, ytmp, ph, sg, mdl, wk, tv, tk, tvn, tvs, tcx)
         for i in range(ns):
             ynew[i] = ytmp[i]
         ist[I_RHS] += 6
@@ -429,7 +429,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
         for i in range(n_ev):
             ev_prev[i] = evn[i]
         if tan is not None:
-            tangent.accept(tv, tk, tsc)
+            tangent.accept(tv, tk, tvn)
         t = t_new
         h = hs * fac
         if land and t < t_final:

@@ -33,7 +33,7 @@ import numpy as np
 from numba import njit
 
 from fivdisc._kernels.dopri5 import A, C, dense_coefficients, dense_eval
-from fivdisc._kernels.dynamics import evaluate, event_values, new_work
+from fivdisc._kernels.dynamics import evaluate, event_values, linearised_one, new_work
 from fivdisc._kernels.layout import A_WC, A_WCD, SEPARATION, STICK, n_dynamic, sizes, work_rows
 from fivdisc._kernels.slots import N_EVI, N_FSTATE, N_ISTATE
 from fivdisc._kernels.switch import MODE_EVENT, _switch
@@ -52,15 +52,18 @@ def new_tangents(mdl, y, n_vectors):
 
 @njit(cache=True)
 def scratch(mdl, y, n_vectors):
-    """Work arrays of the tangent integration (complex ones for the complex step); slots
-    11 and 12 keep the state and slip signs before a switch."""
+    """Work arrays of the tangent integration: (the complex step's state, derivative and
+    work array), complex stages and event values, the tangents at a step's end, a stage's
+    tangent, dense-output coefficients, two vectors, a real work array, and the state and
+    slip signs before a switch (slots 9 and 10). The hot loops take their arrays one by
+    one: numba passes each array of a tuple argument on every call."""
     nd = n_dynamic(mdl)
     n_ev = 3 * sizes(mdl)[1]
     yc = np.empty(nd, np.complex128)
-    return (yc, np.empty(nd, np.complex128), new_work(mdl, yc), np.empty((7, nd), np.complex128),
-            np.empty(n_ev, np.complex128), np.empty((n_vectors, nd)), np.empty(nd),
-            np.empty((5, nd)), np.empty(nd), np.empty(nd), new_work(mdl, y), np.empty(nd),
-            np.empty(sizes(mdl)[1], np.int64))
+    cplx = (yc, np.empty(nd, np.complex128), new_work(mdl, yc))
+    return (cplx, np.empty((7, nd), np.complex128), np.empty(n_ev, np.complex128),
+            np.empty((n_vectors, nd)), np.empty(nd), np.empty((5, nd)), np.empty(nd),
+            np.empty(nd), new_work(mdl, y), np.empty(nd), np.empty(sizes(mdl)[1], np.int64))
 
 
 @njit(cache=True)
@@ -72,10 +75,15 @@ def _norm_inf(v):
 
 
 @njit(cache=True)
-def jvp(t, y, v, ph, sg, right, mdl, sc, out):
+def jvp(t, y, v, ph, sg, right, mdl, wk, cplx, out):
     """``out = J(t, y) v``: the derivative of the right-hand side of phases ``ph`` along
-    ``v`` (complex step, exact to rounding)."""
-    yc, dyc, wkc = sc[0], sc[1], sc[2]
+    ``v``, exact to rounding. ``wk`` must hold what ``evaluate`` left at ``(t, y)``: one
+    slider takes the tangent-linear right-hand side (about the cost of one evaluation),
+    several the complex step of ``evaluate`` (a complex evaluation)."""
+    if sizes(mdl)[1] == 1:
+        linearised_one(t, y, v, ph, sg, right, mdl, wk, out)
+        return
+    yc, dyc, wkc = cplx
     nd = out.shape[0]
     scale = _norm_inf(v)
     if scale == 0.0:
@@ -91,11 +99,11 @@ def jvp(t, y, v, ph, sg, right, mdl, sc, out):
 
 
 @njit(cache=True)
-def stage(st, t, hs, y, ph, sg, mdl, V, KV, sc):
+def stage(st, t, hs, y, ph, sg, mdl, wk, V, KV, vn, vs, cplx):
     """Stage ``st`` of every tangent vector at the stage's state ``y`` (time
-    ``t + C[st] hs``), in the order of operations of the state's stage; the last stage's
-    combination, the tangent at the step's end, is kept in the scratch."""
-    vn, vs = sc[5], sc[6]
+    ``t + C[st] hs``, ``wk`` as the state's stage left it), in the order of operations of
+    the state's stage; the last stage's combination, the tangent at the step's end, is
+    kept in ``vn``."""
     nd = V.shape[1]
     for r in range(V.shape[0]):
         for i in range(nd):
@@ -105,16 +113,16 @@ def stage(st, t, hs, y, ph, sg, mdl, V, KV, sc):
             if a != 0.0:
                 for i in range(nd):
                     vs[i] += a * KV[r, j, i]
-        jvp(t + C[st] * hs, y, vs, ph, sg, False, mdl, sc, KV[r, st])
+        jvp(t + C[st] * hs, y, vs, ph, sg, False, mdl, wk, cplx, KV[r, st])
         if st == 6:
             for i in range(nd):
                 vn[r, i] = vs[i]
 
 
 @njit(cache=True)
-def accept(V, KV, sc):
-    """The step is taken: tangents move to its end, the last stage is the next first."""
-    vn = sc[5]
+def accept(V, KV, vn):
+    """The step is taken: tangents move to its end ``vn``, the last stage is the next
+    first."""
     for r in range(V.shape[0]):
         for i in range(V.shape[1]):
             V[r, i] = vn[r, i]
@@ -124,7 +132,7 @@ def accept(V, KV, sc):
 @njit(cache=True)
 def interpolate(theta, hs, V, KV, sc):
     """Tangents at fraction ``theta`` of the step (the state's dense output formula)."""
-    vn, rc = sc[5], sc[7]
+    vn, rc = sc[3], sc[5]
     for r in range(V.shape[0]):
         dense_coefficients(V[r], vn[r], KV[r], hs, rc)
         dense_eval(rc, theta, V[r])
@@ -147,15 +155,18 @@ def prepare(t, y, ph, sg, mdl, V, KV):
     """Make tangents ``V`` given at a state between steps ready for ``run``: slaved rows
     zeroed, first stages evaluated."""
     sc = scratch(mdl, y, V.shape[0])
+    wk = sc[8]
+    evaluate(t, y, ph, sg, True, mdl, wk, np.empty_like(y))
     for r in range(V.shape[0]):
         slave(ph, mdl, V[r])
-        jvp(t, y, V[r], ph, sg, True, mdl, sc, KV[r, 0])
+        jvp(t, y, V[r], ph, sg, True, mdl, wk, sc[0], KV[r, 0])
 
 
 @njit(cache=True)
 def _event_rate(e, t, y, ph, sg, mdl, sc, v, dt):
     """Derivative of event function ``e`` along ``(v, dt)`` in (state, time)."""
-    yc, dyc, wkc, evc = sc[0], sc[1], sc[2], sc[4]
+    yc, dyc, wkc = sc[0]
+    evc = sc[2]
     nd = v.shape[0]
     scale = max(_norm_inf(v), abs(dt), 1.0)
     h = _STEP / scale
@@ -174,8 +185,9 @@ def saltation(mode, e, t, ypre, ph_pre, sg_pre, ev_start, y, ph, sg, fplus, mdl,
     ``mode`` ``MODE_EVENT``, else a switch at a fixed time (a kink). ``fplus`` is the
     new phases' right-hand side at ``y``. ``ev_start`` are the event values at the start
     of the step, as the switch had them."""
-    yc, dyc, wkc, kc, evc = sc[0], sc[1], sc[2], sc[3], sc[4]
-    fm, wkr, w = sc[8], sc[10], sc[9]
+    yc, dyc, wkc = sc[0]
+    kc, evc = sc[1], sc[2]
+    fm, w, wkr = sc[6], sc[7], sc[8]
     nd = V.shape[1]
     n_sl = ph.shape[0]
     ev_t = np.empty(8 * n_sl + 8)
@@ -209,7 +221,10 @@ def saltation(mode, e, t, ypre, ph_pre, sg_pre, ev_start, y, ph, sg, fplus, mdl,
         for i in range(nd):
             V[r, i] = yc[i].imag / h - fplus[i] * dtau
         slave(ph, mdl, V[r])
-        jvp(t, y, V[r], ph, sg, True, mdl, sc, KV[r, 0])
+    # The new phases' right-hand side at the new state, for the first stages.
+    evaluate(t, y, ph, sg, True, mdl, wkr, np.empty_like(y))
+    for r in range(V.shape[0]):
+        jvp(t, y, V[r], ph, sg, True, mdl, wkr, sc[0], KV[r, 0])
 
 
 @njit(cache=True)
@@ -221,7 +236,7 @@ def unslaved(t, y, ph, sg, mdl, V):
     nd = V.shape[1]
     out = V.copy()
     sc = scratch(mdl, y, 1)
-    yc, dyc, wkc = sc[0], sc[1], sc[2]
+    yc, dyc, wkc = sc[0]
     aux = work_rows(ns)[3]
     for r in range(V.shape[0]):
         scale = max(_norm_inf(V[r]), 1.0)
