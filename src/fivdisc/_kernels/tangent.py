@@ -4,8 +4,9 @@ Tangent vectors ``v`` (rows of ``V``, over the dynamic state without the energy
 accumulators) follow ``dv/dt = J(t, y) v`` inside each phase, integrated by the same
 Dormand-Prince stages as the state, so a step maps them by the exact derivative of the
 step the state takes; the step size is controlled by the state alone, and a run with
-tangents takes exactly the steps of a run without. ``J v`` is the complex-step derivative
-of the phase's right-hand side: exact to rounding, with no step to choose.
+tangents takes exactly the steps of a run without. ``J v`` is exact to rounding: for one
+slider the tangent-linear right-hand side (``dynamics.linearised_one``, which reuses what
+the state's evaluation computed), for several the complex step of the right-hand side.
 
 At a switch at time ``t_s`` where event function ``h`` of the old phase crosses zero,
 with the old field ``f-`` and, after the jump map ``x+ = G(x-, t)``, the new field

@@ -76,6 +76,7 @@ class LyapunovSpectrum:
                 "interval": self.interval}
 
     def to_json(self) -> str:
+        """:meth:`to_dict` as indented JSON (what ``fivdisc lyapunov --json`` prints)."""
         return json.dumps(self.to_dict(), indent=2)
 
     def to_dataset(self):

@@ -23,7 +23,7 @@ import numpy as np
 from fivdisc._kernels import layout as lay
 from fivdisc.case import Case
 from fivdisc.errors import FivdiscError
-from fivdisc.integration import Integration
+from fivdisc.integration import Integration, tangent_step
 from fivdisc.model import Model, build_model
 
 __all__ = ["PeriodicOrbit", "periodic_orbit"]
@@ -54,7 +54,8 @@ class PeriodicOrbit:
         Index in ``multipliers`` of the flow direction's multiplier (1).
     residual : float
         ``|phi_T(x0) - x0|`` at the last iterate, in the energy norm
-        (:func:`energy_scales`) relative to the orbit's size ``|f(x0)| T``.
+        (:func:`fivdisc.analysis.orbits.energy_scales`) relative to the orbit's size
+        ``|f(x0)| T``.
     iterations : int
         Newton iterations taken.
     verdict : str
@@ -104,6 +105,7 @@ class PeriodicOrbit:
         }
 
     def to_json(self) -> str:
+        """:meth:`to_dict` as indented JSON (what ``fivdisc orbit --json`` prints)."""
         return json.dumps(self.to_dict(), indent=2)
 
     def to_dataset(self):
@@ -144,7 +146,7 @@ class PeriodicOrbit:
     def __str__(self) -> str:
         lines = [f"periodic orbit: T = {self.period:.9g} s ({1 / self.period:.6g} Hz), "
                  f"{self.verdict}, residual {self.residual:.2e} after {self.iterations} "
-                 "Newton iterations",
+                 f"Newton iteration{'' if self.iterations == 1 else 's'}",
                  "Floquet multipliers (modulus, real, imag):"]
         for i, m in enumerate(self.multipliers):
             note = "  flow direction" if i == self.trivial else ""
@@ -182,9 +184,14 @@ class _Shot:
 
 def _shoot(model: Model, x0: np.ndarray, phases: np.ndarray, period: float, rtol: float,
            atol: float) -> _Shot:
-    """The flow map over ``period`` from ``x0`` with its Jacobian."""
+    """The flow map over ``period`` from ``x0`` with its Jacobian (steps capped at
+    :func:`~fivdisc.integration.tangent_step`, so that directions the orbit hardly
+    excites are integrated stably at any rtol)."""
+    cap = tangent_step(model)
+    if model.case.simulation.max_step > 0:
+        cap = min(cap, model.case.simulation.max_step)
     run = Integration(model, x0, duration=period, output_rate=1.0 / period, rtol=rtol,
-                      atol=atol, phases=phases)
+                      atol=atol, max_step=cap, phases=phases)
     run.set_tangents(np.eye(model.state_size))
     run.advance(0.0)
     rate_start = run.rhs()
@@ -270,8 +277,9 @@ def periodic_orbit(
         alone, so a tangent direction the orbit hardly excites (a disc mode at rest on
         the orbit) is integrated less accurately than the state: on the rigid-disc
         stick-slip oscillator the multipliers' moduli are off by 4e-6 at rtol 1e-10,
-        2e-7 at 1e-11 and 1e-9 at 1e-12. The default 1e-12 gives the 1e-6 needed to
-        place orbits within 1e-4 of the unit circle. ``atol`` defaults to
+        2e-7 at 1e-11 and 1e-9 at 1e-12. The default 1e-12 makes them right to better
+        than 1e-6, enough to tell whether a multiplier 1e-4 from the unit circle (as
+        on the paper's Fig. 13 orbit) lies inside or outside it. ``atol`` defaults to
         ``1e-7 rtol``.
     tol : float
         Convergence: scaled residual ``|phi_T(x0) - x0|`` below this.
