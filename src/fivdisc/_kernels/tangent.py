@@ -57,7 +57,9 @@ def scratch(mdl, y, n_vectors):
     work array), complex stages and event values, the tangents at a step's end, a stage's
     tangent, dense-output coefficients, two vectors, a real work array, and the state and
     slip signs before a switch (slots 9 and 10). The hot loops take their arrays one by
-    one: numba passes each array of a tuple argument on every call."""
+    one: numba passes each array of a tuple argument on every call, and the step's
+    tangent functions are inlined into the integrator, since each array crossing a call
+    costs reference-count updates."""
     nd = n_dynamic(mdl)
     n_ev = 3 * sizes(mdl)[1]
     yc = np.empty(nd, np.complex128)
@@ -75,7 +77,7 @@ def _norm_inf(v):
     return acc
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def jvp(t, y, v, ph, sg, right, mdl, wk, cplx, out):
     """``out = J(t, y) v``: the derivative of the right-hand side of phases ``ph`` along
     ``v``, exact to rounding. ``wk`` must hold what ``evaluate`` left at ``(t, y)``: one
@@ -99,7 +101,7 @@ def jvp(t, y, v, ph, sg, right, mdl, wk, cplx, out):
         out[i] = dyc[i].imag / h
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def stage(st, t, hs, y, ph, sg, mdl, wk, V, KV, vn, vs, cplx):
     """Stage ``st`` of every tangent vector at the stage's state ``y`` (time
     ``t + C[st] hs``, ``wk`` as the state's stage left it), in the order of operations of
@@ -120,7 +122,7 @@ def stage(st, t, hs, y, ph, sg, mdl, wk, V, KV, vn, vs, cplx):
                 vn[r, i] = vs[i]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def accept(V, KV, vn):
     """The step is taken: tangents move to its end ``vn``, the last stage is the next
     first."""

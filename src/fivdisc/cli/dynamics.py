@@ -18,6 +18,8 @@ _NC = click.Path(dir_okay=False, path_type=Path)
               "close return after the transient).")
 @click.option("--transient", type=float, help="Transient run before the search [s] "
               "(default: the case's simulation.duration).")
+@click.option("--window", type=float, default=1.0, show_default=True,
+              help="How long to follow the trajectory for its first return [s].")
 @click.option("--rtol", type=float, default=1e-12, show_default=True,
               help="Integration tolerance of the shooting runs (sets the multipliers' "
               "accuracy).")
@@ -26,8 +28,8 @@ _NC = click.Path(dir_okay=False, path_type=Path)
 @click.option("-o", "--output", type=_NC, help="Write the orbit to a netCDF file (.nc).")
 @click.option("--progress/--no-progress", default=True, show_default=True,
               help="Say so while the kernel with tangent vectors compiles (first use).")
-def orbit(case_file: Path, period: float | None, transient: float | None, rtol: float,
-          as_json: bool, output: Path | None, progress: bool) -> None:
+def orbit(case_file: Path, period: float | None, transient: float | None, window: float,
+          rtol: float, as_json: bool, output: Path | None, progress: bool) -> None:
     """Periodic orbit of CASE_FILE (constant speed) and its Floquet multipliers.
 
     Runs the case for its duration (or --transient), finds the first return of the
@@ -40,7 +42,7 @@ def orbit(case_file: Path, period: float | None, transient: float | None, rtol: 
 
     case = load_case(case_file)
     out = check_output(output, "-o", (".nc",), inputs=[case_file]) if output else None
-    res = periodic_orbit(case, period=period, transient=transient, rtol=rtol,
+    res = periodic_orbit(case, period=period, transient=transient, window=window, rtol=rtol,
                          progress=progress)
     click.echo(res.to_json() if as_json else str(res))
     if out is not None:
