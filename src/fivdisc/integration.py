@@ -197,7 +197,7 @@ class Integration:
                 "the dynamic state"
             )
         if self.tan is None or self.tan[0].shape != vectors.shape:
-            self.tan = tan.new_tangents(self.mdl, self.y, vectors.shape[0])
+            self.tan = (np.zeros(vectors.shape), np.zeros((vectors.shape[0], 7, nd)))
         v, kv = self.tan
         v[:] = vectors
         if self.ist[slots.I_STARTED]:

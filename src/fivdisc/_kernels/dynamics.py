@@ -670,34 +670,28 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
         dden = (m * (ds_gg - hh * (dsmu * s_ggp + smu * ds_ggp))
                 - sm * r * (dgpq * smu + gpq * dsmu) / inertia)
         dnf = (dnum - nf * dden) / den
+        # The disc's contact force is -sn g + a g' with a = sn h/(2r) s mu in slip.
         sn = sl[S_SIGMA, 0] * nf
         dsn = sl[S_SIGMA, 0] * dnf
-        c = hh * smu
-        dc = hh * dsmu
-        for i in range(n):
-            gi = wk[0, i]
-            gpi = wk[r_gp, i]
-            dgi = gpi * dpsi
-            dgpi = -disc[D_L, i] * disc[D_L, i] * gi * dpsi
-            out[half + i] = (out[half + i] - dsn * (gi - c * gpi)
-                             - sn * (dgi - dc * gpi - c * dgpi)) * disc[D_MINV, i]
-        df = dsmu * nf + smu * dnf
-        out[half + n] = (dfphi + r * df) / inertia
-        return
-    f = wk[aux + A_F, 0]
-    df = sl[S_KPHI, 0] * dpsi / r
-    shh = sl[S_SHH, 0]
-    dnf = (dknown + sm * (ds_gf + shh * (df * s_ggp + f * ds_ggp)) + sm * dgpq * omd
-           - nf * m * ds_gg) / (1.0 + m * s_gg)
-    sn = sl[S_SIGMA, 0] * nf
-    dsn = sl[S_SIGMA, 0] * dnf
-    c = shh * f
-    dc = shh * df
+        a = sn * hh * smu
+        da = hh * (dsn * smu + sn * dsmu)
+        out[half + n] = (dfphi + r * (dsmu * nf + smu * dnf)) / inertia
+    else:
+        # Stick: a = sigma h/(2r) f with the stick reaction f.
+        f = wk[aux + A_F, 0]
+        df = sl[S_KPHI, 0] * dpsi / r
+        shh = sl[S_SHH, 0]
+        dnf = (dknown + sm * (ds_gf + shh * (df * s_ggp + f * ds_ggp)) + sm * dgpq * omd
+               - nf * m * ds_gg) / (1.0 + m * s_gg)
+        sn = sl[S_SIGMA, 0] * nf
+        dsn = sl[S_SIGMA, 0] * dnf
+        a = shh * f
+        da = shh * df
+        out[half + n] = 0.0
     for i in range(n):
         gi = wk[0, i]
         gpi = wk[r_gp, i]
         dgi = gpi * dpsi
         dgpi = -disc[D_L, i] * disc[D_L, i] * gi * dpsi
-        out[half + i] = (out[half + i] + dc * gpi + c * dgpi - dsn * gi - sn * dgi) * (
+        out[half + i] = (out[half + i] + da * gpi + a * dgpi - dsn * gi - sn * dgi) * (
             disc[D_MINV, i])
-    out[half + n] = 0.0

@@ -205,8 +205,9 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
     full event buffer. All arrays are updated in place (``ph``/``sg``: every slider's
     phase and slip sign); returns the status.
 
-    ``tan``, if given, is ``(V, KV)`` of :func:`tangent.new_tangents`: tangent vectors
-    carried along (rows of ``V``) with their stage derivatives: given at the start, they
+    ``tan``, if given, is ``(V, KV)``, shapes ``(k, nd)`` and ``(k, 7, nd)`` for the
+    dynamic state's ``nd`` coordinates: tangent vectors carried along (rows of ``V``)
+    with their stage derivatives: given at the start, they
     are carried across it; given later, :func:`tangent.prepare` makes them ready. Without
     it no tangent code is compiled in.
     """

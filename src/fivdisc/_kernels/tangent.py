@@ -45,13 +45,6 @@ _STEP = 1e-30
 
 
 @njit(cache=True)
-def new_tangents(mdl, y, n_vectors):
-    """Tangent vectors ``V`` (zero) and their stage derivatives ``KV`` for ``run``."""
-    nd = n_dynamic(mdl)
-    return np.zeros((n_vectors, nd)), np.zeros((n_vectors, 7, nd))
-
-
-@njit(cache=True)
 def scratch(mdl, y, n_vectors):
     """Work arrays of the tangent integration: (the complex step's state, derivative and
     work array), complex stages and event values, the tangents at a step's end, a stage's

@@ -179,7 +179,7 @@ class _Shot:
     monodromy: np.ndarray
     rate_end: np.ndarray
     rate_start: np.ndarray
-    events: int
+    free: np.ndarray
 
 
 def _shoot(model: Model, x0: np.ndarray, phases: np.ndarray, period: float, rtol: float,
@@ -195,29 +195,24 @@ def _shoot(model: Model, x0: np.ndarray, phases: np.ndarray, period: float, rtol
     run.set_tangents(np.eye(model.state_size))
     run.advance(0.0)
     rate_start = run.rhs()
+    free = run.free()
     run.run_to(period)
     if run.status_name != "success":
         raise FivdiscError(f"periodic_orbit: the run over one period ended with "
                            f"{run.status_name} at t = {run.t:.9g} s")
     end = run.out_y[1, : model.state_size].copy()
-    return _Shot(end, run.tangents().T, run.rhs(), rate_start, run.events()[0].size)
+    return _Shot(end, run.tangents().T, run.rhs(), rate_start, free)
 
 
-def _transient(model: Model, y0: np.ndarray, duration: float, window: float, rtol: float,
-               atol: float):
-    """End state and phases after ``duration``, and samples of the following ``window``
-    (at about 200 per period of the fastest mode kept) to find the first return."""
+def _probe(model: Model, x0: np.ndarray, phases: np.ndarray | None, window: float,
+           rtol: float, atol: float) -> tuple[np.ndarray, float]:
+    """Samples of the trajectory from ``x0`` over ``window`` (about 200 per period of the
+    fastest mode kept; the output fills in the contact coordinates), and their spacing."""
     rate = max(200.0 * float(np.max(model.omega)) / (2 * np.pi), 1e4)
-    run = Integration(model, y0, duration=duration + window, rtol=rtol, atol=atol)
-    run.run_to(duration)
-    x0 = run.y[: model.state_size].copy()
-    ph0 = run.ph.copy()
-    # The output of a run started at that state fills in the contact coordinates.
     probe = Integration(model, x0, duration=window, output_rate=rate, rtol=rtol, atol=atol,
-                        phases=ph0)
+                        phases=phases)
     probe.run_to(window)
-    samples = probe.out_y[: probe.n_samples, : model.state_size]
-    return samples[0].copy(), ph0, samples, 1.0 / rate
+    return probe.out_y[: probe.n_samples, : model.state_size], 1.0 / rate
 
 
 def _first_return(model: Model, samples: np.ndarray, dt: float) -> float:
@@ -310,7 +305,11 @@ def periodic_orbit(
         duration = case.simulation.duration if transient is None else transient
         if not duration > 0:
             raise FivdiscError(f"transient = {duration!r} is invalid: must be > 0 [s]")
-        x0, phases, samples, dt = _transient(model, y0, duration, window, rtol, atol_run)
+        run = Integration(model, y0, duration=duration, rtol=rtol, atol=atol_run)
+        run.run_to(duration)
+        phases = run.ph.copy()
+        samples, dt = _probe(model, run.state, phases, window, rtol, atol_run)
+        x0 = samples[0].copy()
         if period is None:
             period = _first_return(model, samples, dt)
     else:
@@ -319,31 +318,26 @@ def periodic_orbit(
             raise FivdiscError(f"guess has shape {x0.shape}: must be ({model.state_size},), "
                                "a state")
         if period is None:
-            probe = Integration(model, x0, duration=window, rtol=rtol, atol=atol_run,
-                                output_rate=max(200.0 * float(np.max(model.omega))
-                                                / (2 * np.pi), 1e4), phases=phases)
-            probe.run_to(window)
-            samples = probe.out_y[: probe.n_samples, : model.state_size]
-            period = _first_return(model, samples, window / (samples.shape[0] - 1))
+            period = _first_return(model, *_probe(model, x0, phases, window, rtol, atol_run))
     phases = (np.full(model.n_sliders, lay.SLIP) if phases is None
               else np.asarray(phases, dtype=np.int64))
 
     sc = energy_scales(model)
 
-    def attempt(x: np.ndarray, t: float) -> tuple[_Shot, float, np.ndarray]:
+    def attempt(x: np.ndarray, t: float) -> tuple[_Shot, float]:
         shot = _shoot(model, x, phases, t, rtol, atol_run)
-        free = _free(model, x, phases)
-        gap = (shot.end - x)[free] / sc[free]
-        return shot, float(np.linalg.norm(gap) / (np.linalg.norm(shot.rate_start / sc) * t)), free
+        gap = (shot.end - x)[shot.free] / sc[shot.free]
+        return shot, float(np.linalg.norm(gap) / (np.linalg.norm(shot.rate_start / sc) * t))
 
     from fivdisc.compilation import tangent_notice
 
     with tangent_notice(show=progress):
-        shot, residual, free = attempt(x0, period)
+        shot, residual = attempt(x0, period)
     iterations = 0
     while residual >= tol and iterations < max_iterations:
         iterations += 1
         # Newton on (x0 / sc, T): [M - I, f(end); f(x0)^T, 0] (dx, dT) = (-gap, 0).
+        free = shot.free
         m = int(free.sum())
         gap = (shot.end - x0)[free] / sc[free]
         jac = np.zeros((m + 1, m + 1))
@@ -368,7 +362,7 @@ def periodic_orbit(
                 continue
             if trial[1] < residual:
                 x0, period = trial_x, float(trial_t)
-                shot, residual, free = trial
+                shot, residual = trial
                 break
         else:
             break
@@ -387,13 +381,6 @@ def periodic_orbit(
                          monodromy=shot.monodromy, multipliers=mult, trivial=trivial,
                          residual=residual, iterations=iterations, verdict=verdict,
                          labels=state_labels(model))
-
-
-def _free(model: Model, x0: np.ndarray, phases: np.ndarray) -> np.ndarray:
-    """Coordinates free at ``x0`` in the phases the start gives it."""
-    run = Integration(model, x0, duration=1.0, phases=phases)
-    run.advance(0.0)
-    return run.free()
 
 
 def _flow_multiplier(mult: np.ndarray, vecs: np.ndarray, flow: np.ndarray,

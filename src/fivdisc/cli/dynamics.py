@@ -12,6 +12,17 @@ from fivdisc.cli._case import CASE
 _NC = click.Path(dir_okay=False, path_type=Path)
 
 
+def _report(res, case, as_json: bool, out: Path | None) -> None:
+    """Print a result (text or JSON) and write it, with its case, to netCDF if asked."""
+    from fivdisc.files import write_atomic
+
+    click.echo(res.to_json() if as_json else str(res))
+    if out is not None:
+        ds = res.to_dataset()
+        ds.attrs["case"] = case.to_toml()
+        write_atomic(out, ds.to_netcdf)
+
+
 @click.command()
 @click.argument("case_file", type=CASE)
 @click.option("--period", type=float, help="A guess of the period [s] (default: the first "
@@ -38,17 +49,13 @@ def orbit(case_file: Path, period: float | None, transient: float | None, window
     """
     from fivdisc.analysis.orbits import periodic_orbit
     from fivdisc.case import load_case
-    from fivdisc.files import check_output, write_atomic
+    from fivdisc.files import check_output
 
     case = load_case(case_file)
     out = check_output(output, "-o", (".nc",), inputs=[case_file]) if output else None
     res = periodic_orbit(case, period=period, transient=transient, window=window, rtol=rtol,
                          progress=progress)
-    click.echo(res.to_json() if as_json else str(res))
-    if out is not None:
-        ds = res.to_dataset()
-        ds.attrs["case"] = case.to_toml()
-        write_atomic(out, ds.to_netcdf)
+    _report(res, case, as_json, out)
 
 
 @click.command()
@@ -77,14 +84,10 @@ def lyapunov(case_file: Path, count: int, transient: float | None, duration: flo
     """
     from fivdisc.analysis.lyapunov import lyapunov as compute
     from fivdisc.case import load_case
-    from fivdisc.files import check_output, write_atomic
+    from fivdisc.files import check_output
 
     case = load_case(case_file)
     out = check_output(output, "-o", (".nc",), inputs=[case_file]) if output else None
     res = compute(case, n=count, transient=transient, duration=duration, interval=interval,
                   progress=progress)
-    click.echo(res.to_json() if as_json else str(res))
-    if out is not None:
-        ds = res.to_dataset()
-        ds.attrs["case"] = case.to_toml()
-        write_atomic(out, ds.to_netcdf)
+    _report(res, case, as_json, out)
