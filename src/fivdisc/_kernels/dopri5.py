@@ -50,7 +50,7 @@ D = np.array(
 )
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def dense_coefficients(y0, y1, k, h, rc):
     """Fill ``rc`` (5, n) with the continuous-extension coefficients of one step."""
     n = y0.shape[0]
@@ -67,7 +67,7 @@ def dense_coefficients(y0, y1, k, h, rc):
         rc[4, i] = h * acc
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def dense_eval(rc, theta, out):
     """State at fraction ``theta`` of the step from its dense-output coefficients."""
     th1 = 1.0 - theta

@@ -89,7 +89,7 @@ from fivdisc._kernels.layout import (
 )
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def speed_at(t, speed, right):
     """Disc speed and acceleration at ``t`` from the piecewise-cubic profile.
 
@@ -108,7 +108,7 @@ def speed_at(t, speed, right):
     return om, omd
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _piece(pieces, x, right):
     """Index of the piece of ``pieces`` (starts in column 0, increasing) holding ``x``:
     the last start below ``x``, or at or below it when ``right``; 0 before the first.
@@ -163,7 +163,7 @@ def new_work(mdl, like):
     return np.zeros((rows, width), like.dtype)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def solve_small(a, r0, m):
     """Solve the ``m x m`` system in rows ``r0 .. r0 + m`` of ``a`` (matrix in columns
     ``0 .. m``, right-hand side in column m) in place, the solution left in column m, by
@@ -192,7 +192,7 @@ def solve_small(a, r0, m):
         a[r0 + c, m] = acc / a[r0 + c, c]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def evaluate(t, y, ph, sg, right, mdl, wk, dy):
     """Time derivative ``dy`` of the state, slider j in phase ``ph[j]`` (slip sign
     ``sg[j]``).
@@ -326,11 +326,12 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
             f = (sl[S_INERTIA, j] * omd + sl[S_CPHI, j] * om + sl[S_KPHI, j] * phi) / (
                 sl[S_RADIUS, j])
             wk[aux + A_F, j] = f
+        # Kept for the tangent-linear right-hand side too, which needs them with one slider.
+        wk[aux + A_SGF, j] = s_gf
+        wk[aux + A_SGG, j] = s_gg
+        wk[aux + A_SGGP, j] = s_ggp
         if ns > 1:
             wk[aux + A_KNOWN, j] = known
-            wk[aux + A_SGF, j] = s_gf
-            wk[aux + A_SGG, j] = s_gg
-            wk[aux + A_SGGP, j] = s_ggp
             wk[aux + A_FPHI, j] = fphi
 
     if ns == 1:
@@ -378,7 +379,7 @@ def _one_slider(n, half, phj, known, smu, fphi, f, gpq, s_gf, s_gg, s_ggp, phi, 
     wk[aux + A_F, 0] = f
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, wk, dy):
     """Normal forces and accelerations of several sliders.
 
@@ -460,7 +461,7 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, w
             dy[half + n + j] = omd + y[n + j] * 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _powers(y, ph, om, omd, mdl, wk, dy):
     """Rates of the energy accumulators (``layout.E_*``) [W]."""
     disc = mdl.disc
@@ -511,7 +512,7 @@ def _powers(y, ph, om, omd, mdl, wk, dy):
         dy[e0 + c] = zero
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def event_values(ph, sg, y, mdl, wk, out):
     """Event functions of every slider's phase, positive while it holds (3 per slider;
     unused slots +inf). Needs ``wk`` filled by ``evaluate`` at ``y``."""
@@ -559,7 +560,7 @@ def complex_step_jacobian(t, y, ph, sg, mdl):
     return jac
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
     """``out = J(t, y) v`` for a single slider: the tangent-linear form of ``evaluate``
     (forward-mode derivative, operation by operation), using the values ``evaluate``
@@ -617,9 +618,8 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
     dgpq = 0.0
     dgpqd = 0.0
     dl2gq = 0.0
-    s_gf = 0.0
-    s_gg = 0.0
-    s_ggp = 0.0
+    s_gg = wk[aux + A_SGG, 0]
+    s_ggp = wk[aux + A_SGGP, 0]
     ds_gf = 0.0
     ds_ggp = 0.0
     for i in range(n):
@@ -634,9 +634,6 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
         dgpq += gpi * v[i]
         dgpqd += gpi * v[half + i] - l2 * gi * y[half + i] * dpsi
         dl2gq += l2 * (gi * v[i] + gpi * y[i] * dpsi)
-        s_gf += gi * fi * minv
-        s_gg += gi * gi * minv
-        s_ggp += gi * gpi * minv
         ds_gf += (gpi * dpsi * fi + gi * out[half + i]) * minv
         ds_ggp += (gpi * gpi - l2 * gi * gi) * minv
     dwc += gpq * dpsi

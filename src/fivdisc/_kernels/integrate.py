@@ -72,7 +72,7 @@ _EXPO1 = 0.2 - 0.75 * _BETA
 _PROBES = 4
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _event_at(theta, i, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist):
     ist[I_EVAL_EVENTS] += 1
     dense_eval(rc, theta, ytmp)
@@ -81,7 +81,7 @@ def _event_at(theta, i, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist):
     return evt[i]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def locate(i, lo, hi, g_lo, g_hi, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist):
     """Fraction of the step at which event ``i`` crosses zero, taken on the far side.
 
@@ -124,7 +124,7 @@ def locate(i, lo, hi, g_lo, g_hi, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist)
     return hi
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _write_outputs(t0, t1, h, rc, ph, sg, mdl, wk, dy, ytmp, ctl, out_y, out_aux, ist):
     """Sample the dense output of the step [t0, t0 + h] at output times in (t0, t1]."""
     i = ist[I_OUT_NEXT]
@@ -141,7 +141,7 @@ def _write_outputs(t0, t1, h, rc, ph, sg, mdl, wk, dy, ytmp, ctl, out_y, out_aux
     ist[I_OUT_NEXT] = i
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _write_sample(i, ti, ys, ph, sg, mdl, wk, dy, out_y, out_aux):
     """One output row: the state with the contact kinematics filled in, and per slider
     N, f, phase, w under it (columns j, S + j, 2 S + j, 3 S + j), then Omega."""
@@ -164,7 +164,7 @@ def _write_sample(i, ti, ys, ph, sg, mdl, wk, dy, out_y, out_aux):
     out_aux[i, 4 * ns] = om
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _rms_scaled(a, y0, y1, atol, rtol, m):
     """RMS of ``a[:m]`` scaled by ``atol + rtol max(|y0|, |y1|)``."""
     acc = 0.0

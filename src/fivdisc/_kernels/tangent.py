@@ -62,7 +62,7 @@ def scratch(mdl, y, n_vectors):
             np.empty(nd), new_work(mdl, y), np.empty(nd), np.empty(sizes(mdl)[1], np.int64))
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _norm_inf(v):
     acc = 0.0
     for i in range(v.shape[0]):
@@ -94,7 +94,7 @@ def jvp(t, y, v, ph, sg, right, mdl, wk, cplx, out):
         out[i] = dyc[i].imag / h
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def stage(st, t, hs, y, ph, sg, mdl, wk, V, KV, vn, vs, cplx):
     """Stage ``st`` of every tangent vector at the stage's state ``y`` (time
     ``t + C[st] hs``, ``wk`` as the state's stage left it), in the order of operations of
@@ -115,7 +115,7 @@ def stage(st, t, hs, y, ph, sg, mdl, wk, V, KV, vn, vs, cplx):
                 vn[r, i] = vs[i]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False)
 def accept(V, KV, vn):
     """The step is taken: tangents move to its end ``vn``, the last stage is the next
     first."""
@@ -125,7 +125,7 @@ def accept(V, KV, vn):
             KV[r, 0, i] = KV[r, 6, i]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def interpolate(theta, hs, V, KV, sc):
     """Tangents at fraction ``theta`` of the step (the state's dense output formula)."""
     vn, rc = sc[3], sc[5]
@@ -134,7 +134,7 @@ def interpolate(theta, hs, V, KV, sc):
         dense_eval(rc, theta, V[r])
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def slave(ph, mdl, v):
     """Zero the rows of coordinates that are not free in phases ``ph``."""
     n, ns, half = sizes(mdl)
@@ -158,7 +158,7 @@ def prepare(t, y, ph, sg, mdl, V, KV):
         jvp(t, y, V[r], ph, sg, True, mdl, wk, sc[0], KV[r, 0])
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _event_rate(e, t, y, ph, sg, mdl, sc, v, dt):
     """Derivative of event function ``e`` along ``(v, dt)`` in (state, time)."""
     yc, dyc, wkc = sc[0]
