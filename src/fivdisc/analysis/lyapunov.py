@@ -28,6 +28,8 @@ __all__ = ["LyapunovSpectrum", "lyapunov"]
 
 # Blocks of the run whose exponents give the uncertainty (their spread).
 _BLOCKS = 10
+# [s]: the default re-orthonormalisation interval.
+DEFAULT_INTERVAL = 0.05
 
 
 @dataclass(frozen=True)
@@ -115,7 +117,7 @@ def lyapunov(
     *,
     transient: float | None = None,
     duration: float | None = None,
-    interval: float = 0.01,
+    interval: float | None = None,
     initial=None,
     rtol: float | None = None,
     atol: float | None = None,
@@ -136,9 +138,14 @@ def lyapunov(
         ``simulation.duration``.
     duration : float, optional
         Length of the measurement [s]; default the case's ``simulation.duration``.
-    interval : float
-        Re-orthonormalisation interval [s]. Shorter keeps the vectors well apart when
-        the exponents differ widely; the exponents do not depend on it otherwise.
+    interval : float, optional
+        Re-orthonormalisation interval [s]; default 0.05 s, or the whole measurement
+        when that is shorter. Shorter keeps the vectors well apart when
+        the exponents differ widely (the n-th loses about ``(lambda_1 - lambda_n)
+        interval / ln 10`` digits against the first); the exponents do not depend on it
+        otherwise. Each re-orthonormalisation returns to Python (about 0.1 ms), so the
+        default (a few stick-slip cycles of brake squeal) keeps that a small part of the
+        run.
     initial : optional
         Initial state, as for :func:`fivdisc.simulate`.
     rtol, atol : float, optional
@@ -158,6 +165,8 @@ def lyapunov(
     sim = case.simulation
     transient = 0.2 * sim.duration if transient is None else transient
     duration = sim.duration if duration is None else duration
+    if interval is None:
+        interval = min(DEFAULT_INTERVAL, duration) if duration > 0 else DEFAULT_INTERVAL
     checks = (("transient", transient, transient >= 0), ("duration", duration, duration > 0),
               ("interval", interval, interval > 0 and interval <= duration))
     for name, value, ok in checks:

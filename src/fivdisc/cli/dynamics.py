@@ -67,8 +67,9 @@ def orbit(case_file: Path, period: float | None, transient: float | None, window
               "case's simulation.duration).")
 @click.option("--duration", type=float,
               help="Length of the measurement [s] (default: simulation.duration).")
-@click.option("--interval", type=float, default=0.01, show_default=True,
-              help="Re-orthonormalisation interval [s].")
+@click.option("--interval", type=float,
+              help="Re-orthonormalisation interval [s] (default: 0.05, or the duration "
+              "when shorter).")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the exponents [1/s] and their uncertainty as JSON.")
 @click.option("-o", "--output", type=_NC,
@@ -76,7 +77,7 @@ def orbit(case_file: Path, period: float | None, transient: float | None, window
 @click.option("--progress/--no-progress", default=True, show_default=True,
               help="Show a progress bar (on stderr).")
 def lyapunov(case_file: Path, count: int, transient: float | None, duration: float | None,
-             interval: float, as_json: bool, output: Path | None, progress: bool) -> None:
+             interval: float | None, as_json: bool, output: Path | None, progress: bool) -> None:
     """Lyapunov exponents of CASE_FILE by the QR method on the tangent dynamics.
 
     The tangent vectors are carried across every switch by its saltation matrix.

@@ -145,12 +145,13 @@ class LyapunovSettings:
         Length of the measurement [s]; None: until the point's ``simulation.duration``,
         the window the sections see.
     interval
-        Re-orthonormalisation interval [s].
+        Re-orthonormalisation interval [s]; None: 0.05 s, or the measurement's duration
+        when shorter.
     """
 
     transient: float | None = None
     duration: float | None = None
-    interval: float = 0.01
+    interval: float | None = None
 
     def window(self, case: Case) -> tuple[float, float]:
         """(transient, duration) [s] of the measurement for `case`."""

@@ -367,7 +367,7 @@ class Sweep:
                     f"invalid: must be < simulation.duration = {case.simulation.duration:g} s "
                     f"(or set {where}.duration)"
                 )
-            if self.lyapunov.interval > duration:
+            if self.lyapunov.interval is not None and self.lyapunov.interval > duration:
                 raise SweepError(
                     f"point {i} ({self._describe(i)}): {where}.interval = "
                     f"{self.lyapunov.interval:g} is invalid: must be <= the measurement's "
