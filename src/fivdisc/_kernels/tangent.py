@@ -50,9 +50,12 @@ def scratch(mdl, y, n_vectors):
     work array), complex stages and event values, the tangents at a step's end, a stage's
     tangent, dense-output coefficients, two vectors, a real work array, and the state and
     slip signs before a switch (slots 9 and 10). The hot loops take their arrays one by
-    one: numba passes each array of a tuple argument on every call, and the step's
-    tangent functions are inlined into the integrator, since each array crossing a call
-    costs reference-count updates."""
+    one: numba passes every field of every array of a tuple argument on each call.
+
+    The per-step functions (``stage``, ``accept``, ...) are compiled without reference
+    counting (they never allocate), and ``stage`` has the tangent-linear right-hand side
+    inlined: a call passing the model's arrays costs about what the stage's
+    combination does."""
     nd = n_dynamic(mdl)
     n_ev = 3 * sizes(mdl)[1]
     yc = np.empty(nd, np.complex128)
