@@ -195,6 +195,22 @@ def solve_small(a, r0, m):
         a[r0 + c, m] = acc / a[r0 + c, c]
 
 
+@njit(cache=True, inline="always")
+def _disc_force(i, x, om, om2, omd, eps, damped, disc, half):
+    """Force on modal coordinate ``i`` from its stiffness, the spin and the damping at
+    state ``x`` (``om2 = om^2``): linear in ``x``, so for a tangent vector ``x`` it is
+    the force's derivative along it."""
+    p = int(disc[D_PARTNER, i])
+    f = -(disc[D_KD, i] - disc[D_ML2, i] * om2) * x[i]
+    if p >= 0:
+        f -= disc[D_GYR, i] * (2.0 * om * x[half + p] + eps * omd * x[p] * disc[D_OMD_FIX, i])
+    if damped:
+        f -= disc[D_CDAMP, i] * x[half + i]
+        if p >= 0:
+            f -= disc[D_CDAMP_OM, i] * om * x[p]
+    return f
+
+
 @njit(cache=True, _nrt=False)
 def evaluate(t, y, ph, sg, right, mdl, wk, dy):
     """Time derivative ``dy`` of the state, slider j in phase ``ph[j]`` (slip sign
@@ -219,17 +235,7 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
     damped = opts[O_DAMPED] != 0.0
     om2 = om * om
     for i in range(n):
-        qi = y[i]
-        p = int(disc[D_PARTNER, i])
-        fi = -(disc[D_KD, i] - disc[D_ML2, i] * om2) * qi
-        if p >= 0:
-            fi -= disc[D_GYR, i] * (2.0 * om * y[half + p]
-                                    + eps * omd * y[p] * disc[D_OMD_FIX, i])
-        if damped:
-            fi -= disc[D_CDAMP, i] * y[half + i]
-            if p >= 0:
-                fi -= disc[D_CDAMP_OM, i] * om * y[p]
-        wk[r_fq, i] = fi
+        wk[r_fq, i] = _disc_force(i, y, om, om2, omd, eps, damped, disc, half)
         dy[i] = y[half + i]
 
     lmax = int(opts[O_LMAX])
@@ -588,15 +594,8 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
     sj = sg[0]
     # Disc forces are linear in the state.
     for i in range(n):
-        p = int(disc[D_PARTNER, i])
-        dfi = -(disc[D_KD, i] - disc[D_ML2, i] * om2) * v[i]
-        if p >= 0:
-            dfi -= disc[D_GYR, i] * (2.0 * om * v[half + p] + eps * omd * v[p] * disc[D_OMD_FIX, i])
-        if damped:
-            dfi -= disc[D_CDAMP, i] * v[half + i]
-            if p >= 0:
-                dfi -= disc[D_CDAMP_OM, i] * om * v[p]
-        out[half + i] = dfi  # the force's derivative, turned into the acceleration's below
+        # The force's derivative, turned into the acceleration's below.
+        out[half + i] = _disc_force(i, v, om, om2, omd, eps, damped, disc, half)
         out[i] = v[half + i]
     phi = y[n]
     dpsi = v[n]
