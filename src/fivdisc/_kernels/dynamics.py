@@ -161,7 +161,7 @@ def kinetic_friction(opts, table, r, s, v):
 def new_work(mdl, like):
     """Work array of ``evaluate`` in the dtype of ``like`` (float or complex)."""
     n, ns, _ = sizes(mdl)
-    rows = 4 * ns + 1 + N_AUX + ns
+    rows = work_rows(ns)[5] + ns
     width = max(n, int(mdl.opts[O_LMAX]) + 2, ns + 1, 1)
     return np.zeros((rows, width), like.dtype)
 
@@ -184,10 +184,12 @@ def solve_small(a, r0, m):
                 tmp = a[r0 + c, k]
                 a[r0 + c, k] = a[r0 + piv, k]
                 a[r0 + piv, k] = tmp
-        for r in range(c + 1, m):
-            fac = a[r0 + r, c] / a[r0 + c, c]
-            for k in range(c, m + 1):
-                a[r0 + r, k] -= fac * a[r0 + c, k]
+        if c + 1 < m:
+            inv = 1.0 / a[r0 + c, c]
+            for r in range(c + 1, m):
+                fac = a[r0 + r, c] * inv
+                for k in range(c, m + 1):
+                    a[r0 + r, k] -= fac * a[r0 + c, k]
     for c in range(m - 1, -1, -1):
         acc = a[r0 + c, m]
         for k in range(c + 1, m):
@@ -226,7 +228,7 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
     shape = mdl.shape
     opts = mdl.opts
     n, ns, half = sizes(mdl)
-    r_gp, r_fq, r_trig, r_aux, r_sys = work_rows(ns)
+    r_gp, r_fq, r_trig, r_aux, r_sys, r_u = work_rows(ns)
     om, omd = speed_at(t, mdl.speed, right)
     zero = y[n] * 0.0
 
@@ -295,9 +297,10 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
             gpq += gpi * qi
             gpqd += gpi * qdi
             l2gq += li * li * gi * qi
-            s_gf += gi * wk[r_fq, i] * minv
-            s_gg += gi * gi * minv
-            s_ggp += gi * gpi * minv
+            if ns == 1:
+                s_gf += gi * wk[r_fq, i] * minv
+                s_gg += gi * gi * minv
+                s_ggp += gi * gpi * minv
         wcd += phid * gpq
         wk[aux + A_WC, j] = wc
         wk[aux + A_WCD, j] = wcd
@@ -347,7 +350,8 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
         _one_slider(n, half, phj, known, smu, fphi, f, gpq, s_gf, s_gg, s_ggp, y[n], omd,
                     zero, sl, disc, r_gp, r_fq, aux, wk, dy)
     else:
-        _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, wk, dy)
+        _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r_u, wk,
+                  dy)
 
     if y.shape[0] > n_dynamic(mdl):
         _powers(y, ph, om, omd, mdl, wk, dy)
@@ -389,13 +393,38 @@ def _one_slider(n, half, phj, known, smu, fphi, f, gpq, s_gf, s_gg, s_ggp, phi, 
 
 
 @njit(cache=True, _nrt=False)
-def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, wk, dy):
+def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r_u, wk, dy):
     """Normal forces and accelerations of several sliders.
 
-    One equation per slider for its normal force: N_j = known_j + sigma_j m_j (g_j.q''
-    + g'_j.q phi_j''), with q'' = M^-1 (F + sum_k sigma_k (-N_k g_k + h_k f_k g'_k)) and,
-    in slip, phi_j'' = (F_phi + r s mu N_j) / I. A flying slider's row is N_j = 0.
+    Notes
+    -----
+    Slider k in contact pushes the disc with -sigma_k N_k u_k, where u_k = g_k -
+    h_k / (2 r_k) s_k mu_k g'_k in slip and g_k in stick, plus in stick the known
+    moment of its friction reaction, sigma_k h_k / (2 r_k) f_k g'_k. With F the disc
+    forces known before the contacts (stick moments included),
+    q'' = M^-1 (F - sum_k sigma_k N_k u_k). Each contact's condition
+    N_j = known_j + sigma_j m_j (g_j . q'' + g'_j . q phi_j''), with
+    phi_j'' = (F_phi + r s mu N_j) / I in slip and dOmega/dt in stick, is one row of an
+    S x S system (the capacitance matrix of the Woodbury identity) whose entries are
+    sigma_j sigma_k m_j g_j M^-1 u_k: one dot product of length n per pair. A flying
+    slider's row is N_j = 0. F is gathered in the accelerations of ``dy`` and the rows
+    ``r_u + k`` hold M^-1 u_k.
     """
+    for i in range(n):
+        dy[half + i] = wk[r_fq, i]
+    for k in range(ns):
+        if ph[k] == SEPARATION:
+            continue
+        c = zero
+        if ph[k] == SLIP:
+            c = sl[S_HH, k] * wk[aux + A_SMU, k]
+        else:
+            moment = sl[S_SHH, k] * wk[aux + A_F, k]
+            for i in range(n):
+                dy[half + i] += moment * wk[r_gp + k, i]
+        for i in range(n):
+            wk[r_u + k, i] = (wk[k, i] - c * wk[r_gp + k, i]) * disc[D_MINV, i]
+
     for j in range(ns):
         row = r_sys + j
         for k in range(ns):
@@ -406,68 +435,43 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, w
             continue
         m = sl[S_MASS, j]
         sm = sl[S_SMASS, j]
-        gpq = wk[aux + A_GPQ, j]
-        cross = zero
         for k in range(ns):
-            if k == j or ph[k] == SEPARATION:
+            if ph[k] == SEPARATION:
                 continue
-            # g_j M^-1 g_k and g_j M^-1 g'_k.
-            sgg = zero
-            sggp = zero
+            acc = zero
             for i in range(n):
-                sgg += wk[j, i] * wk[k, i] * disc[D_MINV, i]
-                sggp += wk[j, i] * wk[r_gp + k, i] * disc[D_MINV, i]
-            sig = sl[S_SIGMA, j] * sl[S_SIGMA, k]
-            if ph[k] == SLIP:
-                wk[row, k] = sig * m * (sgg - sl[S_HH, k] * wk[aux + A_SMU, k] * sggp)
-            else:
-                wk[row, k] = sig * m * sgg
-                cross += sl[S_SHH, k] * wk[aux + A_F, k] * sggp
+                acc += wk[j, i] * wk[r_u + k, i]
+            wk[row, k] = sl[S_SIGMA, j] * sl[S_SIGMA, k] * m * acc
+        gf = zero
+        for i in range(n):
+            gf += wk[j, i] * disc[D_MINV, i] * dy[half + i]
+        gpq = wk[aux + A_GPQ, j]
+        wk[row, j] += 1.0
         if ph[j] == SLIP:
             smu = wk[aux + A_SMU, j]
-            wk[row, j] = (
-                1.0
-                + m * (wk[aux + A_SGG, j] - sl[S_HH, j] * smu * wk[aux + A_SGGP, j])
-                - sm * gpq * sl[S_RADIUS, j] * smu / sl[S_INERTIA, j]
-            )
-            wk[row, ns] = (
-                wk[aux + A_KNOWN, j]
-                + sm * (wk[aux + A_SGF, j] + cross)
-                + sm * gpq * wk[aux + A_FPHI, j] / sl[S_INERTIA, j]
-            )
+            wk[row, j] -= sm * gpq * sl[S_RADIUS, j] * smu / sl[S_INERTIA, j]
+            wk[row, ns] = (wk[aux + A_KNOWN, j] + sm * gf
+                           + sm * gpq * wk[aux + A_FPHI, j] / sl[S_INERTIA, j])
         else:
-            wk[row, j] = 1.0 + m * wk[aux + A_SGG, j]
-            wk[row, ns] = (
-                wk[aux + A_KNOWN, j]
-                + sm * (wk[aux + A_SGF, j] + sl[S_SHH, j] * wk[aux + A_F, j]
-                        * wk[aux + A_SGGP, j] + cross)
-                + sm * gpq * omd
-            )
+            wk[row, ns] = wk[aux + A_KNOWN, j] + sm * gf + sm * gpq * omd
     solve_small(wk, r_sys, ns)
 
     for i in range(n):
-        acc = wk[r_fq, i]
-        for j in range(ns):
-            if ph[j] == SEPARATION:
-                continue
-            sn = sl[S_SIGMA, j] * wk[r_sys + j, ns]
-            if ph[j] == SLIP:
-                acc = acc - sn * (wk[j, i] - sl[S_HH, j] * wk[aux + A_SMU, j] * wk[r_gp + j, i])
-            else:
-                acc = acc + sl[S_SHH, j] * wk[aux + A_F, j] * wk[r_gp + j, i]
-                acc = acc - sn * wk[j, i]
-        dy[half + i] = acc * disc[D_MINV, i]
-    for j in range(ns):
-        if ph[j] == SEPARATION:
+        dy[half + i] *= disc[D_MINV, i]
+    for k in range(ns):
+        if ph[k] == SEPARATION:
             continue
-        nf = wk[r_sys + j, ns]
-        wk[aux + A_N, j] = nf
-        if ph[j] == SLIP:
-            wk[aux + A_F, j] = wk[aux + A_SMU, j] * nf
-            dy[half + n + j] = (wk[aux + A_FPHI, j] + sl[S_RADIUS, j] * wk[aux + A_F, j]) / (
-                sl[S_INERTIA, j])
+        nf = wk[r_sys + k, ns]
+        sn = sl[S_SIGMA, k] * nf
+        for i in range(n):
+            dy[half + i] -= sn * wk[r_u + k, i]
+        wk[aux + A_N, k] = nf
+        if ph[k] == SLIP:
+            wk[aux + A_F, k] = wk[aux + A_SMU, k] * nf
+            dy[half + n + k] = (wk[aux + A_FPHI, k] + sl[S_RADIUS, k] * wk[aux + A_F, k]) / (
+                sl[S_INERTIA, k])
         else:
-            dy[half + n + j] = omd + y[n + j] * 0.0
+            dy[half + n + k] = omd + y[n + k] * 0.0
 
 
 @njit(cache=True, _nrt=False)
@@ -476,7 +480,7 @@ def _powers(y, ph, om, omd, mdl, wk, dy):
     disc = mdl.disc
     sl = mdl.slider
     n, ns, half = sizes(mdl)
-    r_gp, _, _, aux, _ = work_rows(ns)
+    r_gp, _, _, aux, _, _ = work_rows(ns)
     e0 = n_dynamic(mdl)
     zero = y[n] * 0.0
     fric = zero
@@ -585,7 +589,7 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
     sl = mdl.slider
     opts = mdl.opts
     n, ns, half = sizes(mdl)
-    r_gp, r_fq, _, aux, _ = work_rows(ns)
+    r_gp, r_fq, _, aux, _, _ = work_rows(ns)
     om, omd = speed_at(t, mdl.speed, right)
     eps = opts[O_OMDOT]
     damped = opts[O_DAMPED] != 0.0

@@ -234,6 +234,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
         tv, tk = tan
         tsc = tangent.scratch(mdl, y, tv.shape[0])
         tcx, tvn, tvs, ypre, sgpre = tsc[0], tsc[3], tsc[4], tsc[9], tsc[10]
+        tys, twk = tsc[11], tsc[12]
 
     t = fst[F_T]
     h = fst[F_H]
@@ -288,7 +289,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
                         ytmp[i] += a * k[j, i]
             evaluate(t + C[st] * hs, ytmp, ph, sg, False, mdl, wk, k[st])
             if tan is not None:
-                tangent.stage(st, t, hs, ytmp, ph, sg, mdl, wk, tv, tk, tvn, tvs, tcx)
+                tangent.keep(st, ytmp, wk, n_sl, tys, twk)
         for i in range(ns):
             ynew[i] = ytmp[i]
         ist[I_RHS] += 6
@@ -315,6 +316,8 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
 
         ist[I_STEPS] += 1
         t_new = tb if land else t + hs
+        if tan is not None:
+            tangent.step(t, hs, ph, sg, mdl, tys, twk, tv, tk, tvn, tvs, tcx)
         # The last stage is at the step's end: its evaluation left the event data there.
         event_values(ph, sg, ynew, mdl, wk, evn)
 

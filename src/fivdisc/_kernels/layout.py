@@ -158,14 +158,17 @@ class KernelModel(NamedTuple):
 def work_rows(n_sliders):
     """Row offsets of the work array: g' (rows ``gp + j``; g is rows ``j``), the disc
     forces, cos(l psi_j) (rows ``trig + j``; sin at ``trig + S + j``), the auxiliary
-    block (rows ``aux + A_*``, column j) and the normal forces' system (rows
-    ``system + a``, its right-hand side in column S)."""
+    block (rows ``aux + A_*``, column j), the normal forces' system (rows
+    ``system + a``, its right-hand side in column S) and, with several sliders, each
+    contact's force on the disc per unit normal force, times M^-1 (rows ``contact + j``).
+    """
     gp = n_sliders
     fq = 2 * n_sliders
     trig = fq + 1
     aux = trig + 2 * n_sliders
     system = aux + N_AUX
-    return gp, fq, trig, aux, system
+    contact = system + n_sliders
+    return gp, fq, trig, aux, system, contact
 
 
 @njit(cache=True)

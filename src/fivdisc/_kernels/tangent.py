@@ -35,7 +35,16 @@ from numba import njit
 
 from fivdisc._kernels.dopri5 import A, C, dense_coefficients, dense_eval
 from fivdisc._kernels.dynamics import evaluate, event_values, linearised_one, new_work
-from fivdisc._kernels.layout import A_WC, A_WCD, SEPARATION, STICK, n_dynamic, sizes, work_rows
+from fivdisc._kernels.layout import (
+    A_WC,
+    A_WCD,
+    N_AUX,
+    SEPARATION,
+    STICK,
+    n_dynamic,
+    sizes,
+    work_rows,
+)
 from fivdisc._kernels.slots import N_EVI, N_FSTATE, N_ISTATE
 from fivdisc._kernels.switch import MODE_EVENT, _switch
 
@@ -48,21 +57,24 @@ _STEP = 1e-30
 def scratch(mdl, y, n_vectors):
     """Work arrays of the tangent integration: (the complex step's state, derivative and
     work array), complex stages and event values, the tangents at a step's end, a stage's
-    tangent, dense-output coefficients, two vectors, a real work array, and the state and
-    slip signs before a switch (slots 9 and 10). The hot loops take their arrays one by
-    one: numba passes every field of every array of a tuple argument on each call.
+    tangent, dense-output coefficients, two vectors, a real work array, the state and
+    slip signs before a switch (slots 9 and 10), and the state's stage states and what
+    its evaluations left in the work array (slots 11 and 12, see :func:`keep`).
 
-    The per-step functions (``stage``, ``accept``, ...) are compiled without reference
-    counting (they never allocate), and ``stage`` has the tangent-linear right-hand side
-    inlined: a call passing the model's arrays costs about what the stage's
-    combination does."""
+    The per-step functions (``step``, ``accept``, ...) are compiled without reference
+    counting (they never allocate), and ``step`` has the tangent-linear right-hand side
+    inlined. The tangent stages of a step are computed in one call once the state's step
+    is accepted: a call passing the model's arrays costs about what a stage's
+    combination does, and a rejected step costs the tangents nothing."""
     nd = n_dynamic(mdl)
     n_ev = 3 * sizes(mdl)[1]
     yc = np.empty(nd, np.complex128)
     cplx = (yc, np.empty(nd, np.complex128), new_work(mdl, yc))
+    wk = new_work(mdl, y)
     return (cplx, np.empty((7, nd), np.complex128), np.empty(n_ev, np.complex128),
             np.empty((n_vectors, nd)), np.empty(nd), np.empty((5, nd)), np.empty(nd),
-            np.empty(nd), new_work(mdl, y), np.empty(nd), np.empty(sizes(mdl)[1], np.int64))
+            np.empty(nd), wk, np.empty(nd), np.empty(sizes(mdl)[1], np.int64),
+            np.empty((7, y.shape[0])), np.zeros((7,) + wk.shape))
 
 
 @njit(cache=True, _nrt=False)
@@ -97,25 +109,42 @@ def jvp(t, y, v, ph, sg, right, mdl, wk, cplx, out):
         out[i] = dyc[i].imag / h
 
 
+@njit(cache=True, inline="always")
+def keep(st, y, wk, n_sl, ys, wks):
+    """Keep stage ``st``'s state ``y`` and, for one slider, the part of ``wk`` that
+    :func:`dynamics.linearised_one` reads (g, g' and the disc forces, rows 0-2, and the
+    slider's auxiliary column), for :func:`step`. Several sliders take the complex step
+    of the right-hand side, which needs the state only."""
+    for i in range(y.shape[0]):
+        ys[st, i] = y[i]
+    if n_sl == 1:
+        aux = work_rows(1)[3]
+        for a in range(aux):
+            for i in range(wk.shape[1]):
+                wks[st, a, i] = wk[a, i]
+        for a in range(aux, aux + N_AUX):
+            wks[st, a, 0] = wk[a, 0]
+
+
 @njit(cache=True, _nrt=False)
-def stage(st, t, hs, y, ph, sg, mdl, wk, V, KV, vn, vs, cplx):
-    """Stage ``st`` of every tangent vector at the stage's state ``y`` (time
-    ``t + C[st] hs``, ``wk`` as the state's stage left it), in the order of operations of
-    the state's stage; the last stage's combination, the tangent at the step's end, is
-    kept in ``vn``."""
+def step(t, hs, ph, sg, mdl, ys, wks, V, KV, vn, vs, cplx):
+    """Stages 1-6 of every tangent vector over the accepted step ``[t, t + hs]``, at the
+    state's stage states ``ys`` with what its evaluations left in ``wks``
+    (:func:`keep`), in the order of operations of the state's stages; the last stage's
+    combination, the tangent at the step's end, is kept in ``vn``."""
     nd = V.shape[1]
     for r in range(V.shape[0]):
-        for i in range(nd):
-            vs[i] = V[r, i]
-        for j in range(st):
-            a = hs * A[st, j]
-            if a != 0.0:
-                for i in range(nd):
-                    vs[i] += a * KV[r, j, i]
-        jvp(t + C[st] * hs, y, vs, ph, sg, False, mdl, wk, cplx, KV[r, st])
-        if st == 6:
+        for st in range(1, 7):
             for i in range(nd):
-                vn[r, i] = vs[i]
+                vs[i] = V[r, i]
+            for j in range(st):
+                a = hs * A[st, j]
+                if a != 0.0:
+                    for i in range(nd):
+                        vs[i] += a * KV[r, j, i]
+            jvp(t + C[st] * hs, ys[st], vs, ph, sg, False, mdl, wks[st], cplx, KV[r, st])
+        for i in range(nd):
+            vn[r, i] = vs[i]
 
 
 @njit(cache=True, _nrt=False)
