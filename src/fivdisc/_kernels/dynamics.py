@@ -56,7 +56,6 @@ from fivdisc._kernels.layout import (
     E_SLOPE,
     LAW_EXPONENTIAL,
     LAW_STRIBECK,
-    N_AUX,
     O_ALPHA,
     O_DAMPED,
     O_DELTA,

@@ -74,7 +74,7 @@ def scratch(mdl, y, n_vectors):
     return (cplx, np.empty((7, nd), np.complex128), np.empty(n_ev, np.complex128),
             np.empty((n_vectors, nd)), np.empty(nd), np.empty((5, nd)), np.empty(nd),
             np.empty(nd), wk, np.empty(nd), np.empty(sizes(mdl)[1], np.int64),
-            np.empty((7, y.shape[0])), np.zeros((7,) + wk.shape))
+            np.empty((7, y.shape[0])), np.zeros((7, wk.shape[0], wk.shape[1])))
 
 
 @njit(cache=True, _nrt=False)
