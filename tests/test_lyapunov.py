@@ -105,6 +105,78 @@ def test_sum_of_all_exponents_is_the_mean_divergence():
     assert spec.exponents.sum() * spec.times[-1] == pytest.approx(integral, rel=1e-7)
 
 
+def test_sum_of_all_exponents_adds_the_saltation_determinants():
+    """Liouville across switches: over a window of slip reversals (no stick, so no
+    direction collapses), the sum of all finite-time exponents times the window's length
+    is the integral of the Jacobian's trace over the smooth stretches plus, at each
+    reversal, log |det S| of its saltation matrix. For a switch that keeps the state
+    and has the event function h = s (Omega - phidot), S = I + (f+ - f-) grad h^T /
+    (grad h . f- + dh/dt), so det S = (dOmega/dt - phi''+) / (dOmega/dt - phi''-).
+
+    Independent of the tangent code: switch times, states and both sides'
+    accelerations come from the slow scipy reference (tests/reference_model.py); the
+    trace is integrated by Simpson on each stretch (601 points of the reference's
+    dense output, the kernel's complex-step Jacobian at each, as in the test above),
+    whose error is below 1e-9 of the total. The slider starts far behind its
+    equilibrium, so every crossing of phidot = Omega is a reversal."""
+    from reference_model import reference_simulate
+
+    case = LIGHT.replace({"friction.static": 0.5, "friction.kinetic_max": 0.5,
+                          "friction.kinetic_min": 0.3, "friction.decay": 1.0,
+                          "slider.rotational_damping": 0.5,
+                          "disc.modes": [[0, 0], [0, 1]], "simulation.initial_state": "rest",
+                          "simulation.rtol": 1e-12, "simulation.atol": 1e-16})
+    model = build_model(case)
+    n = model.n
+    half = model.state_size // 2
+    free = np.r_[0 : n + 1, half : half + n + 1]
+    transient, duration = 0.001, 0.03
+    initial = {"phi": -0.2}
+    spec = lyapunov(case, n=free.size, transient=transient, duration=duration,
+                    interval=duration / 20, initial=initial)
+
+    y0 = np.zeros(2 * n + 4)
+    y0[2 * n] = -0.2
+    ref = reference_simulate(case, transient + duration, y0=y0, phase0=[0])
+    # The measurement starts where the transient's last step ended, ends at the end.
+    end = transient + duration
+    start = end - spec.times[-1]
+    assert transient <= start < transient + 1e-4
+    window = [e for e in ref.events if start < e[0] < end]
+    assert len(window) >= 3 and all(e[3] == "reversal" for e in window)
+    assert all(e[3] == "reversal" for e in ref.events)
+
+    def kernel_state(y):
+        out = np.zeros(model.state_size)
+        out[:n], out[half : half + n] = y[:n], y[n : 2 * n]
+        out[n], out[half + n] = y[2 * n], y[2 * n + 1]
+        return out
+
+    integral = 0.0
+    for seg in ref.segments:
+        a, b = max(seg.t0, start), min(seg.t1, end)
+        if b <= a:
+            continue
+        times = np.linspace(a, b, 601)
+        trace = np.empty(times.size)
+        for i, t in enumerate(times):
+            jac = dyn.complex_step_jacobian(float(t), kernel_state(seg.sol(t)), np.array([0]),
+                                            np.array([int(seg.signs[0])]),
+                                            model.kernel_args)
+            trace[i] = np.trace(jac[np.ix_(free, free)])
+        integral += simpson(trace, x=times)
+    jumps = 0.0
+    for t, *_ in window:
+        before = next(s for s in ref.segments if s.t1 == t)
+        after = next(s for s in ref.segments if s.t0 == t)
+        y = after.sol(t)
+        acc = [ref._model.solve(list(s.phases), list(s.signs), t, y, s.piece)["phidd"][0]
+               for s in (before, after)]
+        jumps += np.log(abs(acc[1] / acc[0]))  # dOmega/dt = 0
+    assert abs(jumps) > 0.1 * abs(integral)  # the switches matter (about 40 % here)
+    assert spec.exponents.sum() * spec.times[-1] == pytest.approx(integral + jumps, rel=1e-7)
+
+
 def test_lyapunov_rejects_bad_input():
     with pytest.raises(FivdiscError, match="n = 0 is invalid"):
         lyapunov(RIGID, n=0)
