@@ -160,7 +160,7 @@ def kinetic_friction(opts, table, r, s, v):
 def new_work(mdl, like):
     """Work array of ``evaluate`` in the dtype of ``like`` (float or complex)."""
     n, ns, _ = sizes(mdl)
-    rows = work_rows(ns)[5] + ns
+    rows = work_rows(ns)[5] + n
     width = max(n, int(mdl.opts[O_LMAX]) + 2, ns + 1, 1)
     return np.zeros((rows, width), like.dtype)
 
@@ -405,14 +405,17 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
     N_j = known_j + sigma_j m_j (g_j . q'' + g'_j . q phi_j''), with
     phi_j'' = (F_phi + r s mu N_j) / I in slip and dOmega/dt in stick, is one row of an
     S x S system (the capacitance matrix of the Woodbury identity) whose entries are
-    sigma_j sigma_k m_j g_j M^-1 u_k: one dot product of length n per pair. A flying
-    slider's row is N_j = 0. F is gathered in the accelerations of ``dy`` and the rows
-    ``r_u + k`` hold M^-1 u_k.
+    sigma_j sigma_k m_j g_j M^-1 u_k. A flying slider's row is N_j = 0. F is gathered in
+    the accelerations of ``dy``; row ``r_u + i`` holds sigma_k (M^-1 u_k)_i in column k
+    (0 for a flying slider), so that the system's rows and the accelerations are sums of
+    contiguous rows (which the compiler vectorises) rather than S^2 short dot products.
     """
     for i in range(n):
         dy[half + i] = wk[r_fq, i]
     for k in range(ns):
         if ph[k] == SEPARATION:
+            for i in range(n):
+                wk[r_u + i, k] = zero
             continue
         c = zero
         if ph[k] == SLIP:
@@ -422,7 +425,7 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
             for i in range(n):
                 dy[half + i] += moment * wk[r_gp + k, i]
         for i in range(n):
-            wk[r_u + k, i] = (wk[k, i] - c * wk[r_gp + k, i]) * disc[D_MINV, i]
+            wk[r_u + i, k] = sl[S_SIGMA, k] * (wk[k, i] - c * wk[r_gp + k, i]) * disc[D_MINV, i]
 
     for j in range(ns):
         row = r_sys + j
@@ -432,18 +435,16 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
             wk[row, j] = 1.0 + zero
             wk[row, ns] = zero
             continue
-        m = sl[S_MASS, j]
-        sm = sl[S_SMASS, j]
-        for k in range(ns):
-            if ph[k] == SEPARATION:
-                continue
-            acc = zero
-            for i in range(n):
-                acc += wk[j, i] * wk[r_u + k, i]
-            wk[row, k] = sl[S_SIGMA, j] * sl[S_SIGMA, k] * m * acc
         gf = zero
         for i in range(n):
-            gf += wk[j, i] * disc[D_MINV, i] * dy[half + i]
+            gji = wk[j, i]
+            gf += gji * disc[D_MINV, i] * dy[half + i]
+            for k in range(ns):
+                wk[row, k] += gji * wk[r_u + i, k]
+        m = sl[S_SIGMA, j] * sl[S_MASS, j]
+        for k in range(ns):
+            wk[row, k] *= m
+        sm = sl[S_SMASS, j]
         gpq = wk[aux + A_GPQ, j]
         wk[row, j] += 1.0
         if ph[j] == SLIP:
@@ -455,15 +456,10 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
             wk[row, ns] = wk[aux + A_KNOWN, j] + sm * gf + sm * gpq * omd
     solve_small(wk, r_sys, ns)
 
-    for i in range(n):
-        dy[half + i] *= disc[D_MINV, i]
     for k in range(ns):
         if ph[k] == SEPARATION:
             continue
         nf = wk[r_sys + k, ns]
-        sn = sl[S_SIGMA, k] * nf
-        for i in range(n):
-            dy[half + i] -= sn * wk[r_u + k, i]
         wk[aux + A_N, k] = nf
         if ph[k] == SLIP:
             wk[aux + A_F, k] = wk[aux + A_SMU, k] * nf
@@ -471,6 +467,12 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
                 sl[S_INERTIA, k])
         else:
             dy[half + n + k] = omd + y[n + k] * 0.0
+    # A flying slider's normal force is 0 (set by ``evaluate``), and so is its column.
+    for i in range(n):
+        acc = dy[half + i] * disc[D_MINV, i]
+        for k in range(ns):
+            acc -= wk[aux + A_N, k] * wk[r_u + i, k]
+        dy[half + i] = acc
 
 
 @njit(cache=True, _nrt=False)

@@ -160,7 +160,8 @@ def work_rows(n_sliders):
     forces, cos(l psi_j) (rows ``trig + j``; sin at ``trig + S + j``), the auxiliary
     block (rows ``aux + A_*``, column j), the normal forces' system (rows
     ``system + a``, its right-hand side in column S) and, with several sliders, each
-    contact's force on the disc per unit normal force, times M^-1 (rows ``contact + j``).
+    contact's force on the disc per unit normal force, times M^-1 (row ``contact + i``
+    for modal coordinate i, column j; n rows).
     """
     gp = n_sliders
     fq = 2 * n_sliders
