@@ -441,10 +441,9 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
             gf += gji * disc[D_MINV, i] * dy[half + i]
             for k in range(ns):
                 wk[row, k] += gji * wk[r_u + i, k]
-        m = sl[S_SIGMA, j] * sl[S_MASS, j]
-        for k in range(ns):
-            wk[row, k] *= m
         sm = sl[S_SMASS, j]
+        for k in range(ns):
+            wk[row, k] *= sm
         gpq = wk[aux + A_GPQ, j]
         wk[row, j] += 1.0
         if ph[j] == SLIP:

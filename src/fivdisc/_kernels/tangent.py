@@ -118,8 +118,8 @@ def keep(st, y, wk, n_sl, ys, wks):
     for i in range(y.shape[0]):
         ys[st, i] = y[i]
     if n_sl == 1:
-        aux = work_rows(1)[3]
-        for a in range(aux):
+        _, _, trig, aux, _, _ = work_rows(1)
+        for a in range(trig):
             for i in range(wk.shape[1]):
                 wks[st, a, i] = wk[a, i]
         for a in range(aux, aux + N_AUX):
