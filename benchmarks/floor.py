@@ -4,12 +4,17 @@ the same step-size control over a linear system of the same state size.
 ``floor_cost(model, duration)`` integrates ``y' = J y`` with J the exact Jacobian of the
 model's slip equations at a generic state (so the step sizes resemble the real run's),
 no events, no contact solve, no output, and returns the median wall time per accepted
-step [s] and the steps taken. Anything the real kernel spends beyond this is the price of
-its right-hand side, events and output.
+step [s] and the steps taken. J is applied two ways: as a dense matrix (O(n^2) per
+product, which at many coordinates costs more than the kernel's O(n) right-hand side)
+and in the model's own structure, the sparse free disc and free sliders plus the
+contacts' low-rank rest (O(n)). Anything the real kernel spends beyond the floor is the
+price of its right-hand side, events and output.
 
 Run ``python benchmarks/floor.py``: it prints, for the paper's Fig. 10 case (one slider,
 7 modal coordinates), the kernel's cost per accepted step without output and with the
-10 kHz output, each as a ratio to the floor measured in the same run.
+10 kHz output, each as a ratio to both floors measured in the same run; then the cost per
+step at 7 to 23 modal coordinates against the floors, and at 1 to 8 sliders, each with
+its least-squares slope and the largest deviation from that line.
 """
 
 from __future__ import annotations
@@ -25,25 +30,35 @@ from fivdisc._kernels.dynamics import complex_step_jacobian
 # The kernel's own step-control constants: the floor must take the steps the kernel would
 # (its PI controller below repeats the kernel's lines on purpose, without events).
 from fivdisc._kernels.integrate import _BETA, _EXPO1
+from fivdisc._kernels.layout import SEPARATION, SLIP
 
 
 @njit(cache=True)
-def _matvec(jac, y, out):
+def _apply(op, y, out):
+    """``out = B y + U^T (V y)``: ``B`` in CSR form, ``U``, ``V`` of shape (rank, n)."""
+    indptr, indices, data, u, v = op
     for i in range(y.shape[0]):
         acc = 0.0
-        for j in range(y.shape[0]):
-            acc += jac[i, j] * y[j]
+        for p in range(indptr[i], indptr[i + 1]):
+            acc += data[p] * y[indices[p]]
         out[i] = acc
+    for r in range(u.shape[0]):
+        s = 0.0
+        for i in range(y.shape[0]):
+            s += v[r, i] * y[i]
+        for i in range(y.shape[0]):
+            out[i] += u[r, i] * s
 
 
 @njit(cache=True)
-def _dopri_linear(jac, y, t_final, rtol, atol):
-    """DOPRI5 with the kernel's PI control on y' = J y; returns accepted steps."""
+def _dopri_linear(op, y, t_final, rtol, atol):
+    """DOPRI5 with the kernel's PI control on y' = J y (J applied by ``_apply``);
+    returns accepted steps."""
     ns = y.shape[0]
     k = np.zeros((7, ns))
     ytmp = np.empty(ns)
     err_vec = np.empty(ns)
-    _matvec(jac, y, k[0])
+    _apply(op, y, k[0])
     t = 0.0
     h = 1e-6
     err_old = 1e-4
@@ -58,7 +73,7 @@ def _dopri_linear(jac, y, t_final, rtol, atol):
                 if a != 0.0:
                     for i in range(ns):
                         ytmp[i] += a * k[j, i]
-            _matvec(jac, ytmp, k[st])
+            _apply(op, ytmp, k[st])
         err_vec[:] = 0.0
         for st in range(7):
             a = hs * E[st]
@@ -89,46 +104,114 @@ def _dopri_linear(jac, y, t_final, rtol, atol):
     return steps
 
 
-def floor_cost(model, duration: float, rtol: float = 1e-6, atol: float = 1e-9,
-               repeat: int = 3) -> tuple[float, int]:
-    """Median wall time per accepted step [s] of the linear floor, and its step count."""
-    from fivdisc.analysis.equilibrium import slip_phases
+def _operators(model) -> dict[str, tuple]:
+    """The model's slip Jacobian J at a generic state, applied two ways: ``dense`` (J as
+    it is, O(n^2) per product) and ``structured`` (J = B + U^T V with B the sparse
+    Jacobian of the free disc and free sliders, and the contact's low-rank rest, O(n))."""
+    import scipy.sparse as sp
 
-    ph, sg = slip_phases(model)
+
+    n_s = model.n_sliders
+    ph = np.full(n_s, SLIP, dtype=np.int64)
+    sg = np.ones(n_s, dtype=np.int64)
     y = np.zeros(model.state_size)
     y[: model.n] = 1e-6
-    y[model.index("phi_dot")] = 1.0
+    for j in range(n_s):
+        y[model.index("phi_dot", j)] = 1.0
     jac = complex_step_jacobian(0.0, y, ph, sg, model.kernel_args)
     # The sliders' own z, zdot are held in contact; keep them so (zero rows).
-    for j in range(model.n_sliders):
+    for j in range(n_s):
         jac[model.index("z", j)] = 0.0
         jac[model.index("z_dot", j)] = 0.0
+    free = complex_step_jacobian(0.0, y, np.full(n_s, SEPARATION, dtype=np.int64), sg,
+                                 model.kernel_args)
+    u, sv, vt = np.linalg.svd(jac - free)
+    rank = int(np.sum(sv > 1e-12 * sv[0]))
+    b = sp.csr_matrix(free)
+    dense = sp.csr_matrix(np.where(jac == 0.0, 0.0, 1.0))
+    dense.data = jac[dense.nonzero()]
+    none = np.zeros((0, model.state_size))
+    return {
+        "dense": (dense.indptr, dense.indices, dense.data, none, none),
+        "structured": (b.indptr, b.indices, b.data,
+                       np.ascontiguousarray((u[:, :rank] * sv[:rank]).T),
+                       np.ascontiguousarray(vt[:rank])),
+    }
+
+
+def floor_cost(model, duration: float, rtol: float = 1e-6, atol: float = 1e-9,
+               repeat: int = 3) -> dict[str, tuple[float, int]]:
+    """Median wall time per accepted step [s] of each linear floor (``_operators``), and
+    its step count."""
     start = np.zeros(model.state_size)
     start[: model.n] = 1e-5
     start[model.n + 2 * model.n_sliders : 2 * model.n + 2 * model.n_sliders] = 1e-2
-    _dopri_linear(jac, start.copy(), 1e-3, rtol, atol)
-    costs = []
-    steps = 0
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        steps = _dopri_linear(jac, start.copy(), duration, rtol, atol)
-        costs.append((time.perf_counter() - t0) / steps)
-    return float(np.median(costs)), steps
+    out = {}
+    for name, op in _operators(model).items():
+        _dopri_linear(op, start.copy(), 1e-3, rtol, atol)
+        costs = []
+        steps = 0
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            steps = _dopri_linear(op, start.copy(), duration, rtol, atol)
+            costs.append((time.perf_counter() - t0) / steps)
+        out[name] = (float(np.median(costs)), steps)
+    return out
+
+
+def _slope(label: str, x: list[int], cost: list[float]) -> None:
+    """Least-squares line through the costs per step, and how far they stray from it."""
+    slope, icpt = np.polyfit(x, cost, 1)
+    stray = max(abs(c - (slope * xi + icpt)) / c for xi, c in zip(x, cost, strict=True))
+    print(f"  slope {slope * 1e6:.3f} us per {label}, intercept {icpt * 1e6:.2f} us; "
+          f"largest deviation from the line {100 * stray:.0f} %")
 
 
 def main() -> None:
-    from bench_family import CASES, per_step
+    from bench_family import CASES, _spread, per_step
     from fivdisc import Case, build_model
 
     fig10 = CASES["fig10"]
     quiet = {**fig10, "simulation": {**fig10["simulation"], "output_rate": 0.1}}
     kernel = per_step({"no output": quiet, "10 kHz output": fig10})
-    floor, steps = floor_cost(build_model(Case(**fig10)), 35.0)
-    print(f"floor (linear DOPRI5, same state size): {floor * 1e6:.2f} us per step "
-          f"({steps} steps)")
+    floors = floor_cost(build_model(Case(**fig10)), 35.0)
+    print("== Fig. 10 case: one slider, 7 modal coordinates")
+    for name, (cost, steps) in floors.items():
+        print(f"floor ({name:10s}): {cost * 1e6:.2f} us per step ({steps} steps)")
     for label, c in kernel.items():
+        ratios = ", ".join(f"{c['cost'] / cost:.2f} x {name}" for name, (cost, _) in
+                           floors.items())
         print(f"kernel, {label:14s}: {c['cost'] * 1e6:.2f} us per step ({c['steps']} steps)"
-              f" -> {c['cost'] / floor:.2f} x floor")
+              f" -> {ratios} floor")
+    print(f"cost of the 10 kHz output: "
+          f"{100 * (kernel['10 kHz output']['cost'] / kernel['no output']['cost'] - 1):+.0f} %")
+
+    print("== modal coordinates (modes (0, l), l <= L; Fig. 10 case, 5 s, no output)")
+    coords, costs = [], []
+    for top in (3, 5, 7, 9, 11):
+        case = {**quiet, "disc": {"modes": [(0, l) for l in range(top + 1)]},
+                "simulation": {**quiet["simulation"], "duration": 5.0}}
+        model = build_model(Case(**case))
+        c = per_step({"k": case})["k"]["cost"]
+        f = floor_cost(model, 5.0)
+        coords.append(model.n)
+        costs.append(c)
+        print(f"{model.n:3d} coordinates: {c * 1e6:.2f} us per step -> "
+              f"{c / f['structured'][0]:.2f} x structured, {c / f['dense'][0]:.2f} x dense floor")
+    _slope("coordinate", coords, costs)
+
+    print("== sliders (Fig. 4 parameters, steady sliding, 5 s)")
+    import tomllib
+
+    from fivdisc import examples
+
+    fig04 = tomllib.loads(examples.path("fig04").read_text())
+    fig04["simulation"] = {**fig04.get("simulation", {}), "duration": 5.0, "output_rate": 100.0}
+    counts = [1, 2, 4, 8]
+    per = per_step({str(s): _spread(fig04, s) for s in counts})
+    for s in counts:
+        print(f"{s} slider(s): {per[str(s)]['cost'] * 1e6:.2f} us per step")
+    _slope("slider", counts, [per[str(s)]["cost"] for s in counts])
 
 
 if __name__ == "__main__":

@@ -67,11 +67,16 @@ def dense_coefficients(y0, y1, k, h, rc):
         rc[4, i] = h * acc
 
 
+@njit(cache=True, inline="always")
+def dense_one(rc, theta, i):
+    """Coordinate ``i`` at fraction ``theta`` of the step from its dense-output
+    coefficients."""
+    th1 = 1.0 - theta
+    return rc[0, i] + theta * (rc[1, i] + th1 * (rc[2, i] + theta * (rc[3, i] + th1 * rc[4, i])))
+
+
 @njit(cache=True, _nrt=False)
 def dense_eval(rc, theta, out):
     """State at fraction ``theta`` of the step from its dense-output coefficients."""
-    th1 = 1.0 - theta
     for i in range(rc.shape[1]):
-        out[i] = rc[0, i] + theta * (
-            rc[1, i] + th1 * (rc[2, i] + theta * (rc[3, i] + th1 * rc[4, i]))
-        )
+        out[i] = dense_one(rc, theta, i)

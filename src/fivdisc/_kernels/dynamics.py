@@ -91,6 +91,12 @@ from fivdisc._kernels.layout import (
     work_rows,
 )
 
+# The side of a speed-profile knot that ``speed_at`` takes (its ``right``): numpy scalars,
+# not True and False, which numba would type as literals and compile every callee
+# that receives them once per value.
+RIGHT = np.bool_(True)
+LEFT = np.bool_(False)
+
 
 @njit(cache=True, _nrt=False)
 def speed_at(t, speed, right):
@@ -151,7 +157,7 @@ def kinetic_friction(opts, table, r, s, v):
         return opts[O_MU1] + (opts[O_MU0] - opts[O_MU1]) * np.exp(-e) + opts[O_MUV] * u
     if u.real < table[0, 0]:
         return table[0, 1] + table[0, 2] * u
-    k = _piece(table, u.real, True)
+    k = _piece(table, u.real, RIGHT)
     tau = u - table[k, 0]
     return table[k, 1] + tau * (table[k, 2] + tau * (table[k, 3] + tau * table[k, 4]))
 
@@ -567,7 +573,7 @@ def complex_step_jacobian(t, y, ph, sg, mdl):
         for j in range(ns):
             yc[j] = y[j]
         yc[i] = y[i] + 1j * step
-        evaluate(t, yc, ph, sg, True, mdl, wk, dy)
+        evaluate(t, yc, ph, sg, RIGHT, mdl, wk, dy)
         for j in range(ns):
             jac[j, i] = dy[j].imag / step
     return jac

@@ -89,7 +89,7 @@ def single_impact(j, y, mdl, wk):
     minv = mdl.disc[D_MINV]
     members = np.array([j])
     u_minus = y.copy()
-    before = _kinetic(y, mdl, members, 1)
+    before = _kinetic(y, mdl, members, members.shape[0])
     m = mdl.slider[S_MASS, j]
     zd_minus = y[half + n + ns + j]
     phid = y[half + n + j]
@@ -102,14 +102,18 @@ def single_impact(j, y, mdl, wk):
     for i in range(n):
         y[half + i] -= m * wk[j, i] * minv[i] * (zd_plus - zd_minus)
     y[half + n + ns + j] = zd_plus
-    _book(y, mdl, before, u_minus, members, 1)
+    _book(y, mdl, before, u_minus, members, members.shape[0])
+
+
+# The active system's first row in its own array (a numpy scalar: see switch.MODE_START).
+_FIRST_ROW = np.int64(0)
 
 
 @njit(cache=True)
 def _solve_active(a, b, x, act, m):
     """x[act] = solution of a[act, act] x = b[act]; x = 0 elsewhere."""
     idx = np.empty(m, np.int64)
-    k = 0
+    k = np.int64(0)  # not a literal: see switch.MODE_START
     for i in range(m):
         x[i] = 0.0
         if act[i]:
@@ -122,7 +126,7 @@ def _solve_active(a, b, x, act, m):
         sub[r, k] = b[idx[r]]
         for c in range(k):
             sub[r, c] = a[idx[r], idx[c]]
-    solve_small(sub, 0, k)
+    solve_small(sub, _FIRST_ROW, k)
     for r in range(k):
         x[idx[r]] = sub[r, k]
 

@@ -17,14 +17,15 @@ import numpy as np
 from numba import njit
 
 from fivdisc._kernels import tangent
-from fivdisc._kernels.dopri5 import A, C, E, dense_coefficients, dense_eval
-from fivdisc._kernels.dynamics import evaluate, event_values, new_work, speed_at
+from fivdisc._kernels.dopri5 import A, C, E, dense_coefficients, dense_eval, dense_one
+from fivdisc._kernels.dynamics import LEFT, evaluate, event_values, new_work, speed_at
 from fivdisc._kernels.layout import (
     A_F,
     A_N,
     A_WC,
     A_WCD,
     SEPARATION,
+    SLIP,
     STICK,
     n_dynamic,
     sizes,
@@ -62,7 +63,15 @@ from fivdisc._kernels.slots import (
     ST_UNDERFLOW,
     ST_ZENO,
 )
-from fivdisc._kernels.switch import MODE_EVENT, MODE_KINK, MODE_START, _aux, _restart, _switch
+from fivdisc._kernels.switch import (
+    MODE_EVENT,
+    MODE_KINK,
+    MODE_START,
+    NO_EVENT,
+    _aux,
+    _restart,
+    _switch,
+)
 
 # Step-size control exponents: 1/5 - 0.75 beta and beta.
 _BETA = 0.04
@@ -72,11 +81,27 @@ _EXPO1 = 0.2 - 0.75 * _BETA
 _PROBES = 4
 
 
+@njit(cache=True, inline="always")
+def _kinematic(i, ph):
+    """Whether event ``i`` is a function of the state alone: a slipping slider's
+    relative speed. The others (normal force, friction against its static limit,
+    gap) need the contact solve of a right-hand side."""
+    return i % 3 == 0 and ph[i // 3] == SLIP
+
+
 @njit(cache=True, _nrt=False)
 def _event_at(theta, i, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist):
+    """Event ``i`` at fraction ``theta`` of the step. A kinematic event is computed
+    from the dense output of phidot alone, with the operations ``evaluate`` and
+    ``event_values`` use (so the same value); any other fills ``evt`` with every
+    event's value there."""
+    if _kinematic(i, ph):
+        n, _, half = sizes(mdl)
+        om, _ = speed_at(t + theta * h, mdl.speed, LEFT)
+        return sg[i // 3] * (om - dense_one(rc, theta, half + n + i // 3))
     ist[I_EVAL_EVENTS] += 1
     dense_eval(rc, theta, ytmp)
-    evaluate(t + theta * h, ytmp, ph, sg, False, mdl, wk, dy)
+    evaluate(t + theta * h, ytmp, ph, sg, LEFT, mdl, wk, dy)
     event_values(ph, sg, ytmp, mdl, wk, evt)
     return evt[i]
 
@@ -147,8 +172,8 @@ def _write_sample(i, ti, ys, ph, sg, mdl, wk, dy, out_y, out_aux):
     N, f, phase, w under it (columns j, S + j, 2 S + j, 3 S + j), then Omega."""
     aux = _aux(mdl, wk)
     n, ns, half = sizes(mdl)
-    evaluate(ti, ys, ph, sg, False, mdl, wk, dy)
-    om, _ = speed_at(ti, mdl.speed, False)
+    evaluate(ti, ys, ph, sg, LEFT, mdl, wk, dy)
+    om, _ = speed_at(ti, mdl.speed, LEFT)
     for j in range(ns):
         if ph[j] == STICK:
             ys[half + n + j] = om
@@ -187,7 +212,7 @@ def _initial_step(t, y, f0, ph, sg, mdl, wk, ctl, ytmp, dy, m):
         h0 = 0.01 * d0 / d1
     for i in range(y.shape[0]):
         ytmp[i] = y[i] + h0 * f0[i]
-    evaluate(t + h0, ytmp, ph, sg, False, mdl, wk, dy)
+    evaluate(t + h0, ytmp, ph, sg, LEFT, mdl, wk, dy)
     for i in range(y.shape[0]):
         dy[i] = (dy[i] - f0[i]) / h0
     d2 = _rms_scaled(dy, y, y, atol, rtol, m)
@@ -223,6 +248,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
     rc = np.empty((5, ns))
     evn = np.empty(n_ev)
     evt = np.empty(n_ev)
+    probes = np.empty((_PROBES, n_ev))
     err_vec = np.empty(ns)
     rtol = ctl[C_RTOL]
     atol = ctl[C_ATOL]
@@ -243,18 +269,18 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
             ph_start = ph.copy()
             ypre[:] = y[:nd]
             sgpre[:] = sg
-        _switch(MODE_START, -1, t, y, ph, sg, ph, ev_prev, mdl, wk, dy, k, ev_prev, ev_t, ev_i,
-                ist, fst)
+        _switch(MODE_START, NO_EVENT, t, y, ph, sg, ph, ev_prev, mdl, wk, dy, k, ev_prev, ev_t,
+                ev_i, ist, fst)
         _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
         if tan is not None:
-            tangent.saltation(MODE_START, -1, t, ypre, ph_start, sgpre, ev_prev, y, ph, sg,
+            tangent.saltation(MODE_START, NO_EVENT, t, ypre, ph_start, sgpre, ev_prev, y, ph, sg,
                               k[0], mdl, tv, tk, tsc)
         if h <= 0.0:
             h = _initial_step(t, y, k[0], ph, sg, mdl, wk, ctl, ytmp, dy, nd)
         if ist[I_OUT_NEXT] == 0 and out_y.shape[0] > 0:
             for i in range(ns):
                 yout[i] = y[i]
-            _write_sample(0, t, yout, ph, sg, mdl, wk, dy, out_y, out_aux)
+            _write_sample(ist[I_OUT_NEXT], t, yout, ph, sg, mdl, wk, dy, out_y, out_aux)
             ist[I_OUT_NEXT] = 1
         ist[I_STARTED] = 1
         ist[I_RHS] += 2
@@ -287,7 +313,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
                 if a != 0.0:
                     for i in range(ns):
                         ytmp[i] += a * k[j, i]
-            evaluate(t + C[st] * hs, ytmp, ph, sg, False, mdl, wk, k[st])
+            evaluate(t + C[st] * hs, ytmp, ph, sg, LEFT, mdl, wk, k[st])
             if tan is not None:
                 tangent.keep(st, ytmp, wk, n_sl, tys, twk)
         for i in range(ns):
@@ -322,7 +348,8 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
         event_values(ph, sg, ynew, mdl, wk, evn)
 
         have_rc = False
-        which = -1
+        probed = 0
+        which = NO_EVENT
         theta = 2.0
         for i in range(n_ev):
             if evn[i] == np.inf:
@@ -344,7 +371,14 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
                 g_lo = ev_prev[i]
                 for p in range(1, _PROBES):
                     tp = p / _PROBES
-                    gp = _event_at(tp, i, t, hs, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist)
+                    # One right-hand side at a probe serves every event probed there.
+                    if _kinematic(i, ph) or (probed >> p) & 1 == 0:
+                        gp = _event_at(tp, i, t, hs, rc, ph, sg, mdl, wk, dy, ytmp,
+                                       probes[p], ist)
+                        if not _kinematic(i, ph):
+                            probed |= 1 << p
+                    else:
+                        gp = probes[p, i]
                     if gp <= 0.0:
                         th = locate(i, (p - 1) / _PROBES, tp, g_lo, gp, t, hs, rc, ph, sg,
                                     mdl, wk, dy, ytmp, evt, ist)
@@ -441,12 +475,12 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
                 ph_start = ph.copy()
                 ypre[:] = y[:nd]
                 sgpre[:] = sg
-            _switch(MODE_KINK, -1, t, y, ph, sg, ph, ev_prev, mdl, wk, dy, k, ev_prev, ev_t,
+            _switch(MODE_KINK, NO_EVENT, t, y, ph, sg, ph, ev_prev, mdl, wk, dy, k, ev_prev, ev_t,
                     ev_i, ist, fst)
             _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
             ist[I_RHS] += 1
             if tan is not None:
-                tangent.saltation(MODE_KINK, -1, t, ypre, ph_start, sgpre, ev_prev, y, ph, sg,
+                tangent.saltation(MODE_KINK, NO_EVENT, t, ypre, ph_start, sgpre, ev_prev, y, ph, sg,
                                   k[0], mdl, tv, tk, tsc)
 
     fst[F_T] = t

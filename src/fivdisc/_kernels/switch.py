@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from fivdisc._kernels.dynamics import evaluate, event_values, speed_at
+from fivdisc._kernels.dynamics import RIGHT, evaluate, event_values, speed_at
 from fivdisc._kernels.impact import contact_impact, contact_velocity, single_impact
 from fivdisc._kernels.layout import (
     A_F,
@@ -70,12 +70,12 @@ def choose_phase(j, t, y, ph, sg, mdl, wk, dy):
     (with its sign) or, where contact would need a pulling normal force, separation."""
     aux = _aux(mdl, wk)
     n, _, half = sizes(mdl)
-    om, _ = speed_at(t, mdl.speed, True)
+    om, _ = speed_at(t, mdl.speed, RIGHT)
     v = (om - y[half + n + j]).real
     s = sg[j]
     if v == 0.0:
         ph[j] = STICK
-        evaluate(t, y, ph, sg, True, mdl, wk, dy)
+        evaluate(t, y, ph, sg, RIGHT, mdl, wk, dy)
         nf = aux[A_N, j].real
         f = aux[A_F, j].real
         if nf > 0.0 and abs(f) < mdl.opts[O_MUS] * nf:
@@ -90,7 +90,7 @@ def choose_phase(j, t, y, ph, sg, mdl, wk, dy):
         s = -1
     ph[j] = SLIP
     sg[j] = s
-    evaluate(t, y, ph, sg, True, mdl, wk, dy)
+    evaluate(t, y, ph, sg, RIGHT, mdl, wk, dy)
     if aux[A_N, j].real < 0.0:
         _separate(j, y, ph, mdl, wk)
 
@@ -133,9 +133,9 @@ def settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist):
     n, ns, half = sizes(mdl)
     if ns == 1:
         return
-    om, _ = speed_at(t, mdl.speed, True)
+    om, _ = speed_at(t, mdl.speed, RIGHT)
     for _ in range(4 * ns + 4):
-        evaluate(t, y, ph, sg, True, mdl, wk, dy)
+        evaluate(t, y, ph, sg, RIGHT, mdl, wk, dy)
         changed = False
         for k in range(ns):
             if ph[k] == SEPARATION:
@@ -188,7 +188,7 @@ def _impact(j, t, y, ph, sg, mdl, wk, dy, fst, released):
     n, ns, half = sizes(mdl)
     members = np.empty(ns, np.int64)
     members[0] = j
-    count = 1
+    count = np.int64(1)
     for k in range(ns):
         if k != j and ph[k] != SEPARATION:
             members[count] = k
@@ -226,7 +226,7 @@ def _impact(j, t, y, ph, sg, mdl, wk, dy, fst, released):
                 y[n + ns + k] = aux[A_WC, k]
             elif k == j:
                 ph[k] = SLIP
-        evaluate(t, y, ph, sg, True, mdl, wk, dy)
+        evaluate(t, y, ph, sg, RIGHT, mdl, wk, dy)
         again = False
         for a in range(count):
             wa = w[a].real
@@ -264,7 +264,7 @@ def apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst):
     which = e % 3
     if ph[j] == SEPARATION:
         # Re-contact: g, g' at the landing state for the impact map, then the phases.
-        evaluate(t, y, ph, sg, True, mdl, wk, dy)
+        evaluate(t, y, ph, sg, RIGHT, mdl, wk, dy)
         released = np.empty(ns, np.int64)
         nrel = 0
         if mdl.opts[O_IMPACT] != 0.0:
@@ -304,10 +304,10 @@ def apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst):
         return
     is_normal_force_event = (ph[j] == SLIP and which == 1) or (ph[j] == STICK and which == 2)
     if is_normal_force_event:
-        evaluate(t, y, ph, sg, True, mdl, wk, dy)
+        evaluate(t, y, ph, sg, RIGHT, mdl, wk, dy)
         old = ph[j]
         if old == STICK:
-            om, _ = speed_at(t, mdl.speed, True)
+            om, _ = speed_at(t, mdl.speed, RIGHT)
             y[half + n + j] = om
         _separate(j, y, ph, mdl, wk)
         _record(t, EV_SEPARATION, old, SEPARATION, j, ev_t, ev_i, ist)
@@ -315,7 +315,7 @@ def apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst):
         return
     # Relative velocity reached zero (slip) or the static limit was reached (stick):
     # the slider moves with the disc at this instant; decide from the forces.
-    om, _ = speed_at(t, mdl.speed, True)
+    om, _ = speed_at(t, mdl.speed, RIGHT)
     y[half + n + j] = om
     old = ph[j]
     old_s = sg[j]
@@ -334,7 +334,7 @@ def _simultaneous(first, t, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k, ev_pr
     handled = np.zeros(n_sl, np.bool_)
     handled[first // 3] = True
     for _ in range(n_sl):
-        nxt = -1
+        nxt = NO_EVENT
         for i in range(ev_prev.shape[0]):
             j = i // 3
             if (not handled[j] and ph[j] == ph_start[j] and ev_start[i] > 0.0
@@ -351,7 +351,7 @@ def _simultaneous(first, t, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k, ev_pr
 
 @njit(cache=True)
 def _restart(t, y, ph, sg, mdl, wk, k, ev_prev):
-    evaluate(t, y, ph, sg, True, mdl, wk, k[0])
+    evaluate(t, y, ph, sg, RIGHT, mdl, wk, k[0])
     event_values(ph, sg, y, mdl, wk, ev_prev)
 
 
@@ -368,10 +368,15 @@ def start(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist):
     settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
 
 
-# What _switch does.
-MODE_START = 0
-MODE_EVENT = 1
-MODE_KINK = 2
+# What _switch does, and the event index of a switch no event triggered. numpy scalars,
+# not Python ints: numba types a Python int passed to a compiled function as a literal
+# and compiles the callee anew for each value; a variable that starts from one (a
+# counter, "none found yet") is passed as that literal too while its type is inferred,
+# so such variables start from numpy scalars as well.
+MODE_START = np.int64(0)
+MODE_EVENT = np.int64(1)
+MODE_KINK = np.int64(2)
+NO_EVENT = np.int64(-1)
 
 
 @njit(cache=True)
@@ -395,7 +400,7 @@ def _switch(mode, e, t, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k, ev_prev, 
                           ev_t, ev_i, ist, fst)
         return
     # Speed-profile kink: Omegadot jumps, so the stick reaction does too.
-    om, _ = speed_at(t, mdl.speed, True)
+    om, _ = speed_at(t, mdl.speed, RIGHT)
     for j in range(n_sl):
         if ph[j] == SEPARATION:
             continue

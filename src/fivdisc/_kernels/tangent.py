@@ -34,7 +34,14 @@ import numpy as np
 from numba import njit
 
 from fivdisc._kernels.dopri5 import A, C, dense_coefficients, dense_eval
-from fivdisc._kernels.dynamics import evaluate, event_values, linearised_one, new_work
+from fivdisc._kernels.dynamics import (
+    LEFT,
+    RIGHT,
+    evaluate,
+    event_values,
+    linearised_one,
+    new_work,
+)
 from fivdisc._kernels.layout import (
     A_WC,
     A_WCD,
@@ -184,7 +191,7 @@ def prepare(t, y, ph, sg, mdl, V, KV):
     zeroed, first stages evaluated."""
     sc = scratch(mdl, y, V.shape[0])
     wk = sc[8]
-    evaluate(t, y, ph, sg, True, mdl, wk, np.empty_like(y))
+    evaluate(t, y, ph, sg, RIGHT, mdl, wk, np.empty_like(y))
     for r in range(V.shape[0]):
         slave(ph, mdl, V[r])
         jvp(t, y, V[r], ph, sg, True, mdl, wk, sc[0], KV[r, 0])
@@ -201,7 +208,7 @@ def _event_rate(e, t, y, ph, sg, mdl, sc, v, dt):
     for i in range(nd):
         yc[i] = complex(y[i], h * v[i])
     tc = complex(t, h * dt)
-    evaluate(tc, yc, ph, sg, False, mdl, wkc, dyc)
+    evaluate(tc, yc, ph, sg, LEFT, mdl, wkc, dyc)
     event_values(ph, sg, yc, mdl, wkc, evc)
     return evc[e].imag / h
 
@@ -224,7 +231,7 @@ def saltation(mode, e, t, ypre, ph_pre, sg_pre, ev_start, y, ph, sg, fplus, mdl,
     fst = np.full(N_FSTATE, np.inf)
     hdot = 1.0
     if mode == MODE_EVENT:
-        evaluate(t, ypre, ph_pre, sg_pre, False, mdl, wkr, fm)
+        evaluate(t, ypre, ph_pre, sg_pre, LEFT, mdl, wkr, fm)
         hdot = _event_rate(e, t, ypre, ph_pre, sg_pre, mdl, sc, fm, 1.0)
     else:
         fm[:] = 0.0
@@ -250,7 +257,7 @@ def saltation(mode, e, t, ypre, ph_pre, sg_pre, ev_start, y, ph, sg, fplus, mdl,
             V[r, i] = yc[i].imag / h - fplus[i] * dtau
         slave(ph, mdl, V[r])
     # The new phases' right-hand side at the new state, for the first stages.
-    evaluate(t, y, ph, sg, True, mdl, wkr, np.empty_like(y))
+    evaluate(t, y, ph, sg, RIGHT, mdl, wkr, np.empty_like(y))
     for r in range(V.shape[0]):
         jvp(t, y, V[r], ph, sg, True, mdl, wkr, sc[0], KV[r, 0])
 
@@ -271,7 +278,7 @@ def unslaved(t, y, ph, sg, mdl, V):
         h = _STEP / scale
         for i in range(nd):
             yc[i] = complex(y[i], h * V[r, i])
-        evaluate(t, yc, ph, sg, False, mdl, wkc, dyc)
+        evaluate(t, yc, ph, sg, LEFT, mdl, wkc, dyc)
         for j in range(ns):
             if ph[j] != SEPARATION:
                 out[r, n + ns + j] = wkc[aux + A_WC, j].imag / h
