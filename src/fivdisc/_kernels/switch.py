@@ -95,7 +95,9 @@ def choose_phase(j, t, y, ph, sg, mdl, wk, dy):
         _separate(j, y, ph, mdl, wk)
 
 
-@njit(cache=True)
+# Inlined: its callers pass the event kinds and phases as literals, which would otherwise
+# compile it once per combination.
+@njit(cache=True, inline="always")
 def _record(t, kind, frm, to, j, ev_t, ev_i, ist):
     i = ist[I_EVENTS]
     if i < ev_t.shape[0]:

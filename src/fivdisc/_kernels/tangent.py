@@ -125,7 +125,7 @@ def keep(st, y, wk, n_sl, ys, wks):
     for i in range(y.shape[0]):
         ys[st, i] = y[i]
     if n_sl == 1:
-        _, _, trig, aux, _, _ = work_rows(1)
+        _, _, trig, aux, _, _ = work_rows(n_sl)
         for a in range(trig):
             for i in range(wk.shape[1]):
                 wks[st, a, i] = wk[a, i]
@@ -262,6 +262,10 @@ def saltation(mode, e, t, ypre, ph_pre, sg_pre, ev_start, y, ph, sg, fplus, mdl,
         jvp(t, y, V[r], ph, sg, True, mdl, wkr, sc[0], KV[r, 0])
 
 
+# One vector's scratch, as a numpy scalar (see switch.MODE_START).
+_ONE_VECTOR = np.int64(1)
+
+
 @njit(cache=True)
 def unslaved(t, y, ph, sg, mdl, V):
     """Tangents with the slaved rows filled in: ``z_j``, ``zdot_j`` of a slider in
@@ -270,7 +274,7 @@ def unslaved(t, y, ph, sg, mdl, V):
     n, ns, half = sizes(mdl)
     nd = V.shape[1]
     out = V.copy()
-    sc = scratch(mdl, y, 1)
+    sc = scratch(mdl, y, _ONE_VECTOR)
     yc, dyc, wkc = sc[0]
     aux = work_rows(ns)[3]
     for r in range(V.shape[0]):
