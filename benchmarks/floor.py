@@ -128,8 +128,7 @@ def _operators(model) -> dict[str, tuple]:
     u, sv, vt = np.linalg.svd(jac - free)
     rank = int(np.sum(sv > 1e-12 * sv[0]))
     b = sp.csr_matrix(free)
-    dense = sp.csr_matrix(np.where(jac == 0.0, 0.0, 1.0))
-    dense.data = jac[dense.nonzero()]
+    dense = sp.csr_matrix(jac)
     none = np.zeros((0, model.state_size))
     return {
         "dense": (dense.indptr, dense.indices, dense.data, none, none),

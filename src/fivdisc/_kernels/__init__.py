@@ -1,5 +1,13 @@
 """Compiled kernels (numba). Importing the package keys their on-disk cache to the
-sources of all of them (:mod:`fivdisc._kernels.cache`)."""
+sources of all of them (:mod:`fivdisc._kernels.cache`).
+
+Integer and boolean constants that the kernels pass to compiled functions are numpy
+scalars (``dynamics.RIGHT``, ``switch.MODE_START``, ...), and so are variables that start
+from a constant and are passed on (counters, "none found yet"): numba types a Python
+``int`` or ``bool`` there as a literal and compiles the callee once per value, which
+made the first compilation about 40 % longer. ``tests/test_kernel_literals.py`` checks
+the call sites.
+"""
 
 from fivdisc._kernels.cache import install
 

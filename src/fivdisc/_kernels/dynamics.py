@@ -91,9 +91,8 @@ from fivdisc._kernels.layout import (
     work_rows,
 )
 
-# The side of a speed-profile knot that ``speed_at`` takes (its ``right``): numpy scalars,
-# not True and False, which numba would type as literals and compile every callee
-# that receives them once per value.
+# The side of a speed-profile knot that ``speed_at`` takes (its ``right``); numpy
+# scalars, not literals (see the package docstring).
 RIGHT = np.bool_(True)
 LEFT = np.bool_(False)
 

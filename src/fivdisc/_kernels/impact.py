@@ -105,7 +105,7 @@ def single_impact(j, y, mdl, wk):
     _book(y, mdl, before, u_minus, members, members.shape[0])
 
 
-# The active system's first row in its own array (a numpy scalar: see switch.MODE_START).
+# The active system's first row in its own array; not a literal (see the package docstring).
 _FIRST_ROW = np.int64(0)
 
 
@@ -113,7 +113,7 @@ _FIRST_ROW = np.int64(0)
 def _solve_active(a, b, x, act, m):
     """x[act] = solution of a[act, act] x = b[act]; x = 0 elsewhere."""
     idx = np.empty(m, np.int64)
-    k = np.int64(0)  # not a literal: see switch.MODE_START
+    k = np.int64(0)
     for i in range(m):
         x[i] = 0.0
         if act[i]:

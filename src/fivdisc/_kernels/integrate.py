@@ -369,13 +369,14 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
                     have_rc = True
                 th = 2.0
                 g_lo = ev_prev[i]
+                kinematic = _kinematic(i, ph)
                 for p in range(1, _PROBES):
                     tp = p / _PROBES
                     # One right-hand side at a probe serves every event probed there.
-                    if _kinematic(i, ph) or (probed >> p) & 1 == 0:
+                    if kinematic or (probed >> p) & 1 == 0:
                         gp = _event_at(tp, i, t, hs, rc, ph, sg, mdl, wk, dy, ytmp,
                                        probes[p], ist)
-                        if not _kinematic(i, ph):
+                        if not kinematic:
                             probed |= 1 << p
                     else:
                         gp = probes[p, i]

@@ -370,11 +370,8 @@ def start(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist):
     settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
 
 
-# What _switch does, and the event index of a switch no event triggered. numpy scalars,
-# not Python ints: numba types a Python int passed to a compiled function as a literal
-# and compiles the callee anew for each value; a variable that starts from one (a
-# counter, "none found yet") is passed as that literal too while its type is inferred,
-# so such variables start from numpy scalars as well.
+# What _switch does, and the event index of a switch no event triggered; numpy scalars,
+# not literals (see the package docstring).
 MODE_START = np.int64(0)
 MODE_EVENT = np.int64(1)
 MODE_KINK = np.int64(2)

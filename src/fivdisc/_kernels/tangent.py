@@ -262,7 +262,7 @@ def saltation(mode, e, t, ypre, ph_pre, sg_pre, ev_start, y, ph, sg, fplus, mdl,
         jvp(t, y, V[r], ph, sg, True, mdl, wkr, sc[0], KV[r, 0])
 
 
-# One vector's scratch, as a numpy scalar (see switch.MODE_START).
+# One vector's scratch; not a literal (see the package docstring).
 _ONE_VECTOR = np.int64(1)
 
 
