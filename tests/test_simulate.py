@@ -231,3 +231,37 @@ def test_bad_initial_state_is_rejected():
         simulate(case, initial={"q": [1.0, 2.0]})
     with pytest.raises(SimulationError, match="stop_on"):
         simulate(case, stop_on=("explosion",))
+
+
+def test_the_kernel_lets_other_threads_run():
+    """The integration kernel releases the GIL, so that the imports of fivdisc.warmup
+    overlap it: a thread waking every millisecond keeps waking during one long kernel
+    call. Holding the GIL, the call would let it wake at most once."""
+    import threading
+    import time
+
+    from fivdisc.integration import Integration
+    from fivdisc.simulate import initial_state
+
+    model = build_model(Case())
+    run = Integration(model, initial_state(model), duration=20.0)
+    run.advance(0.0)  # loads the kernel
+    ticks: list[float] = []
+    done = threading.Event()
+
+    def tick() -> None:
+        while not done.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(1e-3)
+
+    thread = threading.Thread(target=tick)
+    thread.start()
+    time.sleep(0.01)
+    start = time.perf_counter()
+    run.advance(20.0)
+    end = time.perf_counter()
+    done.set()
+    thread.join()
+    assert run.t == 20.0
+    assert end - start > 0.05, "too short a call to tell"
+    assert sum(start < t < end for t in ticks) >= 10

@@ -81,3 +81,21 @@ def test_simulate_stays_the_function_when_its_module_is_imported_first():
             "assert fivdisc.simulate is simulate is sys.modules['fivdisc.simulate'].simulate\n")
     out = _run(code)
     assert out.returncode == 0, out.stderr
+
+
+def test_the_simulator_leaves_the_result_libraries_to_the_warm_up():
+    """Importing the simulator imports neither xarray nor the netCDF engine: a run imports
+    them in a thread while its kernel integrates (fivdisc.warmup), and the waiter it gets
+    returns only once they are imported."""
+    code = (
+        "import sys\n"
+        "import fivdisc.simulate\n"
+        "print(sorted(m for m in ('xarray', 'netCDF4') if m in sys.modules))\n"
+        "from fivdisc.warmup import warm_up\n"
+        "wait = warm_up('xarray', 'netcdf')\n"
+        "wait()\n"
+        "print(sorted(m for m in ('xarray', 'netCDF4') if m in sys.modules))\n"
+    )
+    out = _run(code)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.splitlines() == ["[]", "['netCDF4', 'xarray']"]

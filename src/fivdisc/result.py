@@ -14,12 +14,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import xarray as xr
 
 from fivdisc.errors import FivdiscError
 
 if TYPE_CHECKING:
     import pandas as pd
+    import xarray as xr
     from matplotlib.figure import Figure
 
     from fivdisc.case import Case
@@ -32,6 +32,8 @@ EVENT_KINDS = ("stick", "slip", "reversal", "separation", "recontact")
 
 
 def _var(dims, data, units: str, long_name: str, **attrs) -> xr.Variable:
+    import xarray as xr
+
     return xr.Variable(dims, data, attrs={"units": units, "long_name": long_name, **attrs})
 
 
@@ -143,6 +145,8 @@ def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarr
 
     title = f"fivdisc simulation: {describe_run(model.case, model.speed)}"
     attrs = {**global_attrs(title, "fivdisc.simulate"), "case_name": "", **attrs}
+    import xarray as xr
+
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
@@ -496,6 +500,8 @@ def open_result(path: str | PathLike[str], run: str | None = None) -> Result:
                                f"{', '.join(runs)}")
         if not runs and run is not None:
             raise FivdiscError(f"run = {run!r} is invalid: {path} holds one run; leave run out")
+        import xarray as xr
+
         with xr.open_dataset(path, group=run) as stored:
             ds = stored.load()
     except (OSError, ValueError) as exc:

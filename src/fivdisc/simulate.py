@@ -18,6 +18,7 @@ from fivdisc.limits import check_simulation
 from fivdisc.model import Model, build_model
 from fivdisc.result import EVENT_KINDS, PHASE_NAMES, Result, build_dataset
 from fivdisc.speed import SpeedProfile
+from fivdisc.warmup import warm_up
 
 # Failures in which a state beyond the plate theory's range means the model diverged.
 _BLOW_UPS = ("nonfinite", "step_size_underflow")
@@ -149,6 +150,7 @@ def simulate(
     # (and the wall time excludes the compilation, announced with the bar).
     with compile_notice(kern.run, show=progress):
         run.advance(0.0)
+    imported = warm_up("xarray")
     bar = None
     if progress:
         from tqdm import tqdm
@@ -209,6 +211,7 @@ def simulate(
         "final_phase": ph.copy(),
         "final_state": y.copy(),
     }
+    imported()
     ds = build_dataset(model, run.out_y[:n_done], run.out_aux[:n_done], times, run.events(),
                        attrs)
     return Result(ds)

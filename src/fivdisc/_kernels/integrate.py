@@ -223,7 +223,9 @@ def _initial_step(t, y, f0, ph, sg, mdl, wk, ctl, ytmp, dy, m):
     return min(100.0 * h0, h1)
 
 
-@njit(cache=True)
+# nogil: the caller may import what it needs next in another thread meanwhile
+# (fivdisc.warmup).
+@njit(cache=True, nogil=True)
 def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_aux, ev_t,
         ev_i, tan=None):
     """Advance the integration until ``t >= t_target``, the end, a failure, or a nearly

@@ -29,11 +29,14 @@ def simulate(case_file: Path, output: Path | None, progress: bool) -> None:
     from fivdisc.case import load_case
     from fivdisc.files import NETCDF, check_output
     from fivdisc.simulate import simulate as run
+    from fivdisc.warmup import warm_up
 
     case = load_case(case_file)
     out = check_output(output or default_output(case_file, ".nc"), "-o", NETCDF,
                        inputs=[case_file])
+    imported = warm_up("xarray", "netcdf")
     result = run(case, progress=progress).named(case_file.stem)
+    imported()
     result.to_netcdf(out)
     click.echo(f"wrote {out}")
     for line in result.summary().lines()[1:]:

@@ -1,0 +1,73 @@
+"""Imports a run will need next, done in a background thread while the kernel integrates.
+
+The integration kernel releases the GIL (``nogil``), so while it runs a second thread can
+import what the result needs afterwards: xarray (whose first variable imports the array
+libraries it finds installed, dask.array among them) and, for a command that writes
+netCDF, the netCDF engine (xarray's writer asks dask for its scheduler, which imports
+dask.distributed when installed). On a machine with two cores these imports, about half
+a second, then cost no wall time. In a process that already has them it does nothing.
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+from collections.abc import Callable
+
+
+def _xarray() -> None:
+    import numpy as np
+    import xarray as xr
+
+    xr.Variable("x", np.zeros(1))
+
+
+def _netcdf() -> None:
+    import netCDF4  # noqa: F401
+
+    try:
+        from dask.base import get_scheduler
+    except ImportError:
+        return
+    get_scheduler()
+
+
+_TASKS: dict[str, tuple[Callable[[], None], str]] = {
+    # name: (what to do, the module whose presence says it was done)
+    "xarray": (_xarray, "xarray"),
+    "netcdf": (_netcdf, "netCDF4"),
+}
+_threads: dict[str, threading.Thread] = {}
+
+
+def _quietly(tasks: list[Callable[[], None]]) -> None:
+    for task in tasks:
+        try:
+            task()
+        except Exception:
+            # A failure here (a missing optional library, say) is the main thread's to
+            # report, when it imports the same module and needs it.
+            return
+
+
+def warm_up(*names: str) -> Callable[[], None]:
+    """Start importing ``names`` (``"xarray"``, ``"netcdf"``) in a daemon thread.
+
+    Returns a function that waits until they are imported: call it before using the
+    modules, so that the main thread never imports them while the thread is half-way
+    through. Names imported before are skipped; one already started is waited for.
+    """
+    todo = [name for name in names
+            if name not in _threads and _TASKS[name][1] not in sys.modules]
+    if todo:
+        thread = threading.Thread(target=_quietly, args=([_TASKS[n][0] for n in todo],),
+                                  name="fivdisc-warm-up", daemon=True)
+        _threads.update(dict.fromkeys(todo, thread))
+        thread.start()
+    waits = {_threads[name] for name in names if name in _threads}
+
+    def wait() -> None:
+        for thread in waits:
+            thread.join()
+
+    return wait
