@@ -166,7 +166,7 @@ def _write_outputs(t0, t1, h, rc, ph, sg, mdl, wk, dy, ytmp, ctl, out_y, out_aux
     ist[I_OUT_NEXT] = i
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, inline="always")
 def _write_sample(i, ti, ys, ph, sg, mdl, wk, dy, out_y, out_aux):
     """One output row: the state with the contact kinematics filled in, and per slider
     N, f, phase, w under it (columns j, S + j, 2 S + j, 3 S + j), then Omega."""
@@ -199,7 +199,7 @@ def _rms_scaled(a, y0, y1, atol, rtol, m):
     return np.sqrt(acc / m)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _initial_step(t, y, f0, ph, sg, mdl, wk, ctl, ytmp, dy, m):
     """Starting step size (Hairer, Norsett & Wanner, Sec. II.4)."""
     rtol = ctl[C_RTOL]

@@ -177,7 +177,7 @@ def _surface_acceleration(k, y, mdl, wk, dy):
     return acc
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _impact(j, t, y, ph, sg, mdl, wk, dy, fst, released):
     """Plastic impact of slider j landing while others are in contact.
 
@@ -326,7 +326,7 @@ def apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst):
     settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _simultaneous(first, t, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k, ev_prev, ev_t, ev_i,
                   ist, fst):
     """Switches of other sliders whose events crossed zero at the same instant as event
@@ -351,13 +351,13 @@ def _simultaneous(first, t, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k, ev_pr
         ist[I_RHS] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _restart(t, y, ph, sg, mdl, wk, k, ev_prev):
     evaluate(t, y, ph, sg, RIGHT, mdl, wk, k[0])
     event_values(ph, sg, y, mdl, wk, ev_prev)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def start(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist):
     """Phases at the start: each slider in contact takes the phase its state allows, in
     slider order; one whose contact would need N < 0 starts separated (recorded)."""
