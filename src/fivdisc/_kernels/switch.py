@@ -126,7 +126,7 @@ def _record_change(t, old_phase, old_s, new_phase, new_s, j, ev_t, ev_i, ist):
     _record(t, kind, old_phase, new_phase, j, ev_t, ev_i, ist)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist):
     """After a switch, re-check every slider in contact (several sliders only): one that
     would need N < 0 separates, a sticking one beyond the static limit slips; violators
@@ -257,9 +257,10 @@ def _impact(j, t, y, ph, sg, mdl, wk, dy, fst, released):
     return nrel
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst):
-    """Carry the state across the switch triggered by event ``e`` (slider e // 3)."""
+    """Carry the state across the switch triggered by event ``e`` (slider e // 3); the
+    caller settles the other sliders."""
     aux = _aux(mdl, wk)
     n, ns, half = sizes(mdl)
     j = e // 3
@@ -302,7 +303,6 @@ def apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst):
             k = released[a]
             if k != j:
                 _record(t, EV_SEPARATION, before[k], SEPARATION, k, ev_t, ev_i, ist)
-        settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
         return
     is_normal_force_event = (ph[j] == SLIP and which == 1) or (ph[j] == STICK and which == 2)
     if is_normal_force_event:
@@ -313,7 +313,6 @@ def apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst):
             y[half + n + j] = om
         _separate(j, y, ph, mdl, wk)
         _record(t, EV_SEPARATION, old, SEPARATION, j, ev_t, ev_i, ist)
-        settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
         return
     # Relative velocity reached zero (slip) or the static limit was reached (stick):
     # the slider moves with the disc at this instant; decide from the forces.
@@ -323,32 +322,19 @@ def apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst):
     old_s = sg[j]
     choose_phase(j, t, y, ph, sg, mdl, wk, dy)
     _record_change(t, old, old_s, ph[j], sg[j], j, ev_t, ev_i, ist)
-    settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
 
 
 @njit(cache=True, inline="always")
-def _simultaneous(first, t, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k, ev_prev, ev_t, ev_i,
-                  ist, fst):
-    """Switches of other sliders whose events crossed zero at the same instant as event
-    ``first`` (identical sliders, say), taken one after the other in slider order; without
-    this they would be seen only at the end of the next step."""
-    n_sl = ph.shape[0]
-    handled = np.zeros(n_sl, np.bool_)
-    handled[first // 3] = True
-    for _ in range(n_sl):
-        nxt = NO_EVENT
-        for i in range(ev_prev.shape[0]):
-            j = i // 3
-            if (not handled[j] and ph[j] == ph_start[j] and ev_start[i] > 0.0
-                    and ev_prev[i].real <= 0.0):
-                nxt = i
-                break
-        if nxt < 0:
-            return
-        handled[nxt // 3] = True
-        apply_switch(nxt, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst)
-        _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
-        ist[I_RHS] += 1
+def _simultaneous(handled, ph, ph_start, ev_start, ev_prev):
+    """The first event of a slider not yet handled whose function crossed zero at the
+    same instant as the switch just made (identical sliders, say), or ``NO_EVENT``;
+    without this it would be seen only at the end of the next step."""
+    for i in range(ev_prev.shape[0]):
+        j = i // 3
+        if (not handled[j] and ph[j] == ph_start[j] and ev_start[i] > 0.0
+                and ev_prev[i].real <= 0.0):
+            return i
+    return NO_EVENT
 
 
 @njit(cache=True, inline="always")
@@ -360,14 +346,14 @@ def _restart(t, y, ph, sg, mdl, wk, k, ev_prev):
 @njit(cache=True, inline="always")
 def start(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist):
     """Phases at the start: each slider in contact takes the phase its state allows, in
-    slider order; one whose contact would need N < 0 starts separated (recorded)."""
+    slider order; one whose contact would need N < 0 starts separated (recorded).
+    The caller settles them."""
     ns = ph.shape[0]
     for j in range(ns):
         if ph[j] != SEPARATION:
             choose_phase(j, t, y, ph, sg, mdl, wk, dy)
             if ph[j] == SEPARATION:
                 _record(t, EV_SEPARATION, SLIP, SEPARATION, j, ev_t, ev_i, ist)
-    settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
 
 
 # What _switch does, and the event index of a switch no event triggered; numpy scalars,
@@ -386,19 +372,33 @@ def _switch(mode, e, t, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k, ev_prev, 
     ``ev_start`` are the phases and event values at the start of the step), or a kink of
     the speed profile (``MODE_KINK``). The right-hand side is compiled into this one
     function only, not into each helper."""
+    n_sl = sizes(mdl)[1]
+    handled = np.zeros(n_sl, np.bool_)
+    # One pass per switch: event e's, then those of other sliders at the same instant, one
+    # after the other in slider order. The helpers have one call site each, inlined here.
+    while True:
+        if mode == MODE_START:
+            start(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
+        elif mode == MODE_EVENT:
+            handled[e // 3] = True
+            apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst)
+        else:
+            _kink(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
+        settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
+        if mode != MODE_EVENT or n_sl == 1:
+            return
+        _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
+        ist[I_RHS] += 1
+        e = _simultaneous(handled, ph, ph_start, ev_start, ev_prev)
+        if e == NO_EVENT:
+            return
+
+
+@njit(cache=True, inline="always")
+def _kink(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist):
+    """Speed-profile kink: Omegadot jumps, so the stick reaction does too; every slider
+    in contact takes the phase its state now allows. The caller settles them."""
     n, n_sl, half = sizes(mdl)
-    if mode == MODE_START:
-        start(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
-        return
-    if mode == MODE_EVENT:
-        apply_switch(e, t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist, fst)
-        if n_sl > 1:
-            _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
-            ist[I_RHS] += 1
-            _simultaneous(e, t, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k, ev_prev,
-                          ev_t, ev_i, ist, fst)
-        return
-    # Speed-profile kink: Omegadot jumps, so the stick reaction does too.
     om, _ = speed_at(t, mdl.speed, RIGHT)
     for j in range(n_sl):
         if ph[j] == SEPARATION:
@@ -409,4 +409,3 @@ def _switch(mode, e, t, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k, ev_prev, 
             y[half + n + j] = om
         choose_phase(j, t, y, ph, sg, mdl, wk, dy)
         _record_change(t, old, old_s, ph[j], sg[j], j, ev_t, ev_i, ist)
-    settle(t, y, ph, sg, mdl, wk, dy, ev_t, ev_i, ist)
