@@ -94,13 +94,15 @@ def _kinematic(i, ph):
 # field, about 90 words, which was a fifth of a step and half of a sample. Everywhere
 # else ``evaluate`` is called as the compiled function.
 _stage_rhs = njit(cache=True, inline="always")(evaluate.py_func)
+_stage_events = njit(cache=True, inline="always")(event_values.py_func)
 
 
 @njit(cache=True, _nrt=False)
-def _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, tys, twk):
+def _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, tys, twk):
     """Stages 1-6 of the step ``[t, t + hs]`` from ``y`` into ``k``; ``ytmp`` is left at
-    the last stage's state, the step's end. With tangents (``tys``, ``twk`` given) each
-    stage's state and work rows are kept for them (:func:`tangent.keep`)."""
+    the last stage's state, the step's end, and ``evn`` at the event values there (the
+    last stage's evaluation left their data in ``wk``). With tangents (``tys``, ``twk``
+    given) each stage's state and work rows are kept for them (:func:`tangent.keep`)."""
     ns = y.shape[0]
     for st in range(1, 7):
         for i in range(ns):
@@ -117,6 +119,7 @@ def _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, tys, twk):
             k[st, i] = kst[i]
         if tys is not None:
             tangent.keep(st, ytmp, wk, mdl.slider.shape[1], tys, twk)
+    _stage_events(ph, sg, ytmp, mdl, wk, evn)
 
 
 @njit(cache=True, _nrt=False)
@@ -341,9 +344,9 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
             land = True
 
         if tan is not None:
-            _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, tys, twk)
+            _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, tys, twk)
         else:
-            _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, None, None)
+            _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, None, None)
         for i in range(ns):
             ynew[i] = ytmp[i]
         ist[I_RHS] += 6
@@ -372,8 +375,6 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
         t_new = tb if land else t + hs
         if tan is not None:
             tangent.step(t, hs, ph, sg, mdl, tys, twk, tv, tk, tvn, tvs, tcx)
-        # The last stage is at the step's end: its evaluation left the event data there.
-        event_values(ph, sg, ynew, mdl, wk, evn)
 
         have_rc = False
         probed = 0
