@@ -9,7 +9,8 @@ and every variable must agree to within what round-off does to that run.
 Why not bit for bit: on the machine that wrote the files the current code reproduces them
 exactly, but another CPU rounds some last bits differently (glibc picks FMA or AVX-512
 variants of sin, cos, exp and pow at run time, numpy its SIMD loops), and the switching
-amplifies a last-bit difference. Measured on an AVX-512 machine: every event sequence
+amplifies a last-bit difference. ``tests/data/regression_drift_study.py`` prints the
+figures below; measured on an AVX-512 machine: every event sequence
 the same, event times within 1e-12 s (1e-9 s for the 3.2 s, 1177-switch Fig. 18a run),
 variables within 1e-9 of their peak (4e-7 for Fig. 18a). What round-off does to a run is
 measured in the test itself: the same case with the slider's mass changed by one and by

@@ -4,8 +4,8 @@ The integration kernel releases the GIL (``nogil``), so while it runs a second t
 import what the result needs afterwards: xarray (whose first variable imports the array
 libraries it finds installed, dask.array among them) and, for a command that writes
 netCDF, the netCDF engine (xarray's writer asks dask for its scheduler, which imports
-dask.distributed when installed). On a machine with two cores these imports, about half
-a second, then cost no wall time. In a process that already has them it does nothing.
+dask.distributed when installed). On a machine with two cores these imports then cost
+little wall time. In a process that already has them it does nothing.
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ def _netcdf() -> None:
 
 
 _TASKS: dict[str, tuple[Callable[[], None], str]] = {
-    # name: (what to do, the module whose presence says it was done)
+    # name: (what to do, the module whose presence means it is not needed)
     "xarray": (_xarray, "xarray"),
     "netcdf": (_netcdf, "netCDF4"),
 }

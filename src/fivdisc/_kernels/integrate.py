@@ -118,7 +118,7 @@ def _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, tys, twk):
         for i in range(ns):
             k[st, i] = kst[i]
         if tys is not None:
-            tangent.keep(st, ytmp, wk, mdl.slider.shape[1], tys, twk)
+            tangent.keep(st, ytmp, wk, sizes(mdl)[1], tys, twk)
     _stage_events(ph, sg, ytmp, mdl, wk, evn)
 
 

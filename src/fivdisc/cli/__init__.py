@@ -68,6 +68,6 @@ def main() -> None:
         cli(prog_name="fivdisc")
     finally:
         # Every output is written and closed by now. The interpreter's shutdown then
-        # collects garbage across all the imported libraries' objects (about 0.3 s after
-        # a simulation); frozen, they are left to the exit, which frees them anyway.
+        # collects garbage across all the imported libraries' objects, a noticeable part
+        # of a short command; frozen, they are left to the exit, which frees them anyway.
         gc.freeze()
