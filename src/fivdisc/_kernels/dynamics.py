@@ -601,23 +601,21 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
     om2 = om * om
     phj = ph[0]
     sj = sg[0]
-    # Disc forces are linear in the state.
-    for i in range(n):
-        # The force's derivative, turned into the acceleration's below.
-        out[half + i] = _disc_force(i, v, om, om2, omd, eps, damped, disc, half)
-        out[i] = v[half + i]
     phi = y[n]
     dpsi = v[n]
     phid = wk[aux + A_PHID, 0]
     dphid = 0.0 if phj == STICK else v[half + n]
     out[n] = dphid
+    # Disc forces are linear in the state: their derivatives are the forces at v.
     if phj == SEPARATION:
+        for i in range(n):
+            out[half + i] = _disc_force(i, v, om, om2, omd, eps, damped, disc, half) * (
+                disc[D_MINV, i])
+            out[i] = v[half + i]
         out[half + n] = (-sl[S_CPHI, 0] * dphid - sl[S_KPHI, 0] * dpsi) / sl[S_INERTIA, 0]
         out[n + 1] = v[half + n + 1]
         out[half + n + 1] = (-sl[S_CZ, 0] * v[half + n + 1]
                              - sl[S_KZ, 0] * v[n + 1]) / sl[S_MASS, 0]
-        for i in range(n):
-            out[half + i] *= disc[D_MINV, i]
         return
     out[n + 1] = 0.0
     out[half + n + 1] = 0.0
@@ -634,6 +632,10 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
     ds_gf = 0.0
     ds_ggp = 0.0
     for i in range(n):
+        # The force's derivative, turned into the acceleration's below.
+        dfi = _disc_force(i, v, om, om2, omd, eps, damped, disc, half)
+        out[half + i] = dfi
+        out[i] = v[half + i]
         li = disc[D_L, i]
         minv = disc[D_MINV, i]
         gi = wk[0, i]
@@ -645,7 +647,7 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
         dgpq += gpi * v[i]
         dgpqd += gpi * v[half + i] - l2 * gi * y[half + i] * dpsi
         dl2gq += l2 * (gi * v[i] + gpi * y[i] * dpsi)
-        ds_gf += (gpi * dpsi * fi + gi * out[half + i]) * minv
+        ds_gf += (gpi * dpsi * fi + gi * dfi) * minv
         ds_ggp += (gpi * gpi - l2 * gi * gi) * minv
     dwc += gpq * dpsi
     dgpq -= l2gq * dpsi

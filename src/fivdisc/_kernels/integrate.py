@@ -98,11 +98,11 @@ _stage_events = njit(cache=True, inline="always")(event_values.py_func)
 
 
 @njit(cache=True, _nrt=False)
-def _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, tys, twk):
+def _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, tv, tk, tvn, tvs, tcx):
     """Stages 1-6 of the step ``[t, t + hs]`` from ``y`` into ``k``; ``ytmp`` is left at
     the last stage's state, the step's end, and ``evn`` at the event values there (the
-    last stage's evaluation left their data in ``wk``). With tangents (``tys``, ``twk``
-    given) each stage's state and work rows are kept for them (:func:`tangent.keep`)."""
+    last stage's evaluation left their data in ``wk``). With tangents (``tv`` not None)
+    each stage of the tangents follows the state's (:func:`tangent.stage`)."""
     ns = y.shape[0]
     for st in range(1, 7):
         for i in range(ns):
@@ -117,8 +117,8 @@ def _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, tys, twk):
         _stage_rhs(t + C[st] * hs, ytmp, ph, sg, LEFT, mdl, wk, kst)
         for i in range(ns):
             k[st, i] = kst[i]
-        if tys is not None:
-            tangent.keep(st, ytmp, wk, sizes(mdl)[1], tys, twk)
+        if tv is not None:
+            tangent.stage(st, t, hs, ytmp, ph, sg, mdl, wk, tv, tk, tvn, tvs, tcx)
     _stage_events(ph, sg, ytmp, mdl, wk, evn)
 
 
@@ -297,7 +297,6 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
         tv, tk = tan
         tsc = tangent.scratch(mdl, y, tv.shape[0])
         tcx, tvn, tvs, ypre, sgpre = tsc[0], tsc[3], tsc[4], tsc[9], tsc[10]
-        tys, twk = tsc[11], tsc[12]
 
     t = fst[F_T]
     h = fst[F_H]
@@ -344,9 +343,10 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
             land = True
 
         if tan is not None:
-            _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, tys, twk)
+            _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, tv, tk, tvn, tvs, tcx)
         else:
-            _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, None, None)
+            _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, None, None, None, None,
+                    None)
         for i in range(ns):
             ynew[i] = ytmp[i]
         ist[I_RHS] += 6
@@ -373,8 +373,6 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
 
         ist[I_STEPS] += 1
         t_new = tb if land else t + hs
-        if tan is not None:
-            tangent.step(t, hs, ph, sg, mdl, tys, twk, tv, tk, tvn, tvs, tcx)
 
         have_rc = False
         probed = 0

@@ -45,7 +45,6 @@ from fivdisc._kernels.dynamics import (
 from fivdisc._kernels.layout import (
     A_WC,
     A_WCD,
-    N_AUX,
     SEPARATION,
     STICK,
     n_dynamic,
@@ -64,15 +63,11 @@ _STEP = 1e-30
 def scratch(mdl, y, n_vectors):
     """Work arrays of the tangent integration: (the complex step's state, derivative and
     work array), complex stages and event values, the tangents at a step's end, a stage's
-    tangent, dense-output coefficients, two vectors, a real work array, the state and
-    slip signs before a switch (slots 9 and 10), and the state's stage states and what
-    its evaluations left in the work array (slots 11 and 12, see :func:`keep`).
+    tangent, dense-output coefficients, two vectors, a real work array, and the state
+    and slip signs before a switch (slots 9 and 10).
 
-    The per-step functions (``step``, ``accept``, ...) are compiled without reference
-    counting (they never allocate), and ``step`` has the tangent-linear right-hand side
-    inlined. The tangent stages of a step are computed in one call once the state's step
-    is accepted: a call passing the model's arrays costs about what a stage's
-    combination does, and a rejected step costs the tangents nothing."""
+    The per-step functions (:func:`stage`, ``accept``, ...) never allocate and run
+    without reference counting (``stage`` inlined into the state's stages)."""
     nd = n_dynamic(mdl)
     n_ev = 3 * sizes(mdl)[1]
     yc = np.empty(nd, np.complex128)
@@ -80,8 +75,7 @@ def scratch(mdl, y, n_vectors):
     wk = new_work(mdl, y)
     return (cplx, np.empty((7, nd), np.complex128), np.empty(n_ev, np.complex128),
             np.empty((n_vectors, nd)), np.empty(nd), np.empty((5, nd)), np.empty(nd),
-            np.empty(nd), wk, np.empty(nd), np.empty(sizes(mdl)[1], np.int64),
-            np.empty((7, y.shape[0])), np.zeros((7, wk.shape[0], wk.shape[1])))
+            np.empty(nd), wk, np.empty(nd), np.empty(sizes(mdl)[1], np.int64))
 
 
 @njit(cache=True, _nrt=False)
@@ -117,41 +111,29 @@ def jvp(t, y, v, ph, sg, right, mdl, wk, cplx, out):
 
 
 @njit(cache=True, inline="always")
-def keep(st, y, wk, n_sl, ys, wks):
-    """Keep stage ``st``'s state ``y`` and, for one slider, the part of ``wk`` that
-    :func:`dynamics.linearised_one` reads (g, g' and the disc forces, rows 0-2, and the
-    slider's auxiliary column), for :func:`step`. Several sliders take the complex step
-    of the right-hand side, which needs the state only."""
-    for i in range(y.shape[0]):
-        ys[st, i] = y[i]
-    if n_sl == 1:
-        _, _, trig, aux, _, _ = work_rows(n_sl)
-        for a in range(trig):
-            for i in range(wk.shape[1]):
-                wks[st, a, i] = wk[a, i]
-        for a in range(aux, aux + N_AUX):
-            wks[st, a, 0] = wk[a, 0]
+def stage(st, t, hs, y, ph, sg, mdl, wk, V, KV, vn, vs, cplx):
+    """Stage ``st`` of every tangent vector in the step ``[t, t + hs]``, at the state's
+    stage state ``y`` whose evaluation has just filled ``wk``; the last stage's
+    combination, the tangent at the step's end, is kept in ``vn``.
 
-
-@njit(cache=True, _nrt=False)
-def step(t, hs, ph, sg, mdl, ys, wks, V, KV, vn, vs, cplx):
-    """Stages 1-6 of every tangent vector over the accepted step ``[t, t + hs]``, at the
-    state's stage states ``ys`` with what its evaluations left in ``wks``
-    (:func:`keep`), in the order of operations of the state's stages; the last stage's
-    combination, the tangent at the step's end, is kept in ``vn``."""
+    Inlined into the state's stages (``integrate._stages``), right after each
+    evaluation: the tangent-linear right-hand side reads what that evaluation left in
+    ``wk``, which the next stage overwrites. A rejected step so wastes its tangent
+    stages (rejections are few); the stages of a vector are the same operations in the
+    same order either way."""
     nd = V.shape[1]
     for r in range(V.shape[0]):
-        for st in range(1, 7):
-            for i in range(nd):
-                vs[i] = V[r, i]
-            for j in range(st):
-                a = hs * A[st, j]
-                if a != 0.0:
-                    for i in range(nd):
-                        vs[i] += a * KV[r, j, i]
-            jvp(t + C[st] * hs, ys[st], vs, ph, sg, False, mdl, wks[st], cplx, KV[r, st])
         for i in range(nd):
-            vn[r, i] = vs[i]
+            vs[i] = V[r, i]
+        for j in range(st):
+            a = hs * A[st, j]
+            if a != 0.0:
+                for i in range(nd):
+                    vs[i] += a * KV[r, j, i]
+        jvp(t + C[st] * hs, y, vs, ph, sg, False, mdl, wk, cplx, KV[r, st])
+        if st == 6:
+            for i in range(nd):
+                vn[r, i] = vs[i]
 
 
 @njit(cache=True, _nrt=False)
