@@ -7,7 +7,9 @@ from click.testing import CliRunner
 
 from fivdisc.case import Case
 from fivdisc.cli import cli
-from fivdisc.simulate import Deflection, simulate
+from fivdisc.integration import Integration
+from fivdisc.model import build_model
+from fivdisc.simulate import Deflection, initial_state, simulate
 
 
 def test_absurd_preload_diverges():
@@ -19,6 +21,24 @@ def test_absurd_preload_diverges():
     w = np.abs(res.dataset["w"].values)
     assert res.dataset.attrs["end_time"] < 0.2
     assert np.max(w) > Deflection.DIVERGED * 0.002
+
+
+def test_the_kernel_keeps_the_largest_deflection_under_the_sliders():
+    """The check reads the largest |w| under the sliders that the kernel keeps while it
+    writes the samples: it must be the largest of the written samples, call by call,
+    over both of two sliders in stick-slip."""
+    case = Case(sliders=[{"track_radius": 0.1, "angle": 0.0},
+                         {"track_radius": 0.11, "angle": 2.0, "face": "bottom"}],
+                speed={"value": 20.0}, simulation={"duration": 0.05})
+    model = build_model(case)
+    run = Integration(model, initial_state(model), duration=0.05, output_rate=20000.0)
+    done = 0
+    for target in (0.01, 0.02, 0.05):
+        run.run_to(target)
+        under = run.out_aux[done : run.n_samples, 6:8]  # w under each of the 2 sliders
+        done = run.n_samples
+        assert run.take_peak() == np.max(np.abs(under))
+    assert run.take_peak() == 0.0
 
 
 def test_printed_sign_blow_up_diverges():

@@ -154,6 +154,13 @@ class Integration:
     def n_samples(self) -> int:
         return int(self.ist[slots.I_OUT_NEXT])
 
+    def take_peak(self) -> float:
+        """The largest |w| [m] under the sliders at the samples written since the last
+        call (nan if any was not finite), and start again."""
+        peak = float(self.fst[slots.F_W_PEAK])
+        self.fst[slots.F_W_PEAK] = 0.0
+        return peak
+
     def advance(self, target: float) -> int:
         """Integrate until ``t >= target`` (or the end, a failure, a full event buffer);
         returns the kernel's status. The first call (any target) also chooses the phases

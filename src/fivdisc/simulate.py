@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time as _time
 from collections.abc import Callable, Mapping
 
@@ -168,7 +169,7 @@ def simulate(
             status = run.run_to(sim.duration * chunk / _CHUNKS)
             if bar is not None:
                 bar.update(run.t - bar.n)
-            if limit.exceeded(run.out_y, run.out_aux, run.n_samples, run.y, run.t):
+            if limit.exceeded(run):
                 break
             if status != slots.ST_RUNNING:
                 break
@@ -238,6 +239,7 @@ class Deflection:
         self.checked = 0
         self.when: float | None = None
         self.largest = 0.0
+        self.probes = model.probe_shapes.T if model.probe_shapes.shape[0] else None
 
     def _w(self, q: np.ndarray, phi: np.ndarray) -> np.ndarray:
         """w [m] under the sliders and at the probes for modal coordinates ``q`` (rows)."""
@@ -266,28 +268,28 @@ class Deflection:
         self.largest = max(self.largest, float(w))
         return bool(w > self.thickness)
 
-    def exceeded(self, out_y: np.ndarray, out_aux: np.ndarray, done: int, y: np.ndarray,
-                 t: float) -> bool:
-        """Check the samples written since the last call, or the current state when there
-        are none (a low output rate); remember the first time the limit is passed."""
-        model = self.model
-        ns = model.n_sliders
+    def exceeded(self, run: Integration) -> bool:
+        """Check the samples ``run`` wrote since the last call (the kernel keeps the
+        largest |w| under the sliders), or its current state when there are none (a low
+        output rate); remember the first time the limit is passed."""
+        done = run.n_samples
         if done > self.checked:
-            new = slice(self.checked, done)
-            self.checked = done
-            under = np.max(np.abs(out_aux[new, 3 * ns : 4 * ns]))
-            probes = np.max(np.abs(out_y[new, : model.n] @ model.probe_shapes.T), initial=0.0)
-            largest = float(np.max([under, probes]))  # a nan anywhere stays nan
-            if not np.isfinite(largest):
-                self.largest = np.inf
+            first, self.checked = self.checked, done
+            largest = run.take_peak()
+            if self.probes is not None:
+                q = run.out_y[first:done, : self.model.n]
+                probes = float(np.abs(q @ self.probes).max())
+                largest = probes if math.isnan(probes) or probes > largest else largest
+            if not math.isfinite(largest):
+                self.largest = math.inf
                 passed = True
             else:
                 self.largest = max(self.largest, largest)
                 passed = largest > self.thickness
         else:
-            passed = self.beyond(y)
+            passed = self.beyond(run.y)
         if passed:
-            self.when = t
+            self.when = run.t
         return passed
 
     def message(self, t: float) -> str:

@@ -45,6 +45,7 @@ from fivdisc._kernels.slots import (
     F_H_CAP,
     F_LAST_SWITCH,
     F_T,
+    F_W_PEAK,
     I_EVAL_EVENTS,
     I_EVENTS,
     I_OUT_NEXT,
@@ -183,7 +184,7 @@ def locate(i, lo, hi, g_lo, g_hi, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist)
 
 
 @njit(cache=True, _nrt=False)
-def _write_outputs(t0, t1, h, rc, ph, sg, mdl, wk, dy, ytmp, ctl, out_y, out_aux, ist):
+def _write_outputs(t0, t1, h, rc, ph, sg, mdl, wk, dy, ytmp, ctl, fst, out_y, out_aux, ist):
     """Sample the dense output of the step [t0, t0 + h] at output times in (t0, t1]."""
     i = ist[I_OUT_NEXT]
     n_out = out_y.shape[0]
@@ -195,16 +196,18 @@ def _write_outputs(t0, t1, h, rc, ph, sg, mdl, wk, dy, ytmp, ctl, out_y, out_aux
             break
         dense_eval(rc, (ti - t0) / h, ytmp)
         _stage_rhs(ti, ytmp, ph, sg, LEFT, mdl, wk, dy)
-        _write_row(i, ti, ytmp, ph, mdl, wk, out_y, out_aux)
+        _write_row(i, ti, ytmp, ph, mdl, wk, out_y, out_aux, fst)
         i += 1
     ist[I_OUT_NEXT] = i
 
 
 @njit(cache=True, inline="always")
-def _write_row(i, ti, ys, ph, mdl, wk, out_y, out_aux):
+def _write_row(i, ti, ys, ph, mdl, wk, out_y, out_aux, fst):
     """One output row at state ``ys``, whose right-hand side has just filled ``wk``: the
     state with the contact kinematics filled in, and per slider N, f, phase, w under it
-    (columns j, S + j, 2 S + j, 3 S + j), then Omega."""
+    (columns j, S + j, 2 S + j, 3 S + j), then Omega. ``fst[F_W_PEAK]`` keeps the
+    largest |w| under the sliders (a nan stays), which the caller checks against the
+    range of plate theory after each call without reading the samples again."""
     aux = _aux(mdl, wk)
     n, ns, half = sizes(mdl)
     om, _ = speed_at(ti, mdl.speed, LEFT)
@@ -217,7 +220,10 @@ def _write_row(i, ti, ys, ph, mdl, wk, out_y, out_aux):
         out_aux[i, j] = aux[A_N, j]
         out_aux[i, ns + j] = aux[A_F, j]
         out_aux[i, 2 * ns + j] = ph[j]
+        w = abs(aux[A_WC, j])
         out_aux[i, 3 * ns + j] = aux[A_WC, j]
+        if not w <= fst[F_W_PEAK] and fst[F_W_PEAK] == fst[F_W_PEAK]:
+            fst[F_W_PEAK] = w
     for c in range(ys.shape[0]):
         out_y[i, c] = ys[c]
     out_aux[i, 4 * ns] = om
@@ -317,7 +323,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
             for i in range(ns):
                 yout[i] = y[i]
             evaluate(t, yout, ph, sg, LEFT, mdl, wk, dy)
-            _write_row(ist[I_OUT_NEXT], t, yout, ph, mdl, wk, out_y, out_aux)
+            _write_row(ist[I_OUT_NEXT], t, yout, ph, mdl, wk, out_y, out_aux, fst)
             ist[I_OUT_NEXT] = 1
         ist[I_STARTED] = 1
         ist[I_RHS] += 2
@@ -436,7 +442,8 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
             if not have_rc:
                 dense_coefficients(y, ynew, k, hs, rc)
             t_e = t_new if theta >= 1.0 else t + theta * hs
-            _write_outputs(t, t_e, hs, rc, ph, sg, mdl, wk, dy, yout, ctl, out_y, out_aux, ist)
+            _write_outputs(t, t_e, hs, rc, ph, sg, mdl, wk, dy, yout, ctl, fst, out_y, out_aux,
+                           ist)
             dense_eval(rc, theta, y)
             first_new = ist[I_EVENTS]
             fst[F_H_CAP] = np.inf
@@ -486,7 +493,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
         if ist[I_OUT_NEXT] < out_y.shape[0] and next_out <= t_new:
             if not have_rc:
                 dense_coefficients(y, ynew, k, hs, rc)
-            _write_outputs(t, t_new, hs, rc, ph, sg, mdl, wk, dy, yout, ctl, out_y, out_aux,
+            _write_outputs(t, t_new, hs, rc, ph, sg, mdl, wk, dy, yout, ctl, fst, out_y, out_aux,
                            ist)
         for i in range(ns):
             y[i] = ynew[i]

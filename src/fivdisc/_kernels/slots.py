@@ -28,7 +28,9 @@ F_T = 0
 F_H = 1
 F_LAST_SWITCH = 2
 F_H_CAP = 3
-N_FSTATE = 4
+# Largest |w| under the sliders at the samples written since the caller reset it.
+F_W_PEAK = 4
+N_FSTATE = 5
 
 # Control slots.
 C_RTOL = 0
