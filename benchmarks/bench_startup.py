@@ -2,12 +2,14 @@
 whole Fig. 10 command, side by side with the interpreter's own start in the same run.
 
 Run ``python benchmarks/bench_startup.py`` (``--repeat N`` processes per command, default
-15; ``--no-fig10`` leaves out the slow Fig. 10 command). The fivdisc on ``sys.path`` is
-timed: set ``PYTHONPATH=src`` to time a clone. It prints, per command, the median wall time
-of its fresh processes [s], its ratio to the interpreter's start (``python -c pass``) and
-to ``python -c "import numpy"``, and the target of issue 11 (item 3). The commands take
-turns, so that a change in the machine's load during the run falls on all of them alike;
-each runs once before the timing (compiled bytecode, the kernel's cache, the file cache).
+15; ``--no-fig10`` leaves out the slow Fig. 10 command; it runs twice, the second time
+with the garbage collector's default thresholds, which the command line raises). The
+fivdisc on ``sys.path`` is timed: set ``PYTHONPATH=src`` to time a clone. It prints, per
+command, the median wall time of its fresh processes [s], its ratio to the interpreter's
+start (``python -c pass``) and to ``python -c "import numpy"``, and the target of issue 11
+(item 3). The commands take turns, so that a change in the machine's load during the run
+falls on all of them alike; each runs once before the timing (compiled bytecode, the
+kernel's cache, the file cache).
 """
 
 from __future__ import annotations
@@ -24,6 +26,9 @@ from pathlib import Path
 # The console script `fivdisc` runs exactly this; through the interpreter being timed, so
 # that no installed copy of fivdisc stands in for the one on sys.path.
 _CLI = "from fivdisc.cli import main; main()"
+# The same with Python's default thresholds of the garbage collector, which ``main`` raises.
+_CLI_DEFAULT_GC = ("import gc, fivdisc.cli as c; c._GC_THRESHOLDS = gc.get_threshold(); "
+                   "c.main()")
 
 
 def _commands(workdir: Path, fig10: bool) -> list[tuple[str, list[str], float | None]]:
@@ -41,6 +46,9 @@ def _commands(workdir: Path, fig10: bool) -> list[tuple[str, list[str], float | 
         commands.append(("fivdisc simulate fig10 -o fig10.nc",
                          [python, "-c", _CLI, "simulate", "fig10", "-o", out, "--no-progress"],
                          2.0))
+        commands.append(("  the same, default gc thresholds",
+                         [python, "-c", _CLI_DEFAULT_GC, "simulate", "fig10", "-o", out,
+                          "--no-progress"], None))
     return commands
 
 

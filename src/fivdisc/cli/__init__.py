@@ -15,6 +15,10 @@ import click
 
 from fivdisc.errors import FivdiscError
 
+# Allocations between young collections, young collections per middle one, middle per
+# full one (Python's defaults: 700, 10, 10).
+_GC_THRESHOLDS = (50_000, 20, 20)
+
 
 def _fail(message: str) -> None:
     """End the program with `message` on one line of stderr and exit status 2."""
@@ -64,6 +68,11 @@ _register()
 
 def main() -> None:
     """Console-script entry point."""
+    # A command imports numba, xarray and the netCDF engine as it goes: with the default
+    # thresholds the collector runs hundreds of times over their objects meanwhile, a
+    # noticeable part of a short command (``benchmarks/bench_startup.py`` times both).
+    # Rarer collections still bound what cycles a long sweep leaves behind.
+    gc.set_threshold(*_GC_THRESHOLDS)
     try:
         cli(prog_name="fivdisc")
     finally:
