@@ -434,21 +434,33 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
 
     for j in range(ns):
         row = r_sys + j
-        for k in range(ns):
-            wk[row, k] = zero
         if ph[j] == SEPARATION:
+            for k in range(ns):
+                wk[row, k] = zero
             wk[row, j] = 1.0 + zero
             wk[row, ns] = zero
             continue
         gf = zero
         for i in range(n):
-            gji = wk[j, i]
-            gf += gji * disc[D_MINV, i] * dy[half + i]
-            for k in range(ns):
-                wk[row, k] += gji * wk[r_u + i, k]
+            gf += wk[j, i] * disc[D_MINV, i] * dy[half + i]
         sm = sl[S_SMASS, j]
-        for k in range(ns):
-            wk[row, k] *= sm
+        # The entries summed in locals, two at a time: accumulated in wk, every term
+        # would be a load and a store of the same element (the compiler cannot tell wk's
+        # rows apart), and one at a time, a chain of n dependent additions each.
+        for k in range(0, ns - 1, 2):
+            a0 = zero
+            a1 = zero
+            for i in range(n):
+                gji = wk[j, i]
+                a0 += gji * wk[r_u + i, k]
+                a1 += gji * wk[r_u + i, k + 1]
+            wk[row, k] = a0 * sm
+            wk[row, k + 1] = a1 * sm
+        if ns % 2 == 1:
+            a0 = zero
+            for i in range(n):
+                a0 += wk[j, i] * wk[r_u + i, ns - 1]
+            wk[row, ns - 1] = a0 * sm
         gpq = wk[aux + A_GPQ, j]
         wk[row, j] += 1.0
         if ph[j] == SLIP:
