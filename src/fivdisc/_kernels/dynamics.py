@@ -23,6 +23,7 @@ import numpy as np
 from numba import njit
 
 from fivdisc._kernels.layout import (
+    A_DEN,
     A_F,
     A_FPHI,
     A_GPQ,
@@ -31,8 +32,6 @@ from fivdisc._kernels.layout import (
     A_L2GQ,
     A_N,
     A_PHID,
-    A_SGF,
-    A_SGG,
     A_SGGP,
     A_SMU,
     A_V,
@@ -342,9 +341,7 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
             f = (sl[S_INERTIA, j] * omd + sl[S_CPHI, j] * om + sl[S_KPHI, j] * phi) / (
                 sl[S_RADIUS, j])
             wk[aux + A_F, j] = f
-        # Kept for the tangent-linear right-hand side too, which needs them with one slider.
-        wk[aux + A_SGF, j] = s_gf
-        wk[aux + A_SGG, j] = s_gg
+        # For the tangent-linear right-hand side, which needs it with one slider.
         wk[aux + A_SGGP, j] = s_ggp
         if ns > 1:
             wk[aux + A_KNOWN, j] = known
@@ -375,9 +372,9 @@ def _one_slider(n, half, phj, known, smu, fphi, f, gpq, s_gf, s_gg, s_ggp, phi, 
     sm = sl[S_SMASS, 0]
     inertia = sl[S_INERTIA, 0]
     if phj == SLIP:
-        nf = (known + sm * (s_gf + zero) + sm * gpq * fphi / inertia) / (
-            1.0 + m * (s_gg - sl[S_HH, 0] * smu * s_ggp)
-            - sm * gpq * sl[S_RADIUS, 0] * smu / inertia)
+        den = (1.0 + m * (s_gg - sl[S_HH, 0] * smu * s_ggp)
+               - sm * gpq * sl[S_RADIUS, 0] * smu / inertia)
+        nf = (known + sm * (s_gf + zero) + sm * gpq * fphi / inertia) / den
         sn = sl[S_SIGMA, 0] * nf
         c = sl[S_HH, 0] * smu
         for i in range(n):
@@ -385,8 +382,8 @@ def _one_slider(n, half, phj, known, smu, fphi, f, gpq, s_gf, s_gg, s_ggp, phi, 
         f = smu * nf
         dy[half + n] = (fphi + sl[S_RADIUS, 0] * f) / inertia
     else:
-        nf = (known + sm * (s_gf + sl[S_SHH, 0] * f * s_ggp + zero) + sm * gpq * omd) / (
-            1.0 + m * s_gg)
+        den = 1.0 + m * s_gg
+        nf = (known + sm * (s_gf + sl[S_SHH, 0] * f * s_ggp + zero) + sm * gpq * omd) / den
         sn = sl[S_SIGMA, 0] * nf
         c = sl[S_SHH, 0] * f
         for i in range(n):
@@ -394,6 +391,8 @@ def _one_slider(n, half, phj, known, smu, fphi, f, gpq, s_gf, s_gg, s_ggp, phi, 
         dy[half + n] = omd + phi * 0.0
     wk[aux + A_N, 0] = nf
     wk[aux + A_F, 0] = f
+    # For the tangent-linear right-hand side, which divides by it too.
+    wk[aux + A_DEN, 0] = den
 
 
 @njit(cache=True, _nrt=False)
@@ -639,7 +638,6 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
     dgpq = 0.0
     dgpqd = 0.0
     dl2gq = 0.0
-    s_gg = wk[aux + A_SGG, 0]
     s_ggp = wk[aux + A_SGGP, 0]
     ds_gf = 0.0
     ds_ggp = 0.0
@@ -687,7 +685,7 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
         fphi = -sl[S_CPHI, 0] * phid - sl[S_KPHI, 0] * phi
         dfphi = -sl[S_CPHI, 0] * dphid - sl[S_KPHI, 0] * dpsi
         hh = sl[S_HH, 0]
-        den = 1.0 + m * (s_gg - hh * smu * s_ggp) - sm * gpq * r * smu / inertia
+        den = wk[aux + A_DEN, 0]
         dnum = dknown + sm * ds_gf + sm * (dgpq * fphi + gpq * dfphi) / inertia
         dden = (m * (ds_gg - hh * (dsmu * s_ggp + smu * ds_ggp))
                 - sm * r * (dgpq * smu + gpq * dsmu) / inertia)
@@ -704,7 +702,7 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
         df = sl[S_KPHI, 0] * dpsi / r
         shh = sl[S_SHH, 0]
         dnf = (dknown + sm * (ds_gf + shh * (df * s_ggp + f * ds_ggp)) + sm * dgpq * omd
-               - nf * m * ds_gg) / (1.0 + m * s_gg)
+               - nf * m * ds_gg) / wk[aux + A_DEN, 0]
         sn = sl[S_SIGMA, 0] * nf
         dsn = sl[S_SIGMA, 0] * dnf
         a = shh * f

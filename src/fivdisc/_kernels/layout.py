@@ -121,14 +121,13 @@ A_V = 4  # relative speed Omega - phidot [rad/s]
 A_GPQ = 5  # g'.q
 A_GPQD = 6  # g'.qdot
 A_L2GQ = 7  # sum l^2 g q
-A_SGF = 8  # g M^-1 F_q
-A_SGG = 9  # g M^-1 g
-A_SGGP = 10  # g M^-1 g'
-A_PHID = 11  # phidot (Omega in stick)
-A_SMU = 12  # s mu in slip
-A_FPHI = 13  # in-plane spring and damper force
-A_KNOWN = 14  # the part of N that does not depend on the accelerations
-N_AUX = 15
+A_SGGP = 8  # g M^-1 g'
+A_PHID = 9  # phidot (Omega in stick)
+A_SMU = 10  # s mu in slip
+A_FPHI = 11  # in-plane spring and damper force
+A_KNOWN = 12  # the part of N that does not depend on the accelerations
+A_DEN = 13  # one slider in contact: the divisor of its N in closed form
+N_AUX = 14
 
 
 class KernelModel(NamedTuple):
