@@ -3,7 +3,8 @@ whole Fig. 10 command, side by side with the interpreter's own start in the same
 
 Run ``python benchmarks/bench_startup.py`` (``--repeat N`` processes per command, default
 15; ``--no-fig10`` leaves out the slow Fig. 10 command; it runs twice, the second time
-with the garbage collector's default thresholds, which the command line raises). The
+with the garbage collector's default thresholds, which the command line raises;
+``--reference`` also times the slow scipy reference on it, once, as a whole process). The
 fivdisc on ``sys.path`` is timed: set ``PYTHONPATH=src`` to time a clone. It prints, per
 command, the median wall time of its fresh processes [s], its ratio to the interpreter's
 start (``python -c pass``) and to ``python -c "import numpy"``, and the target of issue 11
@@ -27,6 +28,10 @@ from pathlib import Path
 # that no installed copy of fivdisc stands in for the one on sys.path.
 _CLI = "from fivdisc.cli import main; main()"
 # The same with Python's default thresholds of the garbage collector, which ``main`` raises.
+# The slow reference (benchmarks/baseline.py) integrating the same case, as a process.
+_REFERENCE = (f"import sys; sys.path.insert(0, {str(Path(__file__).resolve().parent)!r}); "
+              "from baseline import baseline_simulate; from fivdisc import load_case, "
+              "examples; baseline_simulate(load_case(examples.path('fig10')))")
 _CLI_DEFAULT_GC = ("import gc, fivdisc.cli as c; c._GC_THRESHOLDS = gc.get_threshold(); "
                    "c.main()")
 
@@ -63,6 +68,9 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=15, help="processes per command")
     parser.add_argument("--no-fig10", dest="fig10", action="store_false",
                         help="leave out fivdisc simulate fig10 (about 2 s a process)")
+    parser.add_argument("--reference", action="store_true",
+                        help="also time one process running the slow scipy reference on "
+                             "the Fig. 10 case (about 2.5 min), against the command")
     args = parser.parse_args()
     # One core per process, as in the other benchmarks.
     os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -76,6 +84,8 @@ def main() -> None:
         for _ in range(args.repeat):
             for (_, argv, _), samples in zip(commands, times, strict=True):
                 samples.append(_seconds(argv, workdir))
+        reference = _seconds([sys.executable, "-c", _REFERENCE], workdir) if (
+            args.reference and args.fig10) else None
     medians = [statistics.median(samples) for samples in times]
     interpreter, numpy = medians[0], medians[1]
     print(f"fresh processes, median of {args.repeat} each ({sys.executable})")
@@ -84,6 +94,10 @@ def main() -> None:
         goal = f"{target:.1f}" if target is not None else ""
         print(f"{label:<36} {median:>10.3f} {median / interpreter:>8.1f} "
               f"{median / numpy:>8.2f} {goal:>11}")
+    if reference is not None:
+        command = medians[len(_commands(Path("."), False))]
+        print(f"the slow scipy reference on the Fig. 10 case, one process: {reference:.1f} s, "
+              f"{reference / command:.0f} x the command (target of issue 11, item 3: >= 200)")
 
 
 if __name__ == "__main__":
