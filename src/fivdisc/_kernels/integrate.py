@@ -99,28 +99,35 @@ _stage_events = njit(cache=True, inline="always")(event_values.py_func)
 
 
 @njit(cache=True, _nrt=False)
-def _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, tv, tk, tvn, tvs, tcx):
+def _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, tys, twk):
     """Stages 1-6 of the step ``[t, t + hs]`` from ``y`` into ``k``; ``ytmp`` is left at
-    the last stage's state, the step's end, and ``evn`` at the event values there (the
-    last stage's evaluation left their data in ``wk``). With tangents (``tv`` not None)
-    each stage of the tangents follows the state's (:func:`tangent.stage`)."""
+    the last stage's state, the step's end, and ``evn`` at the event values there. With
+    tangents (``tys``, ``twk`` given) each stage's state and evaluation go to its own
+    row of them, for :func:`tangent.step` once the step is accepted; else to ``ytmp``
+    and ``wk``."""
     ns = y.shape[0]
+    ys = ytmp
+    ws = wk
     for st in range(1, 7):
+        if tys is not None:
+            ys = tys[st]
+            ws = twk[st]
         for i in range(ns):
-            ytmp[i] = y[i]
+            ys[i] = y[i]
         for j in range(st):
             a = hs * A[st, j]
             if a != 0.0:
                 for i in range(ns):
-                    ytmp[i] += a * k[j, i]
+                    ys[i] += a * k[j, i]
         # Into a vector of its own, then copied: a view k[st] would cost two atomic
         # reference-count updates per stage in a caller that counts references.
-        _stage_rhs(t + C[st] * hs, ytmp, ph, sg, LEFT, mdl, wk, kst)
+        _stage_rhs(t + C[st] * hs, ys, ph, sg, LEFT, mdl, ws, kst)
         for i in range(ns):
             k[st, i] = kst[i]
-        if tv is not None:
-            tangent.stage(st, t, hs, ytmp, ph, sg, mdl, wk, tv, tk, tvn, tvs, tcx)
-    _stage_events(ph, sg, ytmp, mdl, wk, evn)
+    if tys is not None:
+        for i in range(ns):
+            ytmp[i] = ys[i]
+    _stage_events(ph, sg, ytmp, mdl, ws, evn)
 
 
 @njit(cache=True, _nrt=False)
@@ -303,6 +310,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
         tv, tk = tan
         tsc = tangent.scratch(mdl, y, tv.shape[0])
         tcx, tvn, tvs, ypre, sgpre = tsc[0], tsc[3], tsc[4], tsc[9], tsc[10]
+        tys, twk = tsc[11], tsc[12]
 
     t = fst[F_T]
     h = fst[F_H]
@@ -349,10 +357,9 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
             land = True
 
         if tan is not None:
-            _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, tv, tk, tvn, tvs, tcx)
+            _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, tys, twk)
         else:
-            _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, None, None, None, None,
-                    None)
+            _stages(t, hs, y, ph, sg, mdl, wk, k, ytmp, kst, evn, None, None)
         for i in range(ns):
             ynew[i] = ytmp[i]
         ist[I_RHS] += 6
@@ -379,6 +386,8 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
 
         ist[I_STEPS] += 1
         t_new = tb if land else t + hs
+        if tan is not None:
+            tangent.step(t, hs, ph, sg, mdl, tys, twk, tv, tk, tvn, tvs, tcx)
 
         have_rc = False
         probed = 0

@@ -63,11 +63,12 @@ _STEP = 1e-30
 def scratch(mdl, y, n_vectors):
     """Work arrays of the tangent integration: (the complex step's state, derivative and
     work array), complex stages and event values, the tangents at a step's end, a stage's
-    tangent, dense-output coefficients, two vectors, a real work array, and the state
-    and slip signs before a switch (slots 9 and 10).
+    tangent, dense-output coefficients, two vectors, a real work array, the state and
+    slip signs before a switch (slots 9 and 10), and the state's stage states and work
+    arrays (slots 11 and 12), which the state's stages fill for :func:`step`.
 
-    The per-step functions (:func:`stage`, ``accept``, ...) never allocate and run
-    without reference counting (``stage`` inlined into the state's stages)."""
+    The per-step functions (:func:`step`, ``accept``, ...) never allocate and run
+    without reference counting."""
     nd = n_dynamic(mdl)
     n_ev = 3 * sizes(mdl)[1]
     yc = np.empty(nd, np.complex128)
@@ -75,7 +76,8 @@ def scratch(mdl, y, n_vectors):
     wk = new_work(mdl, y)
     return (cplx, np.empty((7, nd), np.complex128), np.empty(n_ev, np.complex128),
             np.empty((n_vectors, nd)), np.empty(nd), np.empty((5, nd)), np.empty(nd),
-            np.empty(nd), wk, np.empty(nd), np.empty(sizes(mdl)[1], np.int64))
+            np.empty(nd), wk, np.empty(nd), np.empty(sizes(mdl)[1], np.int64),
+            np.empty((7, y.shape[0])), np.zeros((7, wk.shape[0], wk.shape[1])))
 
 
 @njit(cache=True, _nrt=False)
@@ -110,30 +112,30 @@ def jvp(t, y, v, ph, sg, right, mdl, wk, cplx, out):
         out[i] = dyc[i].imag / h
 
 
-@njit(cache=True, inline="always")
-def stage(st, t, hs, y, ph, sg, mdl, wk, V, KV, vn, vs, cplx):
-    """Stage ``st`` of every tangent vector in the step ``[t, t + hs]``, at the state's
-    stage state ``y`` whose evaluation has just filled ``wk``; the last stage's
-    combination, the tangent at the step's end, is kept in ``vn``.
+@njit(cache=True, _nrt=False)
+def step(t, hs, ph, sg, mdl, ys, wks, V, KV, vn, vs, cplx):
+    """Stages 1-6 of every tangent vector over the accepted step ``[t, t + hs]``, at the
+    state's stage states ``ys`` with what its evaluations left in ``wks`` (the state's
+    stages evaluate into them, ``integrate._stages``); the last stage's combination, the
+    tangent at the step's end, is kept in ``vn``.
 
-    Inlined into the state's stages (``integrate._stages``), right after each
-    evaluation: the tangent-linear right-hand side reads what that evaluation left in
-    ``wk``, which the next stage overwrites. A rejected step so wastes its tangent
-    stages (rejections are few); the stages of a vector are the same operations in the
-    same order either way."""
+    A function of its own, called once per accepted step: inlined into the state's
+    stages, right after each evaluation, the stages' machine code grew so large that a
+    step with one vector cost about 2 plain steps instead of about 1.75
+    (``benchmarks/bench_tangent.py --processes 8``)."""
     nd = V.shape[1]
     for r in range(V.shape[0]):
-        for i in range(nd):
-            vs[i] = V[r, i]
-        for j in range(st):
-            a = hs * A[st, j]
-            if a != 0.0:
-                for i in range(nd):
-                    vs[i] += a * KV[r, j, i]
-        jvp(t + C[st] * hs, y, vs, ph, sg, False, mdl, wk, cplx, KV[r, st])
-        if st == 6:
+        for st in range(1, 7):
             for i in range(nd):
-                vn[r, i] = vs[i]
+                vs[i] = V[r, i]
+            for j in range(st):
+                a = hs * A[st, j]
+                if a != 0.0:
+                    for i in range(nd):
+                        vs[i] += a * KV[r, j, i]
+            jvp(t + C[st] * hs, ys[st], vs, ph, sg, False, mdl, wks[st], cplx, KV[r, st])
+        for i in range(nd):
+            vn[r, i] = vs[i]
 
 
 @njit(cache=True, _nrt=False)
