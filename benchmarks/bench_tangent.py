@@ -27,7 +27,6 @@ import platform
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -115,13 +114,10 @@ def processes(count: int) -> None:
     Within a process the rounds agree to about 1 %, but the figure moves by several per
     cent from one process to the next (the same code, the same steps): this shows the
     spread a single run of this script can land anywhere in."""
-    code = ("import sys; sys.argv = ['bench_tangent', '--one']; "
-            f"sys.path.insert(0, {str(Path(__file__).resolve().parent)!r}); "
-            "import bench_tangent; bench_tangent.main()")
     figures = []
     for _ in range(count):
-        out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
-                             text=True).stdout
+        out = subprocess.run([sys.executable, __file__, "--one"], check=True,
+                             capture_output=True, text=True).stdout
         figures.append(float(out.split("1 tangent vector(s):")[1].split("x")[0]))
     print(f"1 tangent vector in {count} fresh processes: "
           + ", ".join(f"{f:.2f}" for f in sorted(figures)) + " x the plain run per step")

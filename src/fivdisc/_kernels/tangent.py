@@ -120,9 +120,8 @@ def step(t, hs, ph, sg, mdl, ys, wks, V, KV, vn, vs, cplx):
     tangent at the step's end, is kept in ``vn``.
 
     A function of its own, called once per accepted step: inlined into the state's
-    stages, right after each evaluation, the stages' machine code grew so large that a
-    step with one vector cost about 2 plain steps instead of about 1.75
-    (``benchmarks/bench_tangent.py --processes 8``)."""
+    stages, right after each evaluation, it made their machine code so large that a step
+    with one vector cost more, not less (``benchmarks/bench_tangent.py`` measures it)."""
     nd = V.shape[1]
     for r in range(V.shape[0]):
         for st in range(1, 7):
