@@ -12,9 +12,10 @@ Functions of the cold path called from one or two places (the start's phases, a
 switch, the settling of the other sliders, the restart after a switch, an impact, the
 first step size, one output sample) are inlined into their callers
 (``inline="always"``): numba links every callee into each separately compiled function
-and optimises and emits it there again, so each such function added about half a second
-to the first compilation. ``switch._switch`` is written as one loop over the switches at
-one instant so that each of its helpers has a single call site.
+and optimises and emits it there again, so each such function lengthened the first
+compilation (``benchmarks/bench_compile.py`` measures it). ``switch._switch`` is
+written as one loop over the switches at one instant so that each of its helpers has a
+single call site.
 """
 
 from fivdisc._kernels.cache import install

@@ -92,8 +92,9 @@ def _kinematic(i, ph):
 
 # The right-hand side inlined where it runs most, the stages of a step (``_stages``) and
 # the output samples (``_write_outputs``): a call passes the model's arrays field by
-# field, about 90 words, which was a fifth of a step and half of a sample. Everywhere
-# else ``evaluate`` is called as the compiled function.
+# field, dozens of words on the stack, a large part of a step and of a sample (the
+# CHANGELOG gives the profile). Everywhere else ``evaluate`` is called as the compiled
+# function.
 _stage_rhs = njit(cache=True, inline="always")(evaluate.py_func)
 _stage_events = njit(cache=True, inline="always")(event_values.py_func)
 
