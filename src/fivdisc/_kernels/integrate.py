@@ -91,7 +91,7 @@ def _kinematic(i, ph):
 
 
 # The right-hand side inlined where it runs most, the stages of a step (``_stages``) and
-# the output samples (``_write_outputs``): a call passes the model's arrays field by
+# the output samples (``_complete_rows``): a call passes the model's arrays field by
 # field, dozens of words on the stack, a large part of a step and of a sample (the
 # CHANGELOG gives the profile). Everywhere else ``evaluate`` is called as the compiled
 # function.
@@ -192,8 +192,10 @@ def locate(i, lo, hi, g_lo, g_hi, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist)
 
 
 @njit(cache=True, _nrt=False)
-def _write_outputs(t0, t1, h, rc, ph, sg, mdl, wk, dy, ytmp, ctl, fst, out_y, out_aux, ist):
-    """Sample the dense output of the step [t0, t0 + h] at output times in (t0, t1]."""
+def _sample_states(t0, t1, h, rc, ph, sg, ctl, out_y, out_aux, ist):
+    """Sample the dense output of the step [t0, t0 + h] at output times in (t0, t1]: the
+    state, and each slider's phase and slip sign (in the columns of its phase and of its
+    normal force), from which :func:`_complete_rows` makes the rows."""
     i = ist[I_OUT_NEXT]
     n_out = out_y.shape[0]
     out_dt = ctl[C_OUT_DT]
@@ -202,39 +204,60 @@ def _write_outputs(t0, t1, h, rc, ph, sg, mdl, wk, dy, ytmp, ctl, fst, out_y, ou
         ti = min(i * out_dt, t_final)
         if ti > t1:
             break
-        dense_eval(rc, (ti - t0) / h, ytmp)
-        _stage_rhs(ti, ytmp, ph, sg, LEFT, mdl, wk, dy)
-        _write_row(i, ti, ytmp, ph, mdl, wk, out_y, out_aux, fst)
+        theta = (ti - t0) / h
+        for c in range(rc.shape[1]):
+            out_y[i, c] = dense_one(rc, theta, c)
+        _begin_row(i, ph, sg, out_aux)
         i += 1
     ist[I_OUT_NEXT] = i
 
 
 @njit(cache=True, inline="always")
-def _write_row(i, ti, ys, ph, mdl, wk, out_y, out_aux, fst):
-    """One output row at state ``ys``, whose right-hand side has just filled ``wk``: the
-    state with the contact kinematics filled in, and per slider N, f, phase, w under it
-    (columns j, S + j, 2 S + j, 3 S + j), then Omega. ``fst[F_W_PEAK]`` keeps the
-    largest |w| under the sliders (a nan stays), which the caller checks against the
-    range of plate theory after each call without reading the samples again."""
+def _begin_row(i, ph, sg, out_aux):
+    """Keep each slider's phase and slip sign in output row ``i`` for
+    :func:`_complete_rows`."""
+    n_sl = ph.shape[0]
+    for j in range(n_sl):
+        out_aux[i, j] = sg[j]
+        out_aux[i, 2 * n_sl + j] = ph[j]
+
+
+@njit(cache=True, _nrt=False)
+def _complete_rows(first, last, ctl, mdl, wk, ys, dy, ph, sg, out_y, out_aux, fst):
+    """Complete the output rows ``first`` to ``last - 1`` that :func:`_sample_states`
+    began, from the right-hand side at each: the state's contact kinematics (a sticking
+    slider's phidot, and z, zdot of one in contact), per slider N, f, w under it
+    (columns j, S + j, 3 S + j; the phase is in 2 S + j), then Omega. ``ys``, ``ph``,
+    ``sg`` are scratch. ``fst[F_W_PEAK]`` keeps the largest |w| under the sliders (a nan
+    stays), which the caller checks against the range of plate theory after each call
+    of :func:`run` without reading the samples again.
+
+    Done once the steps are taken, not at each sample: interleaved with the steps, the
+    samples cost about twice as much (the CHANGELOG gives the figures)."""
+    n, n_sl, half = sizes(mdl)
     aux = _aux(mdl, wk)
-    n, ns, half = sizes(mdl)
-    om, _ = speed_at(ti, mdl.speed, LEFT)
-    for j in range(ns):
-        if ph[j] == STICK:
-            ys[half + n + j] = om
-        if ph[j] != SEPARATION:
-            ys[n + ns + j] = aux[A_WC, j]
-            ys[half + n + ns + j] = aux[A_WCD, j]
-        out_aux[i, j] = aux[A_N, j]
-        out_aux[i, ns + j] = aux[A_F, j]
-        out_aux[i, 2 * ns + j] = ph[j]
-        w = abs(aux[A_WC, j])
-        out_aux[i, 3 * ns + j] = aux[A_WC, j]
-        if not w <= fst[F_W_PEAK] and fst[F_W_PEAK] == fst[F_W_PEAK]:
-            fst[F_W_PEAK] = w
-    for c in range(ys.shape[0]):
-        out_y[i, c] = ys[c]
-    out_aux[i, 4 * ns] = om
+    for i in range(first, last):
+        ti = min(i * ctl[C_OUT_DT], ctl[C_T_FINAL])
+        for j in range(n_sl):
+            sg[j] = np.int64(out_aux[i, j])
+            ph[j] = np.int64(out_aux[i, 2 * n_sl + j])
+        for c in range(ys.shape[0]):
+            ys[c] = out_y[i, c]
+        _stage_rhs(ti, ys, ph, sg, LEFT, mdl, wk, dy)
+        om, _ = speed_at(ti, mdl.speed, LEFT)
+        for j in range(n_sl):
+            if ph[j] == STICK:
+                out_y[i, half + n + j] = om
+            if ph[j] != SEPARATION:
+                out_y[i, n + n_sl + j] = aux[A_WC, j]
+                out_y[i, half + n + n_sl + j] = aux[A_WCD, j]
+            out_aux[i, j] = aux[A_N, j]
+            out_aux[i, n_sl + j] = aux[A_F, j]
+            w = abs(aux[A_WC, j])
+            out_aux[i, 3 * n_sl + j] = aux[A_WC, j]
+            if not w <= fst[F_W_PEAK] and fst[F_W_PEAK] == fst[F_W_PEAK]:
+                fst[F_W_PEAK] = w
+        out_aux[i, 4 * n_sl] = om
 
 
 @njit(cache=True, _nrt=False)
@@ -315,6 +338,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
 
     t = fst[F_T]
     h = fst[F_H]
+    first_row = ist[I_OUT_NEXT]
     if ist[I_STARTED] == 0:
         if tan is not None:
             ph_start = ph.copy()
@@ -330,9 +354,8 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
             h = _initial_step(t, y, k[0], ph, sg, mdl, wk, ctl, ytmp, dy, nd)
         if ist[I_OUT_NEXT] == 0 and out_y.shape[0] > 0:
             for i in range(ns):
-                yout[i] = y[i]
-            evaluate(t, yout, ph, sg, LEFT, mdl, wk, dy)
-            _write_row(ist[I_OUT_NEXT], t, yout, ph, mdl, wk, out_y, out_aux, fst)
+                out_y[0, i] = y[i]
+            _begin_row(0, ph, sg, out_aux)
             ist[I_OUT_NEXT] = 1
         ist[I_STARTED] = 1
         ist[I_RHS] += 2
@@ -452,8 +475,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
             if not have_rc:
                 dense_coefficients(y, ynew, k, hs, rc)
             t_e = t_new if theta >= 1.0 else t + theta * hs
-            _write_outputs(t, t_e, hs, rc, ph, sg, mdl, wk, dy, yout, ctl, fst, out_y, out_aux,
-                           ist)
+            _sample_states(t, t_e, hs, rc, ph, sg, ctl, out_y, out_aux, ist)
             dense_eval(rc, theta, y)
             first_new = ist[I_EVENTS]
             fst[F_H_CAP] = np.inf
@@ -503,8 +525,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
         if ist[I_OUT_NEXT] < out_y.shape[0] and next_out <= t_new:
             if not have_rc:
                 dense_coefficients(y, ynew, k, hs, rc)
-            _write_outputs(t, t_new, hs, rc, ph, sg, mdl, wk, dy, yout, ctl, fst, out_y, out_aux,
-                           ist)
+            _sample_states(t, t_new, hs, rc, ph, sg, ctl, out_y, out_aux, ist)
         for i in range(ns):
             y[i] = ynew[i]
         for i in range(ns):
@@ -528,6 +549,8 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
                 tangent.saltation(MODE_KINK, NO_EVENT, t, ypre, ph_start, sgpre, ev_prev, y, ph, sg,
                                   k[0], mdl, tv, tk, tsc)
 
+    _complete_rows(first_row, ist[I_OUT_NEXT], ctl, mdl, wk, yout, dy, ph.copy(), sg.copy(),
+                   out_y, out_aux, fst)
     fst[F_T] = t
     fst[F_H] = h
     ist[I_STATUS] = status
