@@ -13,14 +13,14 @@ from pathlib import Path
 
 import fivdisc
 
-# integrate._aux slices the work array at the offset that layout.work_rows computes: its
+# switch._aux slices the work array at the offset that layout.work_rows computes: its
 # own file stays the same when layout.py changes, which is the case numba's per-file
 # stamp missed.
 _PROBE = """
 import json
 import numpy as np
 from fivdisc._kernels.cache import sources_hash
-from fivdisc._kernels.integrate import _aux
+from fivdisc._kernels.switch import _aux
 from fivdisc._kernels.layout import KernelModel
 mdl = KernelModel(*(np.zeros((1, 1)) for _ in range(5)), np.zeros(1))
 rows = _aux(mdl, np.zeros((40, 1))).shape[0]

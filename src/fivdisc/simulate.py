@@ -19,6 +19,7 @@ from fivdisc.limits import check_simulation
 from fivdisc.model import Model, build_model
 from fivdisc.result import EVENT_KINDS, PHASE_NAMES, Result, build_dataset
 from fivdisc.speed import SpeedProfile
+from fivdisc.split_compile import compile_split
 from fivdisc.warmup import warm_up
 
 # Failures in which a state beyond the plate theory's range means the model diverged.
@@ -150,6 +151,7 @@ def simulate(
     # before the progress bar starts, so the bar's rate and estimate are the integrator's
     # (and the wall time excludes the compilation, announced with the bar).
     with compile_notice(kern.run, show=progress):
+        compile_split(run)
         run.advance(0.0)
     imported = warm_up("xarray")
     bar = None

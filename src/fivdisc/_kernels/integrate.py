@@ -29,6 +29,7 @@ from fivdisc._kernels.layout import (
     STICK,
     n_dynamic,
     sizes,
+    work_rows,
 )
 from fivdisc._kernels.slots import (
     C_ATOL,
@@ -69,7 +70,6 @@ from fivdisc._kernels.switch import (
     MODE_KINK,
     MODE_START,
     NO_EVENT,
-    _aux,
     _restart,
     _switch,
 )
@@ -235,7 +235,9 @@ def _complete_rows(first, last, ctl, mdl, wk, ys, dy, ph, sg, out_y, out_aux, fs
     Done once the steps are taken, not at each sample: interleaved with the steps, the
     samples cost about twice as much (the CHANGELOG gives the figures)."""
     n, n_sl, half = sizes(mdl)
-    aux = _aux(mdl, wk)
+    # Rows of wk, not the view _aux gives: a function compiled without reference counts
+    # (_nrt=False) may not take an array view from a callee.
+    r_aux = work_rows(n_sl)[3]
     for i in range(first, last):
         ti = min(i * ctl[C_OUT_DT], ctl[C_T_FINAL])
         for j in range(n_sl):
@@ -249,12 +251,12 @@ def _complete_rows(first, last, ctl, mdl, wk, ys, dy, ph, sg, out_y, out_aux, fs
             if ph[j] == STICK:
                 out_y[i, half + n + j] = om
             if ph[j] != SEPARATION:
-                out_y[i, n + n_sl + j] = aux[A_WC, j]
-                out_y[i, half + n + n_sl + j] = aux[A_WCD, j]
-            out_aux[i, j] = aux[A_N, j]
-            out_aux[i, n_sl + j] = aux[A_F, j]
-            w = abs(aux[A_WC, j])
-            out_aux[i, 3 * n_sl + j] = aux[A_WC, j]
+                out_y[i, n + n_sl + j] = wk[r_aux + A_WC, j]
+                out_y[i, half + n + n_sl + j] = wk[r_aux + A_WCD, j]
+            out_aux[i, j] = wk[r_aux + A_N, j]
+            out_aux[i, n_sl + j] = wk[r_aux + A_F, j]
+            w = abs(wk[r_aux + A_WC, j])
+            out_aux[i, 3 * n_sl + j] = wk[r_aux + A_WC, j]
             if not w <= fst[F_W_PEAK] and fst[F_W_PEAK] == fst[F_W_PEAK]:
                 fst[F_W_PEAK] = w
         out_aux[i, 4 * n_sl] = om
