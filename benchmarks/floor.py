@@ -13,8 +13,9 @@ price of its right-hand side, events and output.
 Run ``python benchmarks/floor.py``: it prints, for the paper's Fig. 10 case (one slider,
 7 modal coordinates), the kernel's cost per accepted step without output and with the
 10 kHz output, each as a ratio to both floors measured in the same run; then the cost per
-step at 7 to 23 modal coordinates against the floors, and at 1 to 8 sliders, each with
-its least-squares slope and the largest deviation from that line.
+step at 7 to 23 modal coordinates against the floors, and at 1 to 8 sliders beside the
+floors of the same sliders (each as a ratio to one slider's), each with its
+least-squares slope and the largest deviation from that line.
 """
 
 from __future__ import annotations
@@ -208,8 +209,14 @@ def main() -> None:
     fig04["simulation"] = {**fig04.get("simulation", {}), "duration": 5.0, "output_rate": 100.0}
     counts = [1, 2, 4, 8]
     per = per_step({str(s): _spread(fig04, s) for s in counts})
+    # The floors grow with the sliders too: what the kernel's growth compares with.
+    floors = {s: floor_cost(build_model(Case(**_spread(fig04, s))), 5.0) for s in counts}
     for s in counts:
-        print(f"{s} slider(s): {per[str(s)]['cost'] * 1e6:.2f} us per step")
+        cost = per[str(s)]["cost"]
+        grows = ", ".join(f"{name} floor {f[0] * 1e6:.2f} us ({f[0] / floors[1][name][0]:.2f} x)"
+                          for name, f in floors[s].items())
+        print(f"{s} slider(s): {cost * 1e6:.2f} us per step "
+              f"({cost / per['1']['cost']:.2f} x one slider); {grows}")
     _slope("slider", counts, [per[str(s)]["cost"] for s in counts])
 
 

@@ -28,14 +28,14 @@ if TYPE_CHECKING:
 
 __all__ = ["HELPER_KERNELS", "OWN_KERNELS", "callee_types", "compile_split"]
 
-#: What the helper process compiles, and what this process compiles before ``run``: the
-#: two shares took about 9 and 7 s of the 20 s on the machine of the benchmarks.
+#: What the helper process compiles, and what this process compiles before ``run``: two
+#: shares of about the same compile time.
 HELPER_KERNELS = ("_stages", "_complete_rows", "locate", "_event_at", "_sample_states",
                   "dense_coefficients")
 OWN_KERNELS = ("_switch",)
 
 # The helper is given this long [s] before this process gives up on it and compiles its
-# part itself: ten times what it takes on a loaded 2-core machine.
+# part itself: only so that a hung helper cannot hang the first simulation.
 _HELPER_TIMEOUT = 600.0
 
 

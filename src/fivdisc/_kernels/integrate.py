@@ -233,7 +233,7 @@ def _complete_rows(first, last, ctl, mdl, wk, ys, dy, ph, sg, out_y, out_aux, fs
     of :func:`run` without reading the samples again.
 
     Done once the steps are taken, not at each sample: interleaved with the steps, the
-    samples cost about twice as much (the CHANGELOG gives the figures)."""
+    samples cost more (the CHANGELOG gives the figures)."""
     n, n_sl, half = sizes(mdl)
     # Rows of wk, not the view _aux gives: a function compiled without reference counts
     # (_nrt=False) may not take an array view from a callee.
