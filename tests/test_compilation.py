@@ -13,19 +13,47 @@ from fivdisc import compilation
 from fivdisc.cli import cli
 
 
-def _dispatcher(tmp_path, signatures=(), cached=False):
-    """A stand-in for a numba dispatcher: compiled signatures and a cache index file."""
-    index = tmp_path / "run.nbi"
-    if cached:
-        index.write_bytes(b"")
-    cache = types.SimpleNamespace(_cache_file=types.SimpleNamespace(_index_path=str(index)))
+def _dispatcher(signatures=(), index=None):
+    """A stand-in for a numba dispatcher: compiled signatures and what its cache index
+    holds (None: no index to read; an exception: one that cannot be read)."""
+
+    def load_index():
+        if isinstance(index, Exception):
+            raise index
+        return index or {}
+
+    cache = types.SimpleNamespace(_cache_file=types.SimpleNamespace(_load_index=load_index))
     return types.SimpleNamespace(signatures=list(signatures), _cache=cache)
 
 
-def test_needs_compiling_only_without_memory_or_cache(tmp_path):
-    assert compilation.needs_compiling(_dispatcher(tmp_path))
-    assert not compilation.needs_compiling(_dispatcher(tmp_path, cached=True))
-    assert not compilation.needs_compiling(_dispatcher(tmp_path, signatures=["sig"]))
+def test_needs_compiling_only_without_memory_or_fresh_cache():
+    assert compilation.needs_compiling(_dispatcher())
+    assert not compilation.needs_compiling(_dispatcher(index={"sig": "run.1.nbc"}))
+    assert not compilation.needs_compiling(_dispatcher(signatures=["sig"]))
+    assert compilation.needs_compiling(_dispatcher(index=EOFError("truncated")))
+    assert compilation.needs_compiling(types.SimpleNamespace(signatures=[]))
+
+
+def test_a_stale_cache_index_needs_compiling(tmp_path):
+    """numba's own index of a real function: fresh after a compile, stale once the
+    function's source stamp changes (an edited kernel file, another numba)."""
+    import numba
+
+    def twice(x):
+        return 2 * x
+
+    env = {"NUMBA_CACHE_DIR": str(tmp_path)}
+    with pytest.MonkeyPatch.context() as mp:
+        for key, value in env.items():
+            mp.setenv(key, value)
+        mp.setattr(numba.config, "CACHE_DIR", str(tmp_path))
+        fresh = numba.njit(cache=True)(twice)
+        assert compilation.needs_compiling(fresh)
+        fresh(1.0)
+        again = numba.njit(cache=True)(twice)
+        assert not compilation.needs_compiling(again)
+        again._cache._cache_file._source_stamp = "another"
+        assert compilation.needs_compiling(again)
 
 
 class _Terminal(io.StringIO):
@@ -34,10 +62,10 @@ class _Terminal(io.StringIO):
 
 
 @pytest.mark.parametrize("stream", [io.StringIO, _Terminal])
-def test_notice_while_compiling(tmp_path, monkeypatch, stream):
+def test_notice_while_compiling(monkeypatch, stream):
     monkeypatch.setattr(compilation, "_TICK", 0.01)
     out = stream()
-    with compilation.compile_notice(_dispatcher(tmp_path), stream=out):
+    with compilation.compile_notice(_dispatcher(), stream=out):
         import time
 
         time.sleep(0.1)
@@ -49,18 +77,18 @@ def test_notice_while_compiling(tmp_path, monkeypatch, stream):
         assert text.count("\r") >= 3  # the spinner turned
 
 
-def test_no_notice_when_cached_or_quiet(tmp_path):
-    for dispatcher, show in ((_dispatcher(tmp_path, cached=True), True),
-                             (_dispatcher(tmp_path), False)):
+def test_no_notice_when_cached_or_quiet():
+    for dispatcher, show in ((_dispatcher(index={"sig": "run.1.nbc"}), True),
+                             (_dispatcher(), False)):
         out = io.StringIO()
         with compilation.compile_notice(dispatcher, show=show, stream=out):
             pass
         assert out.getvalue() == ""
 
 
-def test_interrupted_compilation_ends_the_line(tmp_path):
+def test_interrupted_compilation_ends_the_line():
     out = _Terminal()
-    with pytest.raises(KeyboardInterrupt), compilation.compile_notice(_dispatcher(tmp_path),
+    with pytest.raises(KeyboardInterrupt), compilation.compile_notice(_dispatcher(),
                                                                       stream=out):
         raise KeyboardInterrupt
     assert out.getvalue().endswith("\n") and "compiled" not in out.getvalue()
@@ -70,6 +98,8 @@ def test_simulate_command_announces_compilation(tmp_path, monkeypatch):
     """A fresh installation (no kernel in memory or cache): the notice comes first, on
     stderr; the summary's wall time says it leaves the compilation out."""
     monkeypatch.setattr(compilation, "needs_compiling", lambda dispatcher: True)
+    # The kernel is in the cache: no helper process to share a compilation with.
+    monkeypatch.setattr("fivdisc.split_compile._cores", lambda: 1)
     case = tmp_path / "c.toml"
     case.write_text("[simulation]\nduration = 0.01\n")
     run = CliRunner().invoke(cli, ["simulate", str(case), "-o", str(tmp_path / "c.nc")])

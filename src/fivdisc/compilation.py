@@ -14,7 +14,6 @@ import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
-from pathlib import Path
 from typing import Any, TextIO
 
 __all__ = ["COMPILE_SECONDS", "TANGENT_COMPILE_SECONDS", "compile_notice", "needs_compiling",
@@ -32,16 +31,23 @@ _TICK = 0.25  # [s] between spinner frames
 
 def needs_compiling(dispatcher: Any) -> bool:
     """Whether calling a numba dispatcher will compile it: it has no compiled signature in
-    this process and numba's on-disk cache has no index for it.
+    this process and numba's on-disk cache holds no fresh entry for it.
 
-    A cache index that numba then finds stale (another numba version) still counts as
-    cached here; that is a rare upgrade path, and the run then compiles without notice.
+    An index that numba would find stale (written by another numba version, or for kernel
+    sources since edited, see :mod:`fivdisc._kernels.cache`) counts as no entry, as does
+    one it cannot read.
     """
     if getattr(dispatcher, "signatures", None):
         return False
-    cache = getattr(dispatcher, "_cache", None)
-    index = getattr(getattr(cache, "_cache_file", None), "_index_path", None)
-    return index is None or not Path(index).exists()
+    cache_file = getattr(getattr(dispatcher, "_cache", None), "_cache_file", None)
+    load_index = getattr(cache_file, "_load_index", None)
+    if load_index is None:
+        return True
+    try:
+        return not load_index()
+    except Exception:
+        # Whatever numba cannot unpickle it compiles afresh.
+        return True
 
 
 @contextmanager
