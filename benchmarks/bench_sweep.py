@@ -1,6 +1,6 @@
 """Time sweeps: the paper's Fig. 27 separation map, per-worker throughput, 2 vs 1 workers.
 
-Run ``python benchmarks/bench_sweep.py`` (a 40 x 40 map, about 10 min on two cores) or
+Run ``python benchmarks/bench_sweep.py`` (a 40 x 40 map, a few minutes on two cores) or
 ``python benchmarks/bench_sweep.py --n 12`` for a smaller map. Printed:
 
 1. the speed of a single run in this process (simulated seconds per wall second);
