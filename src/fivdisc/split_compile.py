@@ -73,13 +73,11 @@ def callee_types(run: Integration) -> dict[str, tuple]:
     ist, fst, ctl = typeof(run.ist), typeof(run.fst), typeof(run.ctl)
     out_y, out_aux = typeof(run.out_y), typeof(run.out_aux)
     none = typeof(None)
-    located = (f8, i8, f8, f8, mat, ph, sg, mdl, mat, vec, vec, vec, ist)
     return {
         "_stages": (f8, f8, y, ph, sg, mdl, mat, k, vec, vec, vec, none, none),
-        "_complete_rows": (typeof(run.ist[0]), typeof(run.ist[0]), ctl, mdl, mat, vec, vec,
-                           ivec, ivec, out_y, out_aux, fst),
+        "_complete_rows": (i8, i8, ctl, mdl, mat, vec, vec, ivec, ivec, out_y, out_aux, fst),
         "locate": (i8, f8, f8, f8, f8, f8, f8, mat, ph, sg, mdl, mat, vec, vec, vec, ist),
-        "_event_at": located,
+        "_event_at": (f8, i8, f8, f8, mat, ph, sg, mdl, mat, vec, vec, vec, ist),
         "_sample_states": (f8, f8, f8, mat, ph, sg, ctl, out_y, out_aux, ist),
         "dense_coefficients": (y, vec, k, f8, mat),
         "_switch": (i8, i8, f8, y, ph, sg, ph, ev_prev, mdl, mat, vec, k, ev_prev, ev_t, ev_i,
