@@ -48,3 +48,15 @@ def nearest(name: str, names: Iterable[str]) -> str:
         return max(whole, last)
 
     return f"; did you mean '{max(candidates, key=likeness)}'?"
+
+
+class ConvergenceError(FivdiscError, RuntimeError):
+    """An iterative solve (a periodic orbit's Newton shooting, a continuation step) did
+    not converge. ``result`` holds the last iterate (for an orbit, a
+    :class:`~fivdisc.analysis.orbits.PeriodicOrbit` whose ``converged`` is False), and
+    ``reason`` says which budget ran out or what failed."""
+
+    def __init__(self, message: str, result: object = None, reason: str = "") -> None:
+        super().__init__(message)
+        self.result = result
+        self.reason = reason

@@ -176,6 +176,45 @@ def friction_arrays(friction, opts: np.ndarray) -> np.ndarray:
     return table
 
 
+# Per-slider case keys that enter the model only through a row of the kernel's slider
+# array, and friction keys that enter only through its options (layout.FRICTION_SLOTS):
+# a model at other values of them is the base model patched, without rebuilding the
+# plate modes.
+_SLIDER_ARRAYS = {
+    "normal_damping": "cz",
+    "rotational_damping": "cphi",
+    "normal_stiffness": "kz",
+    "rotational_stiffness": "kphi",
+    "preload": "n0",
+}
+
+
+def model_at(base: Model, case: Case, updates: dict[str, float]) -> Model:
+    """The model of ``case.replace(updates)``, by patching ``base`` (the model of
+    ``case``) where that is exact: the constant disc speed, the sliders' stiffnesses,
+    dampings and preloads, the friction law's coefficients; otherwise built afresh.
+
+    The patched model keeps ``base.case``: what it takes from the case beyond the
+    patched arrays (tolerances, output) is the same.
+    """
+    model = base
+    for key, value in updates.items():
+        parts = key.split(".")
+        if key == "speed.value" and case.speed.profile == "constant":
+            model = model.with_speed(SpeedProfile.constant(value))
+        elif parts[0] in ("slider", "sliders") and parts[-1] in _SLIDER_ARRAYS:
+            j = 0 if parts[0] == "slider" else int(parts[1])
+            name = _SLIDER_ARRAYS[parts[-1]]
+            values = model.kernel.row(name).copy()
+            values[j] = value
+            model = model.with_sliders(**{name: values})
+        elif parts[0] == "friction" and parts[-1] in lay.FRICTION_SLOTS:
+            model = model.with_friction(**{parts[-1]: value})
+        else:
+            return build_model(case.replace(updates))
+    return model
+
+
 def build_model(case: Case, speed: SpeedProfile | None = None) -> Model:
     """Assemble the kernel arrays of ``case``.
 

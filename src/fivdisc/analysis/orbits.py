@@ -7,6 +7,11 @@ flow, which removes the freedom to slide x0 along the orbit). Newton's method us
 monodromy matrix ``M = d phi_T / d x0``, carried exactly across every switch by the
 saltation matrices (:mod:`fivdisc._kernels.tangent`), and ``d phi_T / dT = f(phi_T(x0))``.
 
+A converged orbit is reduced to its minimal period: an orbit of period T is also a fixed
+point of the flow over 2T, 3T, ..., so a first guess near a multiple of the period
+converges there. The flow from x0 over T/k is tried for k up to 12, and the largest k
+at which the orbit closes is solved again.
+
 The Floquet multipliers are the eigenvalues of ``M``. An autonomous orbit has one equal
 to 1 (the flow direction); a direction collapsed by the flow (onto the stick manifold at
 slip-to-stick, by a plastic impact) or a coordinate that is not free at x0 (``z``,
@@ -16,23 +21,27 @@ slip-to-stick, by a plastic impact) or a coordinate that is not free at x0 (``z`
 from __future__ import annotations
 
 import json
+import time
 from dataclasses import dataclass, field
+from os import PathLike
 
 import numpy as np
 
 from fivdisc._kernels import layout as lay
 from fivdisc.case import Case
-from fivdisc.errors import FivdiscError
+from fivdisc.errors import ConvergenceError, FivdiscError
 from fivdisc.integration import Integration, tangent_step
 from fivdisc.model import Model, build_model
 
-__all__ = ["PeriodicOrbit", "periodic_orbit"]
+__all__ = ["PeriodicOrbit", "Shooting", "periodic_orbit", "saved_start"]
 
 VERDICTS = ("stable", "unstable", "not converged")
 # Halvings of a Newton step that does not reduce the residual before giving up.
 _HALVINGS = 6
-
-
+# Largest divisor of a converged period tried when reducing it to the minimal period.
+_MAX_DIVISOR = 12
+# A return at T/k closer than this (the residual's measure) is solved again at T/k.
+_CLOSES = 1e-4
 @dataclass(frozen=True)
 class PeriodicOrbit:
     """A periodic orbit found by :func:`periodic_orbit`.
@@ -63,6 +72,9 @@ class PeriodicOrbit:
         ``"not converged"``.
     labels : tuple of str
         Names of the state's coordinates.
+    start : str
+        Where the search started (a transient from the case's initial state, a given
+        state, a file): coexisting orbits of nearly the same period are told apart by it.
     """
 
     period: float
@@ -75,6 +87,13 @@ class PeriodicOrbit:
     iterations: int
     verdict: str
     labels: tuple[str, ...] = field(default=())
+    start: str = ""
+
+    @property
+    def converged(self) -> bool:
+        """Whether Newton shooting converged: only then is this a periodic orbit, and
+        its multipliers its Floquet multipliers."""
+        return self.verdict != "not converged"
 
     @property
     def moduli(self) -> np.ndarray:
@@ -93,15 +112,17 @@ class PeriodicOrbit:
             return np.log(self.moduli) / self.period
 
     def to_dict(self) -> dict:
-        """The orbit as plain JSON types: period [s], multipliers (real, imag,
-        modulus), verdict, residual."""
+        """The orbit as plain JSON types: whether it converged, period [s], multipliers
+        (real, imag, modulus), verdict, residual, where the search started."""
         return {
+            "converged": self.converged,
             "period": self.period,
             "multipliers": [{"real": float(m.real), "imag": float(m.imag),
                              "modulus": float(abs(m))} for m in self.multipliers],
             "verdict": self.verdict,
             "residual": self.residual,
             "iterations": self.iterations,
+            "start": self.start,
         }
 
     def to_json(self) -> str:
@@ -139,19 +160,26 @@ class PeriodicOrbit:
                     "label": ("coordinate", list(self.labels or map(str, coord)))},
             attrs={"period": self.period, "period_units": "s", "verdict": self.verdict,
                    "residual": self.residual, "iterations": self.iterations,
-                   "trivial_multiplier": self.trivial},
+                   "trivial_multiplier": self.trivial, "converged": int(self.converged),
+                   "start": self.start, "content": "periodic orbit"},
         )
         return ds
 
     def __str__(self) -> str:
+        if not self.converged:
+            return (f"no periodic orbit: Newton shooting did not converge (residual "
+                    f"{self.residual:.2e} after {self.iterations} iteration"
+                    f"{'' if self.iterations == 1 else 's'}, last period {self.period:.9g} s; "
+                    f"started {self.start or 'from the given state'})")
         lines = [f"periodic orbit: T = {self.period:.9g} s ({1 / self.period:.6g} Hz), "
                  f"{self.verdict}, residual {self.residual:.2e} after {self.iterations} "
                  f"Newton iteration{'' if self.iterations == 1 else 's'}",
+                 f"started {self.start}" if self.start else "",
                  "Floquet multipliers (modulus, real, imag):"]
         for i, m in enumerate(self.multipliers):
             note = "  flow direction" if i == self.trivial else ""
             lines.append(f"  {abs(m):.9f}  {m.real:+.9f}  {m.imag:+.9f}{note}")
-        return "\n".join(lines)
+        return "\n".join(line for line in lines if line)
 
 
 def state_labels(model: Model) -> tuple[str, ...]:
@@ -174,36 +202,185 @@ def energy_scales(model: Model) -> np.ndarray:
 
 
 @dataclass
-class _Shot:
+class Shot:
+    """One run of the flow map: the state reached, the monodromy (None without tangents),
+    the vector field at both ends, and the coordinates free at the start."""
+
     end: np.ndarray
-    monodromy: np.ndarray
+    monodromy: np.ndarray | None
     rate_end: np.ndarray
     rate_start: np.ndarray
     free: np.ndarray
 
 
-def _shoot(model: Model, x0: np.ndarray, phases: np.ndarray, period: float, rtol: float,
-           atol: float) -> _Shot:
-    """The flow map over ``period`` from ``x0`` with its Jacobian (steps capped at
-    :func:`~fivdisc.integration.tangent_step`, so that directions the orbit hardly
-    excites are integrated stably at any rtol)."""
-    cap = tangent_step(model)
-    if model.case.simulation.max_step > 0:
-        cap = min(cap, model.case.simulation.max_step)
-    run = Integration(model, x0, duration=period, output_rate=1.0 / period, rtol=rtol,
-                      atol=atol, max_step=cap, phases=phases)
-    run.set_tangents(np.eye(model.state_size))
-    run.advance(0.0)
-    rate_start = run.rhs()
-    free = run.free()
-    run.run_to(period)
-    if run.status_name != "success":
-        raise FivdiscError(f"periodic_orbit: the run over one period ended with "
-                           f"{run.status_name} at t = {run.t:.9g} s")
-    end = run.out_y[1, : model.state_size].copy()
-    return _Shot(end, run.tangents().T, run.rhs(), rate_start, free)
+class Shooting:
+    """The flow map of a model over a time from a start whose phases are given, with its
+    Jacobian: what Newton shooting (:func:`periodic_orbit`) and continuation
+    (:func:`fivdisc.analysis.continuation.continue_orbit`) solve.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    phases : array of int
+        Each slider's phase at the start.
+    rtol, atol : float
+        Integration tolerances.
+    scale : ndarray, optional
+        Per coordinate, the size distances are measured in (default
+        :func:`energy_scales` of `model`; a continuation keeps its first point's).
+    """
+
+    def __init__(self, model: Model, phases: np.ndarray, rtol: float, atol: float,
+                 scale: np.ndarray | None = None) -> None:
+        self.model = model
+        self.phases = np.asarray(phases, dtype=np.int64)
+        self.rtol, self.atol = rtol, atol
+        self.scale = energy_scales(model) if scale is None else scale
+        # Steps capped at tangent_step, so that directions the orbit hardly excites are
+        # integrated stably at any rtol.
+        cap = tangent_step(model)
+        if model.case.simulation.max_step > 0:
+            cap = min(cap, model.case.simulation.max_step)
+        self.cap = cap
+
+    def at(self, model: Model) -> Shooting:
+        """The same shooting (phases, tolerances, scales) on another model."""
+        return Shooting(model, self.phases, self.rtol, self.atol, self.scale)
+
+    def shoot(self, x0: np.ndarray, period: float, tangents: bool = True) -> Shot:
+        """The flow map over ``period`` [s] from ``x0``, with its Jacobian if asked.
+
+        Raises
+        ------
+        FivdiscError
+            The run did not reach ``period`` (divergence, endless switching, ...).
+        """
+        nd = self.model.state_size
+        run = Integration(self.model, x0, duration=period, output_rate=1.0 / period,
+                          rtol=self.rtol, atol=self.atol, max_step=self.cap,
+                          phases=self.phases)
+        if tangents:
+            run.set_tangents(np.eye(nd))
+        run.advance(0.0)
+        rate_start = run.rhs()
+        free = run.free()
+        run.run_to(period)
+        if run.status_name != "success":
+            raise FivdiscError(f"the run over one period ({period:.6g} s) ended with "
+                               f"{run.status_name} at t = {run.t:.9g} s")
+        end = run.out_y[1, :nd].copy()
+        return Shot(end, run.tangents().T if tangents else None, run.rhs(), rate_start, free)
+
+    def gap(self, shot: Shot, x0: np.ndarray) -> np.ndarray:
+        """``(phi_T(x0) - x0) / scale`` on the free coordinates."""
+        free = shot.free
+        return (shot.end - x0)[free] / self.scale[free]
+
+    def residual(self, shot: Shot, x0: np.ndarray, period: float) -> float:
+        """The gap's norm relative to the orbit's size ``|f(x0)| T`` (scaled): the
+        measure of convergence."""
+        size = np.linalg.norm(shot.rate_start / self.scale) * period
+        return float(np.linalg.norm(self.gap(shot, x0)) / size) if size > 0 else np.inf
+
+    def jacobian(self, shot: Shot) -> np.ndarray:
+        """``[M - I, f(end); f(x0)^T, 0]`` on the scaled free coordinates and T: the
+        Jacobian of the gap and the phase condition."""
+        free, sc = shot.free, self.scale
+        m = int(free.sum())
+        jac = np.zeros((m + 1, m + 1))
+        jac[:m, :m] = shot.monodromy[np.ix_(free, free)] * (sc[free][None, :]
+                                                            / sc[free][:, None])
+        jac[:m, :m] -= np.eye(m)
+        jac[:m, m] = shot.rate_end[free] / sc[free]
+        jac[m, :m] = shot.rate_start[free] / sc[free]
+        return jac
+
+    def stability(self, shot: Shot) -> tuple[np.ndarray, int]:
+        """The monodromy's eigenvalues, largest modulus first, and the index of the flow
+        direction's."""
+        mult, vecs = np.linalg.eig(shot.monodromy)
+        order = np.argsort(-np.abs(mult), kind="stable")
+        mult, vecs = mult[order], vecs[:, order]
+        return mult, _flow_multiplier(mult, vecs, shot.rate_start, self.scale)
 
 
+def verdict_of(mult: np.ndarray, trivial: int) -> str:
+    """``"stable"`` if every multiplier but the flow direction's lies inside the unit
+    circle, else ``"unstable"``."""
+    others = np.delete(np.abs(mult), trivial)
+    return "stable" if (others.size == 0 or others.max() < 1.0) else "unstable"
+
+
+@dataclass
+class _Newton:
+    x0: np.ndarray
+    period: float
+    shot: Shot
+    residual: float
+    iterations: int
+    reason: str
+
+
+def _newton(shooting: Shooting, x0: np.ndarray, period: float, tol: float,
+            max_iterations: int, deadline: float, bar=None) -> _Newton:
+    """Newton shooting on (x0, T) from a guess, each step halved until it reduces the
+    residual; ``reason`` is "" when converged, else what ended the iteration."""
+    sc = shooting.scale
+    shot = shooting.shoot(x0, period)
+    residual = shooting.residual(shot, x0, period)
+    iterations = 0
+    reason = ""
+    while residual >= tol:
+        if iterations >= max_iterations:
+            reason = f"the iteration budget ({max_iterations} Newton iterations) ran out"
+            break
+        if time.monotonic() > deadline:
+            reason = "the time budget ran out"
+            break
+        iterations += 1
+        free = shot.free
+        m = int(free.sum())
+        step = np.linalg.lstsq(shooting.jacobian(shot), np.r_[-shooting.gap(shot, x0), 0.0],
+                               rcond=None)[0]
+        # The flow map is smooth only while the switch sequence stays the same: a step
+        # that adds or removes a switch may not reduce the residual, so it is halved
+        # until it does.
+        for halving in range(_HALVINGS):
+            frac = 0.5**halving
+            trial_t = period + frac * step[m]
+            if not trial_t > 0:
+                continue
+            trial_x = x0.copy()
+            trial_x[free] += frac * step[:m] * sc[free]
+            try:
+                trial = shooting.shoot(trial_x, trial_t)
+            except FivdiscError:
+                continue
+            trial_res = shooting.residual(trial, trial_x, trial_t)
+            if trial_res < residual:
+                x0, period, shot, residual = trial_x, float(trial_t), trial, trial_res
+                break
+        else:
+            reason = "no Newton step reduces the residual (the guess is too far)"
+            break
+        if bar is not None:
+            bar.update()
+            bar.set_postfix_str(f"residual {residual:.2e}")
+    return _Newton(x0, period, shot, residual, iterations, reason)
+
+
+def _returns_at(shooting: Shooting, x0: np.ndarray, period: float) -> int:
+    """The largest k <= 12 at which the orbit through ``x0`` closes after T/k (1 if none):
+    T is then k times the minimal period."""
+    for k in range(_MAX_DIVISOR, 1, -1):
+        try:
+            shot = shooting.shoot(x0, period / k, tangents=False)
+        except FivdiscError:
+            continue
+        if shooting.residual(shot, x0, period / k) < _CLOSES:
+            return k
+    return 1
 def _probe(model: Model, x0: np.ndarray, phases: np.ndarray | None, window: float,
            rtol: float, atol: float) -> tuple[np.ndarray, float]:
     """Samples of the trajectory from ``x0`` over ``window`` (about 200 per period of the
@@ -234,6 +411,12 @@ def _first_return(model: Model, samples: np.ndarray, dt: float) -> float:
     return float(first * dt)
 
 
+def _positive(name: str, value: float, unit: str = "") -> None:
+    if not (np.isfinite(value) and value > 0):
+        raise FivdiscError(f"{name} = {value!r} is invalid: must be a finite number > 0"
+                           + (f" [{unit}]" if unit else ""))
+
+
 def periodic_orbit(
     case: Case,
     guess: np.ndarray | None = None,
@@ -246,6 +429,8 @@ def periodic_orbit(
     atol: float | None = None,
     tol: float = 1e-8,
     max_iterations: int = 30,
+    time_budget: float = 900.0,
+    start: str = "",
     progress: bool = False,
 ) -> PeriodicOrbit:
     """Find a periodic orbit of a constant-speed case by shooting.
@@ -259,7 +444,8 @@ def periodic_orbit(
         case's initial state.
     period : float, optional
         A guess of the period [s]. Default: the first close return of the trajectory
-        from the guess within `window`.
+        from the guess within `window`. Either way the converged orbit is reduced to
+        its minimal period.
     phases : array of int, optional
         Phases of the sliders at `guess` (default: in contact).
     transient : float, optional
@@ -279,108 +465,142 @@ def periodic_orbit(
     tol : float
         Convergence: scaled residual ``|phi_T(x0) - x0|`` below this.
     max_iterations : int
-        Newton iterations before giving up (verdict ``"not converged"``).
+        Budget of Newton iterations.
+    time_budget : float
+        Budget of wall time for the Newton iterations [s].
+    start : str
+        Where `guess` comes from, kept in the orbit's ``start`` (default: "from the
+        given state", or the transient run's description).
     progress : bool
-        Say so on stderr when the kernel with tangent vectors compiles (first use).
+        Show the Newton iterations and their residual on a terminal (stderr), and say
+        so when the kernel with tangent vectors compiles (first use).
 
     Returns
     -------
     PeriodicOrbit
+        A converged orbit at its minimal period.
+
+    Raises
+    ------
+    ConvergenceError
+        Newton shooting did not converge within its budgets; its ``result`` is the
+        last iterate, a :class:`PeriodicOrbit` whose ``converged`` is False and whose
+        ``verdict`` is ``"not converged"``, and its ``reason`` says which budget ran out.
+    FivdiscError
+        A case that is not autonomous, or an invalid argument.
     """
     if case.speed.profile != "constant":
         raise FivdiscError(f"periodic_orbit needs a constant disc speed (speed.profile = "
                            f"'constant'), not {case.speed.profile!r}: with a varying speed "
                            "the system is not autonomous and has no free period")
-    for name, value in (("rtol", rtol), ("tol", tol), ("window", window)):
-        if not value > 0:
-            raise FivdiscError(f"{name} = {value!r} is invalid: must be > 0")
-    if period is not None and not period > 0:
-        raise FivdiscError(f"period = {period!r} is invalid: must be > 0 [s]")
+    for name, value in (("tol", tol), ("window", window), ("time_budget", time_budget)):
+        _positive(name, value)
+    if not (np.isfinite(rtol) and 0 < rtol < 1e-2):
+        raise FivdiscError(f"rtol = {rtol!r} is invalid: must be in (0, 1e-2)")
+    if period is not None:
+        _positive("period", period, "s")
+    if not (isinstance(max_iterations, int) and max_iterations >= 0):
+        raise FivdiscError(f"max_iterations = {max_iterations!r} is invalid: must be an "
+                           "integer >= 0")
     model = build_model(case)
+    if model.n_sliders == 0 or model.state_size == 0:
+        raise FivdiscError("periodic_orbit needs a case with a slider")
     from fivdisc.simulate import initial_state
 
     atol_run = atol if atol is not None else rtol * 1e-7
     if guess is None:
         y0 = initial_state(model)
         duration = case.simulation.duration if transient is None else transient
-        if not duration > 0:
-            raise FivdiscError(f"transient = {duration!r} is invalid: must be > 0 [s]")
+        _positive("transient", duration, "s")
         run = Integration(model, y0, duration=duration, rtol=rtol, atol=atol_run)
         run.run_to(duration)
+        if run.status_name != "success":
+            raise FivdiscError(f"periodic_orbit: the transient run ended with "
+                               f"{run.status_name} at t = {run.t:.9g} s")
         phases = run.ph.copy()
         samples, dt = _probe(model, run.state, phases, window, rtol, atol_run)
         x0 = samples[0].copy()
+        start = start or (f"after a {duration:g} s transient from the case's initial state "
+                          f"({case.simulation.initial_state})")
         if period is None:
             period = _first_return(model, samples, dt)
     else:
         x0 = np.array(guess, dtype=float)
-        if x0.shape != (model.state_size,):
+        if x0.shape != (model.state_size,) or not np.all(np.isfinite(x0)):
             raise FivdiscError(f"guess has shape {x0.shape}: must be ({model.state_size},), "
-                               "a state")
+                               "a finite state")
+        start = start or "from the given state"
         if period is None:
             period = _first_return(model, *_probe(model, x0, phases, window, rtol, atol_run))
     phases = (np.full(model.n_sliders, lay.SLIP) if phases is None
               else np.asarray(phases, dtype=np.int64))
-
-    sc = energy_scales(model)
-
-    def attempt(x: np.ndarray, t: float) -> tuple[_Shot, float]:
-        shot = _shoot(model, x, phases, t, rtol, atol_run)
-        gap = (shot.end - x)[shot.free] / sc[shot.free]
-        return shot, float(np.linalg.norm(gap) / (np.linalg.norm(shot.rate_start / sc) * t))
+    shooting = Shooting(model, phases, rtol, atol_run)
+    deadline = time.monotonic() + time_budget
 
     from fivdisc.compilation import tangent_notice
+    from fivdisc.progress import progress_bar
 
     with tangent_notice(show=progress):
-        shot, residual = attempt(x0, period)
-    iterations = 0
-    while residual >= tol and iterations < max_iterations:
-        iterations += 1
-        # Newton on (x0 / sc, T): [M - I, f(end); f(x0)^T, 0] (dx, dT) = (-gap, 0).
-        free = shot.free
-        m = int(free.sum())
-        gap = (shot.end - x0)[free] / sc[free]
-        jac = np.zeros((m + 1, m + 1))
-        jac[:m, :m] = shot.monodromy[np.ix_(free, free)] * (sc[free][None, :] / sc[free][:, None])
-        jac[:m, :m] -= np.eye(m)
-        jac[:m, m] = shot.rate_end[free] / sc[free]
-        jac[m, :m] = shot.rate_start[free] / sc[free]
-        step = np.linalg.lstsq(jac, np.r_[-gap, 0.0], rcond=None)[0]
-        # The flow map is smooth only while the switch sequence stays the same: a step
-        # that adds or removes a switch may not reduce the residual, so it is halved
-        # until it does.
-        for halving in range(_HALVINGS):
-            frac = 0.5**halving
-            trial_t = period + frac * step[m]
-            if not trial_t > 0:
-                continue
-            trial_x = x0.copy()
-            trial_x[free] += frac * step[:m] * sc[free]
-            try:
-                trial = attempt(trial_x, trial_t)
-            except FivdiscError:
-                continue
-            if trial[1] < residual:
-                x0, period = trial_x, float(trial_t)
-                shot, residual = trial
-                break
-        else:
-            break
-    converged = residual < tol
-    assert shot is not None
-    mult, vecs = np.linalg.eig(shot.monodromy)
-    order = np.argsort(-np.abs(mult), kind="stable")
-    mult, vecs = mult[order], vecs[:, order]
-    trivial = _flow_multiplier(mult, vecs, shot.rate_start, sc)
-    others = np.delete(np.abs(mult), trivial)
-    if not converged:
-        verdict = "not converged"
-    else:
-        verdict = "stable" if (others.size == 0 or others.max() < 1.0) else "unstable"
-    return PeriodicOrbit(period=float(period), state=x0, phases=phases.copy(),
-                         monodromy=shot.monodromy, multipliers=mult, trivial=trivial,
-                         residual=residual, iterations=iterations, verdict=verdict,
-                         labels=state_labels(model))
+        shooting.shoot(x0, min(period, 1e-6), tangents=True)
+    with progress_bar(progress, total=max_iterations, desc="Newton shooting",
+                      unit="iteration") as bar:
+        sol = _newton(shooting, x0, period, tol, max_iterations, deadline, bar)
+    if not sol.reason:
+        k = _returns_at(shooting, sol.x0, sol.period)
+        if k > 1:
+            again = _newton(shooting, sol.x0, sol.period / k, tol, max_iterations, deadline)
+            if not again.reason and abs(again.period * k / sol.period - 1.0) < 1e-6:
+                again.iterations += sol.iterations
+                sol = again
+    mult, trivial = shooting.stability(sol.shot)
+    orbit = PeriodicOrbit(period=float(sol.period), state=sol.x0, phases=phases.copy(),
+                          monodromy=sol.shot.monodromy, multipliers=mult, trivial=trivial,
+                          residual=sol.residual, iterations=sol.iterations,
+                          verdict="not converged" if sol.reason else verdict_of(mult, trivial),
+                          labels=state_labels(model), start=start)
+    if sol.reason:
+        raise ConvergenceError(
+            f"periodic_orbit: not converged: {sol.reason}; residual {sol.residual:.2e} "
+            f"(tolerance {tol:g}) with period {sol.period:.6g} s; try a longer transient, "
+            "a period guess, or a start nearer the orbit", result=orbit, reason=sol.reason)
+    return orbit
+
+
+def saved_start(path: str | PathLike[str]) -> tuple[Case | None, np.ndarray, np.ndarray,
+                                                     float | None, str]:
+    """A start for :func:`periodic_orbit` from a file fivdisc wrote: an orbit
+    (``fivdisc orbit -o``; its state, phases and period) or a simulation result (its
+    final state and phases).
+
+    Returns
+    -------
+    case : Case or None
+        The case stored in the file.
+    state : ndarray
+    phases : ndarray of int
+    period : float or None
+        The orbit's period [s] (None for a simulation result).
+    start : str
+        Where it came from, for the orbit's ``start``.
+    """
+    import xarray as xr
+
+    try:
+        with xr.open_dataset(path) as ds:
+            ds.load()
+    except (OSError, ValueError) as exc:
+        raise FivdiscError(f"--from {path}: cannot be read as a netCDF file ({exc})") from None
+    text = ds.attrs.get("case")
+    case = Case.from_toml(text) if text else None
+    if ds.attrs.get("content") == "periodic orbit" and "state" in ds:
+        return (case, ds["state"].values.astype(float), ds["phase"].values.astype(np.int64),
+                float(ds.attrs["period"]), f"from the orbit in {path}")
+    if "final_state" in ds.attrs and "final_phase" in ds.attrs:
+        state = np.atleast_1d(np.asarray(ds.attrs["final_state"], dtype=float))
+        phases = np.atleast_1d(np.asarray(ds.attrs["final_phase"], dtype=np.int64))
+        return case, state, phases, None, f"from the final state of the run in {path}"
+    raise FivdiscError(f"--from {path}: holds neither a periodic orbit (fivdisc orbit -o) "
+                       "nor a simulation result (fivdisc simulate -o)")
 
 
 def _flow_multiplier(mult: np.ndarray, vecs: np.ndarray, flow: np.ndarray,

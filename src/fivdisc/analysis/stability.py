@@ -16,8 +16,7 @@ from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium, slip_
 from fivdisc.case import Case, is_case_key, keys_like, unit_of
 from fivdisc.errors import CaseError, SimulationError, nearest
 from fivdisc.limits import check_memory
-from fivdisc.model import Model, build_model
-from fivdisc.speed import SpeedProfile
+from fivdisc.model import Model, build_model, model_at
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -25,19 +24,6 @@ if TYPE_CHECKING:
 # Bytes per grid point of a stability map: growth rate and stability flag, and the
 # dataset's and the netCDF writer's copies of them.
 _GRID_BYTES = 3 * (8 + 1)
-# Per-slider case keys that enter the model only through a row of the kernel's slider
-# array, and friction keys that enter only through its options (layout.FRICTION_SLOTS):
-# a map over them patches those values instead of rebuilding the model (and the plate
-# modes) per point.
-_SLIDER_ARRAYS = {
-    "normal_damping": "cz",
-    "rotational_damping": "cphi",
-    "normal_stiffness": "kz",
-    "rotational_stiffness": "kphi",
-    "preload": "n0",
-}
-
-
 @dataclass(frozen=True, repr=False)
 class LinearStability:
     """Eigen-analysis of the slip equations linearised about the sliding equilibrium.
@@ -279,26 +265,6 @@ def _equilibrium_key(model: Model) -> tuple:
     return tuple(a.tobytes() for a in kern)
 
 
-def _point_model(base: Model, case: Case, updates: dict[str, float]) -> Model:
-    """Model of ``case`` with ``updates``, by patching ``base`` where that is exact."""
-    model = base
-    for key, value in updates.items():
-        parts = key.split(".")
-        if key == "speed.value":
-            model = model.with_speed(SpeedProfile.constant(value))
-        elif parts[0] in ("slider", "sliders") and parts[-1] in _SLIDER_ARRAYS:
-            j = 0 if parts[0] == "slider" else int(parts[1])
-            name = _SLIDER_ARRAYS[parts[-1]]
-            values = model.kernel.row(name).copy()
-            values[j] = value
-            model = model.with_sliders(**{name: values})
-        elif parts[0] == "friction" and parts[-1] in lay.FRICTION_SLOTS:
-            model = model.with_friction(**{parts[-1]: value})
-        else:
-            return build_model(case.replace(updates))
-    return model
-
-
 def _validate_grid(case: Case, axes: list[tuple[str, np.ndarray]]) -> None:
     """Every axis value, alone and at the grid's corners, must give a valid case."""
     for key, values in axes:
@@ -372,7 +338,7 @@ def stability_map(
             jacs = []
             guess = None
             for xval in xs:
-                model = _point_model(base, case, {**fixed, ykey: float(yval), xkey: float(xval)})
+                model = model_at(base, case, {**fixed, ykey: float(yval), xkey: float(xval)})
                 key = _equilibrium_key(model)
                 if key not in cache:
                     try:

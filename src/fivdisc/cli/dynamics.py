@@ -3,6 +3,7 @@ multipliers, and Lyapunov exponents."""
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import click
@@ -24,11 +25,17 @@ def _report(res, case, as_json: bool, out: Path | None) -> None:
 
 
 @click.command()
-@click.argument("case_file", type=CASE)
+@click.argument("case_file", type=CASE, required=False)
 @click.option("--period", type=float, help="A guess of the period [s] (default: the first "
-              "close return after the transient).")
+              "close return after the transient); the orbit found is reduced to its "
+              "minimal period either way.")
 @click.option("--transient", type=float, help="Transient run before the search [s] "
               "(default: the case's simulation.duration).")
+@click.option("--from", "from_file", type=click.Path(dir_okay=False, exists=True,
+                                                     path_type=Path),
+              help="Start from a saved state instead of a transient: an orbit file "
+              "(fivdisc orbit -o) or a simulation result (its final state). Without "
+              "CASE_FILE, the case stored in the file is used.")
 @click.option("--window", type=float, default=1.0, show_default=True,
               help="How long to follow the trajectory for its first return [s].")
 @click.option("--rtol", type=float, default=1e-12, show_default=True,
@@ -38,23 +45,43 @@ def _report(res, case, as_json: bool, out: Path | None) -> None:
               help="Print period, multipliers, verdict and residual as JSON.")
 @click.option("-o", "--output", type=_NC, help="Write the orbit to a netCDF file (.nc).")
 @click.option("--progress/--no-progress", default=True, show_default=True,
-              help="Say so while the kernel with tangent vectors compiles (first use).")
-def orbit(case_file: Path, period: float | None, transient: float | None, window: float,
-          rtol: float, as_json: bool, output: Path | None, progress: bool) -> None:
+              help="Show the Newton iterations on a terminal, and say so while the kernel "
+              "with tangent vectors compiles (first use).")
+def orbit(case_file: Path | None, period: float | None, transient: float | None,
+          from_file: Path | None, window: float, rtol: float, as_json: bool,
+          output: Path | None, progress: bool) -> None:
     """Periodic orbit of CASE_FILE (constant speed) and its Floquet multipliers.
 
     Runs the case for its duration (or --transient), finds the first return of the
     trajectory and refines the orbit by Newton shooting with the exact monodromy matrix
-    (saltation matrices at every switch). CASE_FILE is a TOML file or a packaged example.
+    (saltation matrices at every switch); the orbit is reported at its minimal period.
+    CASE_FILE is a TOML file or a packaged example. An orbit that does not converge is
+    not a result: exit status 1, with the residual reached.
     """
-    from fivdisc.analysis.orbits import periodic_orbit
+    from fivdisc.analysis.orbits import periodic_orbit, saved_start
     from fivdisc.case import load_case
+    from fivdisc.errors import ConvergenceError, FivdiscError
     from fivdisc.files import check_output
 
-    case = load_case(case_file)
-    out = check_output(output, "-o", (".nc",), inputs=[case_file]) if output else None
-    res = periodic_orbit(case, period=period, transient=transient, window=window, rtol=rtol,
-                         progress=progress)
+    inputs = [p for p in (case_file, from_file) if p is not None]
+    out = check_output(output, "-o", (".nc",), inputs=inputs) if output else None
+    guess = phases = None
+    start = ""
+    case = load_case(case_file) if case_file is not None else None
+    if from_file is not None:
+        stored, guess, phases, saved_period, start = saved_start(from_file)
+        case = case or stored
+        period = period if period is not None else saved_period
+    if case is None:
+        raise FivdiscError("orbit needs CASE_FILE, or --from a file that stores its case")
+    try:
+        res = periodic_orbit(case, guess, period=period, phases=phases, transient=transient,
+                             window=window, rtol=rtol, start=start, progress=progress)
+    except ConvergenceError as exc:
+        if as_json and exc.result is not None:
+            click.echo(exc.result.to_json())
+        click.echo(f"error: {exc}", err=True)
+        sys.exit(1)
     _report(res, case, as_json, out)
 
 

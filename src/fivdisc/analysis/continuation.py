@@ -1,0 +1,633 @@
+"""Continuation of periodic orbits in one case key, through their bifurcations.
+
+A branch is followed by pseudo-arclength continuation of the shooting equations of
+:mod:`fivdisc.analysis.orbits` with the parameter ``p`` as one more unknown. With ``x``
+the free coordinates of the orbit's point, scaled (energy scales, divided by the first
+orbit's size), ``T`` the period and ``p`` the key's value, each divided by its value at
+the start, the unknowns are ``z = (x, T, p)`` and the equations
+
+* ``phi_T(x; p) - x = 0``: the orbit closes;
+* ``f(x_prev) . (x - x_prev) = 0``: the point moves orthogonally to the flow from the
+  previous point's (which fixes it on the orbit);
+* ``t_prev . (z - z_prev) = ds``: a step ``ds`` along the previous tangent.
+
+The predictor is ``z_prev + ds t_prev``; Newton's corrector takes the monodromy (exact
+across every switch) for ``d phi_T / dx``, the vector field for ``d phi_T / dT`` and a
+central difference for ``d phi_T / dp``. A corrector that needs more than
+:data:`_MAX_CORRECTION` of ``ds`` to converge, or whose tangent turns by more than 60
+degrees, is refused and the step halved: so the branch moves continuously and never
+jumps to a nearby orbit (orbits of nearly the same period coexist in the paper's cases).
+
+Bifurcations are detected between consecutive points and located by a root of a test
+function along the arclength (:func:`scipy.optimize.brentq`) or, for a change of the
+event signature, by bisection, each to a relative accuracy of 1e-6 in the parameter:
+
+* fold: the tangent's parameter component changes sign;
+* period doubling: a real multiplier crosses -1;
+* torus (Neimark-Sacker): a complex pair crosses the unit circle;
+* discontinuity-induced: the event signature (:mod:`fivdisc.analysis.cycle`) changes;
+  the multipliers on either side are reported, since they may jump there.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fivdisc.analysis.cycle import Cycle, one_period
+from fivdisc.analysis.orbits import (
+    PeriodicOrbit,
+    Shooting,
+    Shot,
+    energy_scales,
+    periodic_orbit,
+    verdict_of,
+)
+from fivdisc.case import Case, is_case_key
+from fivdisc.errors import CaseError, ConvergenceError, FivdiscError
+from fivdisc.integration import Integration
+from fivdisc.model import Model, build_model, model_at
+
+__all__ = ["Bifurcation", "check_key", "continue_orbit"]
+
+# A corrector may move the point at most this many step lengths from the predictor.
+_MAX_CORRECTION = 0.5
+# Cosine of the largest turn of the tangent between consecutive points (60 degrees).
+_MIN_COSINE = 0.5
+_MAX_NEWTON = 8
+# Relative step of the central difference d phi_T / dp.
+_DP = 1e-6
+# Relative accuracy in the parameter to which bifurcations are located.
+_LOCATE = 1e-6
+# A multiplier whose imaginary part is below this (relative) is taken as real.
+_REAL = 1e-6
+
+
+@dataclass
+class _Point:
+    """A converged point of the branch."""
+
+    z: np.ndarray
+    x: np.ndarray
+    shot: Shot
+    jac: np.ndarray
+    tangent: np.ndarray
+    multipliers: np.ndarray
+    trivial: int
+    residual: float
+    iterations: int
+    cycle: Cycle | None = None
+
+    @property
+    def verdict(self) -> str:
+        return verdict_of(self.multipliers, self.trivial)
+
+
+@dataclass
+class Bifurcation:
+    """A bifurcation located on a branch.
+
+    Attributes
+    ----------
+    kind : str
+        ``"fold"``, ``"period doubling"``, ``"torus"``, ``"branch point"`` (a real
+        multiplier through +1 without a fold) or ``"signature change"``
+        (discontinuity-induced).
+    parameter : float
+        The key's value there [its unit].
+    period : float
+        The orbit's period there [s].
+    state : ndarray
+        The orbit's point there.
+    before, after : ndarray of complex
+        Floquet multipliers on either side (the same located point for a smooth
+        bifurcation, the two sides of the bracket for a signature change).
+    signature_before, signature_after : tuple of str
+        Event signatures on either side.
+    rotation : float
+        For a torus: the critical pair's angle / 2 pi [-]; else nan.
+    point : int
+        Index of the branch point before it.
+    note : str
+        What happens there in words.
+    """
+
+    kind: str
+    parameter: float
+    period: float
+    state: np.ndarray
+    before: np.ndarray
+    after: np.ndarray
+    signature_before: tuple[str, ...]
+    signature_after: tuple[str, ...]
+    rotation: float = math.nan
+    point: int = 0
+    note: str = ""
+
+
+@dataclass
+class _Stop:
+    reason: str = ""
+    lost: bool = False
+
+
+def check_key(case: Case, key: str, option: str = "key") -> float:
+    """The current value of a numeric case key, or a one-line error.
+
+    Raises
+    ------
+    CaseError
+        The key is unknown, or not a single number (a table, a list, a name, a switch).
+    """
+    if not is_case_key(key):
+        from fivdisc.analysis.stability import resolve_key
+
+        key = resolve_key(key, option)
+    value = case.get(key)
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise CaseError(f"{option} = {key!r} is invalid: its value {value!r} is not a number; "
+                        "continuation needs a numeric key")
+    return float(value)
+
+
+class _Branch:
+    """The continuation problem: the case, the key, scales and the point machinery."""
+
+    def __init__(self, case: Case, key: str, orbit: PeriodicOrbit, rtol: float, atol: float,
+                 tol: float) -> None:
+        self.case, self.key = case, key
+        self.base = build_model(case)
+        self.p0 = check_key(case, key)
+        self.rtol, self.atol, self.tol = rtol, atol, tol
+        self.scale = energy_scales(self.base)
+        self.shooting = Shooting(self.base, orbit.phases, rtol, atol, self.scale)
+        self._models: dict[float, Model] = {}
+        self.period0 = orbit.period
+        self.ps = abs(self.p0) if self.p0 != 0 else 1.0
+
+    # --- coordinates ----------------------------------------------------------------------
+
+    def set_free(self, shot: Shot, x: np.ndarray) -> None:
+        self.free = shot.free.copy()
+        self.m = int(self.free.sum())
+        self.xs = float(np.linalg.norm(shot.rate_start / self.scale) * self.period0)
+        self.template = x.copy()
+
+    def pack(self, x: np.ndarray, period: float, p: float) -> np.ndarray:
+        return np.r_[x[self.free] / self.scale[self.free] / self.xs, period / self.period0,
+                     p / self.ps]
+
+    def unpack(self, z: np.ndarray) -> tuple[np.ndarray, float, float]:
+        x = self.template.copy()
+        x[self.free] = z[: self.m] * self.scale[self.free] * self.xs
+        return x, float(z[self.m] * self.period0), float(z[self.m + 1] * self.ps)
+
+    def model(self, p: float) -> Model:
+        if p not in self._models:
+            if len(self._models) > 64:
+                self._models.clear()
+            self._models[p] = model_at(self.base, self.case, {self.key: p})
+        return self._models[p]
+
+    def shooter(self, p: float) -> Shooting:
+        return self.shooting.at(self.model(p))
+
+    # --- equations ------------------------------------------------------------------------
+
+    def gap_of(self, shot: Shot, x: np.ndarray) -> np.ndarray:
+        return (shot.end - x)[self.free] / self.scale[self.free] / self.xs
+
+    def dgap_dp(self, x: np.ndarray, period: float, p: float) -> np.ndarray:
+        """``d (phi_T - x) / d p`` in the scaled unknowns, by a central difference."""
+        h = _DP * self.ps
+        ends = []
+        for q in (p + h, p - h):
+            ends.append(self.shooter(q).shoot(x, period, tangents=False).end)
+        return (ends[0] - ends[1])[self.free] / self.scale[self.free] / self.xs / (2 * h) \
+            * self.ps
+
+    def jacobian(self, shot: Shot, shooting: Shooting, dp: np.ndarray,
+                 ref: np.ndarray) -> np.ndarray:
+        """``(m + 1, m + 2)``: the gap's and the phase condition's derivatives in z."""
+        m = self.m
+        if not np.array_equal(shot.free, self.free):
+            raise FivdiscError("the orbit's point reached a switch (its free coordinates "
+                               "changed)")
+        base = shooting.jacobian(shot)
+        jac = np.zeros((m + 1, m + 2))
+        jac[:m, :m] = base[:m, :m]
+        jac[:m, m] = base[:m, m] * self.period0 / self.xs
+        jac[:m, m + 1] = dp
+        jac[m, :m] = ref
+        return jac
+
+    def phase_row(self, shot: Shot) -> np.ndarray:
+        f = shot.rate_start[self.free] / self.scale[self.free]
+        return f / np.linalg.norm(f)
+
+    def tangent(self, jac: np.ndarray, previous: np.ndarray | None, sign: float) -> np.ndarray:
+        """Unit null vector of ``jac``, oriented along ``previous`` (or with the sign of
+        its parameter component = ``sign``)."""
+        _, _, vt = np.linalg.svd(jac)
+        t = vt[-1]
+        if previous is not None:
+            if float(t @ previous) < 0:
+                t = -t
+        elif t[-1] * sign < 0:
+            t = -t
+        return t / np.linalg.norm(t)
+
+    def correct(self, z_pred: np.ndarray, row: np.ndarray, target: float, ref: _Point,
+                step: float, deadline: float) -> _Point:
+        """Newton on the gap, the phase condition about ``ref`` and ``row . z = target``,
+        from ``z_pred``; each correction bounded (module docstring).
+
+        Raises
+        ------
+        ConvergenceError
+            Not converged, or a correction too large (``reason`` says which).
+        """
+        phase = self.phase_row(ref.shot)
+        x_ref = ref.z[: self.m]
+        dp = ref.jac[: self.m, self.m + 1]
+        z = z_pred.copy()
+        reason = f"no convergence in {_MAX_NEWTON} Newton iterations"
+        for it in range(_MAX_NEWTON + 1):
+            x, period, p = self.unpack(z)
+            if not period > 0:
+                reason = "the period reached zero"
+                break
+            shooting = self.shooter(p)
+            try:
+                shot = shooting.shoot(x, period)
+            except FivdiscError as exc:
+                reason = str(exc)
+                break
+            residual = shooting.residual(shot, x, period)
+            if not np.array_equal(shot.free, self.free):
+                reason = "the orbit's point reached a switch"
+                break
+            if residual < self.tol:
+                dp = self.dgap_dp(x, period, p)
+                jac = self.jacobian(shot, shooting, dp, phase)
+                mult, trivial = shooting.stability(shot)
+                return _Point(z, x, shot, jac, np.zeros_like(z), mult, trivial, residual, it)
+            if it == _MAX_NEWTON or time.monotonic() > deadline:
+                reason = (f"no convergence in {_MAX_NEWTON} Newton iterations" if
+                          it == _MAX_NEWTON else "the time budget ran out")
+                break
+            jac = self.jacobian(shot, shooting, dp, phase)
+            lhs = np.vstack([jac, row])
+            rhs = -np.r_[self.gap_of(shot, x), phase @ (z[: self.m] - x_ref), row @ z - target]
+            dz = np.linalg.solve(lhs, rhs)
+            z = z + dz
+            if np.linalg.norm(z - z_pred) > _MAX_CORRECTION * step:
+                reason = "the corrector left the neighbourhood of the predictor"
+                break
+        raise ConvergenceError(reason, reason=reason)
+
+    def finish(self, point: _Point, previous: np.ndarray | None, sign: float) -> _Point:
+        point.tangent = self.tangent(point.jac, previous, sign)
+        x, period, p = self.unpack(point.z)
+        point.cycle = one_period(self.model(p), x, self.shooting.phases, period, self.rtol,
+                                 self.atol)
+        return point
+
+    def step_from(self, a: _Point, s: float, deadline: float) -> _Point:
+        """The point at arclength ``s`` from ``a`` along ``a``'s tangent."""
+        pt = self.correct(a.z + s * a.tangent, a.tangent, float(a.tangent @ a.z) + s, a,
+                          abs(s), deadline)
+        return self.finish(pt, a.tangent, 1.0)
+
+    def at_value(self, a: _Point, value: float, deadline: float) -> _Point:
+        """The point at parameter ``value``, from ``a`` (secant to it along the tangent)."""
+        target = value / self.ps
+        s = (target - a.z[-1]) / a.tangent[-1]
+        row = np.zeros_like(a.z)
+        row[-1] = 1.0
+        pt = self.correct(a.z + s * a.tangent, row, target, a, abs(s), deadline)
+        return self.finish(pt, a.tangent, 1.0)
+
+
+def _start_point(branch: _Branch, orbit: PeriodicOrbit, direction: float) -> _Point:
+    """The first point: the orbit moved to the middle of its longest interval without a
+    switch in which no slider sticks (so that the point stays away from switches along
+    the branch, and no coordinate of it is held by a sticking slider)."""
+    model = branch.base
+    cyc = one_period(model, orbit.state, orbit.phases, orbit.period, branch.rtol, branch.atol)
+    times = np.r_[0.0, cyc.switch_times, orbit.period]
+    gaps = np.where(cyc.stick_free, np.diff(times), -1.0)
+    i = int(np.argmax(gaps))
+    shift = times[i] + 0.5 * gaps[i]
+    x, phases = orbit.state, orbit.phases
+    if shift > 0:
+        run = Integration(model, x, duration=shift, output_rate=1.0 / shift,
+                          rtol=branch.rtol, atol=branch.atol, phases=phases)
+        run.run_to(shift)
+        x, phases = run.out_y[1, : model.state_size].copy(), run.ph.copy()
+    branch.shooting = Shooting(model, phases, branch.rtol, branch.atol, branch.scale)
+    shot = branch.shooting.shoot(x, orbit.period)
+    branch.set_free(shot, x)
+    z = branch.pack(x, orbit.period, branch.p0)
+    dp = branch.dgap_dp(x, orbit.period, branch.p0)
+    jac = branch.jacobian(shot, branch.shooting, dp, branch.phase_row(shot))
+    mult, trivial = branch.shooting.stability(shot)
+    residual = branch.shooting.residual(shot, x, orbit.period)
+    pt = _Point(z, x, shot, jac, np.zeros_like(z), mult, trivial, residual, 0)
+    return branch.finish(pt, None, direction)
+
+
+# --- bifurcations ---------------------------------------------------------------------------
+
+
+def _outside(mult: np.ndarray, trivial: int) -> tuple[int, int, int]:
+    """Numbers of multipliers (flow direction left out) outside the unit circle: real
+    positive, real negative, complex."""
+    others = np.delete(mult, trivial)
+    out = others[np.abs(others) > 1.0]
+    real = np.abs(out.imag) <= _REAL * np.abs(out)
+    return (int(np.sum(real & (out.real > 0))), int(np.sum(real & (out.real < 0))),
+            int(np.sum(~real)))
+
+
+def _nearest_to(mult: np.ndarray, trivial: int, kind: str) -> complex:
+    others = np.delete(mult, trivial)
+    if kind == "period doubling":
+        return complex(others[np.argmin(np.abs(others + 1.0))])
+    cplx = others[np.abs(others.imag) > _REAL * np.abs(others)]
+    return complex(cplx[np.argmin(np.abs(np.abs(cplx) - 1.0))]) if cplx.size else 0j
+
+
+def _test_value(pt: _Point, kind: str) -> float:
+    if kind == "fold":
+        return float(pt.tangent[-1])
+    if kind == "period doubling":
+        return float(_nearest_to(pt.multipliers, pt.trivial, kind).real + 1.0)
+    if kind == "branch point":
+        others = np.delete(pt.multipliers, pt.trivial)
+        real = others[np.abs(others.imag) <= _REAL * np.abs(others)]
+        return float(real.real[np.argmin(np.abs(real.real - 1.0))] - 1.0) if real.size else 1.0
+    return float(abs(_nearest_to(pt.multipliers, pt.trivial, kind)) - 1.0)
+
+
+def _smooth_kinds(a: _Point, b: _Point) -> list[str]:
+    kinds = []
+    if a.tangent[-1] * b.tangent[-1] < 0:
+        kinds.append("fold")
+    oa, ob = _outside(a.multipliers, a.trivial), _outside(b.multipliers, b.trivial)
+    if oa[1] != ob[1]:
+        kinds.append("period doubling")
+    if oa[2] != ob[2]:
+        kinds.append("torus")
+    if oa[0] != ob[0] and "fold" not in kinds:
+        kinds.append("branch point")
+    return kinds
+
+
+def _locate(branch: _Branch, a: _Point, b: _Point, s_ab: float, kind: str,
+            deadline: float) -> tuple[_Point, _Point]:
+    """The bifurcation of ``kind`` between ``a`` and ``b`` (arclength ``s_ab`` apart):
+    the located point, or for a signature change the two points bracketing it."""
+    from scipy.optimize import brentq
+
+    p_tol = _LOCATE * max(abs(branch.unpack(a.z)[2]), 1e-12) / branch.ps
+    if kind == "signature change":
+        lo, hi, s_lo, s_hi = a, b, 0.0, s_ab
+        key = a.cycle.cyclic()
+        while abs(hi.z[-1] - lo.z[-1]) > p_tol and s_hi - s_lo > 1e-12:
+            s = 0.5 * (s_lo + s_hi)
+            mid = branch.step_from(a, s, deadline)
+            if mid.cycle.cyclic() == key:
+                lo, s_lo = mid, s
+            else:
+                hi, s_hi = mid, s
+        return lo, hi
+    memo: dict[float, _Point] = {0.0: a, s_ab: b}
+
+    def value(s: float) -> float:
+        if s not in memo:
+            memo[s] = branch.step_from(a, s, deadline)
+        return _test_value(memo[s], kind)
+
+    # |dp/ds| <= 1 in the scaled unknowns, so s to p_tol gives p to p_tol.
+    s = brentq(value, 0.0, s_ab, xtol=p_tol, rtol=4 * np.finfo(float).eps)
+    value(s)
+    return memo[s], memo[s]
+
+
+def _bifurcation(branch: _Branch, kind: str, lo: _Point, hi: _Point, index: int) -> Bifurcation:
+    _, t_lo, p_lo = branch.unpack(lo.z)
+    _, t_hi, p_hi = branch.unpack(hi.z)
+    at = hi if kind == "signature change" else lo
+    rotation = math.nan
+    note = ""
+    if kind == "torus":
+        pair = _nearest_to(at.multipliers, at.trivial, kind)
+        rotation = abs(math.atan2(pair.imag, pair.real)) / (2 * math.pi)
+        note = f"a complex pair crosses the unit circle, rotation number {rotation:.6f}"
+    elif kind == "period doubling":
+        note = "a real multiplier crosses -1: an orbit of twice the period branches off"
+    elif kind == "fold":
+        note = "the branch turns back in the parameter (fold of cycles)"
+    elif kind == "branch point":
+        note = "a real multiplier crosses +1 without a fold"
+    else:
+        sides = [f"slider {j}: {u} -> {v}" for j, (u, v) in
+                 enumerate(zip(lo.cycle.signature, hi.cycle.signature, strict=True)) if u != v]
+        note = "the event signature changes (" + "; ".join(sides) + ")"
+    return Bifurcation(kind=kind, parameter=0.5 * (p_lo + p_hi), period=0.5 * (t_lo + t_hi),
+                       state=at.x.copy(), before=lo.multipliers, after=hi.multipliers,
+                       signature_before=lo.cycle.signature, signature_after=hi.cycle.signature,
+                       rotation=rotation, point=index, note=note)
+
+
+# --- the driver -----------------------------------------------------------------------------
+
+
+@dataclass
+class _Walk:
+    points: list[_Point] = field(default_factory=list)
+    bifurcations: list[Bifurcation] = field(default_factory=list)
+    stop: _Stop = field(default_factory=_Stop)
+
+
+def continue_orbit(
+    case: Case,
+    key: str,
+    to: float,
+    *,
+    orbit: PeriodicOrbit | None = None,
+    max_points: int = 200,
+    step: float = 0.02,
+    max_step: float = 0.1,
+    min_step: float = 1e-6,
+    rtol: float = 1e-12,
+    atol: float | None = None,
+    tol: float = 1e-8,
+    time_budget: float = 3600.0,
+    progress: bool = False,
+    **search,
+):
+    """Follow a periodic orbit of ``case`` as ``key`` goes to ``to``, and locate the
+    bifurcations on the way.
+
+    Parameters
+    ----------
+    case : Case
+        A constant-speed case.
+    key : str
+        A numeric case key (``speed.value``, ``slider.normal_damping``,
+        ``sliders.1.preload``, ``friction.decay``, ``disc.damping_ratio``, ...).
+    to : float
+        Where the continuation stops [the key's unit]; its side of the case's value sets
+        the direction.
+    orbit : PeriodicOrbit, optional
+        The orbit to start from (at the case's value of ``key``). Default: found as
+        :func:`~fivdisc.analysis.orbits.periodic_orbit` finds it, with ``search`` as its
+        keyword arguments (``transient``, ``period``, ``guess``, ``phases``, ...).
+    max_points : int
+        Most points on the branch (the first included).
+    step, max_step, min_step : float
+        First, largest and smallest arclength step, in the scaled unknowns (the orbit's
+        point over its size, the period over the first period, the parameter over its
+        first value): a step of 0.02 changes them by about 2 %.
+    rtol, atol, tol : float
+        Integration tolerances and the shooting residual's tolerance, as for
+        :func:`~fivdisc.analysis.orbits.periodic_orbit`.
+    time_budget : float
+        Wall time after which the continuation stops [s].
+    progress : bool
+        Show the points on a terminal (stderr).
+
+    Returns
+    -------
+    Branch
+        The points, their measures and multipliers, the bifurcations and why the
+        continuation stopped (:class:`fivdisc.analysis.branch.Branch`).
+
+    Raises
+    ------
+    CaseError
+        ``key`` is not a numeric key, or ``to`` is not an allowed value of it.
+    ConvergenceError
+        No periodic orbit to start from.
+
+    Notes
+    -----
+    The method is in the module's docstring and on the documentation's continuation
+    page. Step control: after a point that took at most 2 Newton iterations the step
+    grows by 1.5, after 5 or more it halves; a refused or failed step is halved, and a
+    step below ``min_step`` ends the branch as lost.
+    """
+    from fivdisc.analysis.branch import Branch
+    from fivdisc.progress import progress_bar
+
+    if case.speed.profile != "constant":
+        raise FivdiscError(f"continuation needs a constant disc speed (speed.profile = "
+                           f"'constant'), not {case.speed.profile!r}: with a varying speed "
+                           "the system is not autonomous and has no periodic orbits")
+    p0 = check_key(case, key)
+    if not np.isfinite(to):
+        raise CaseError(f"to = {to!r} is invalid: must be a finite value of {key}")
+    case.replace({key: float(to)})  # the target must be an allowed value
+    if to == p0:
+        raise CaseError(f"to = {to!r} is invalid: it is the case's own value of {key}; "
+                        "give the value to continue to")
+    for name, value in (("step", step), ("max_step", max_step), ("min_step", min_step),
+                        ("time_budget", time_budget), ("tol", tol)):
+        if not (np.isfinite(value) and value > 0):
+            raise FivdiscError(f"{name} = {value!r} is invalid: must be a finite number > 0")
+    if not min_step <= step <= max_step:
+        raise FivdiscError(f"step = {step!r} is invalid: must lie between min_step = "
+                           f"{min_step!r} and max_step = {max_step!r}")
+    if not (isinstance(max_points, int) and max_points >= 1):
+        raise FivdiscError(f"max_points = {max_points!r} is invalid: must be an integer >= 1")
+    atol_run = atol if atol is not None else rtol * 1e-7
+    if orbit is None:
+        orbit = periodic_orbit(case, rtol=rtol, atol=atol_run, tol=tol, progress=progress,
+                               **search)
+    elif not orbit.converged:
+        raise ConvergenceError("the start is not a converged periodic orbit", result=orbit,
+                               reason="not converged")
+    deadline = time.monotonic() + time_budget
+    direction = 1.0 if to > p0 else -1.0
+    branch = _Branch(case, key, orbit, rtol, atol_run, tol)
+    walk = _Walk()
+    with progress_bar(progress, total=max_points, desc=f"continuing in {key}",
+                      unit="point") as bar:
+        walk.points.append(_start_point(branch, orbit, direction))
+        bar.update()
+        _walk(branch, walk, to, max_points, step, max_step, min_step, deadline, bar)
+    return Branch.from_walk(branch, walk, orbit.start)
+
+
+def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
+          max_step: float, min_step: float, deadline: float, bar) -> None:
+    target = to / branch.ps
+    side = np.sign(target - walk.points[0].z[-1])
+    lo_period, hi_period = branch.period0 / 100.0, branch.period0 * 100.0
+    while len(walk.points) < max_points:
+        a = walk.points[-1]
+        if time.monotonic() > deadline:
+            walk.stop = _Stop("the time budget ran out")
+            return
+        try:
+            b = branch.step_from(a, ds, deadline)
+            if float(b.tangent @ a.tangent) < _MIN_COSINE:
+                raise ConvergenceError("the tangent turned too far", reason="turn")
+        except ConvergenceError as exc:
+            ds *= 0.5
+            if ds < min_step:
+                _, _, p = branch.unpack(a.z)
+                walk.stop = _Stop(f"the orbit is lost at {branch.key} = {p:.9g}: {exc.reason}",
+                                  lost=True)
+                return
+            continue
+        _, period, _ = branch.unpack(b.z)
+        if not lo_period < period < hi_period:
+            walk.stop = _Stop(f"the period left [{lo_period:.3g}, {hi_period:.3g}] s "
+                              "(a period growing without bound: a homoclinic orbit?)")
+            return
+        passed = np.sign(target - b.z[-1]) != side
+        if passed:
+            try:
+                b = branch.at_value(a, to, deadline)
+            except ConvergenceError:
+                ds *= 0.5
+                continue
+        _record(branch, walk, a, b, float(np.linalg.norm(b.z - a.z)), deadline)
+        walk.points.append(b)
+        bar.update()
+        _, _, p = branch.unpack(b.z)
+        bar.set_postfix_str(f"{branch.key} = {p:.6g}, T = {period:.6g} s")
+        if passed:
+            walk.stop = _Stop(f"reached {branch.key} = {to:.9g}")
+            return
+        if b.iterations <= 2:
+            ds = min(ds * 1.5, max_step)
+        elif b.iterations >= 5:
+            ds = max(ds * 0.5, min_step)
+    walk.stop = _Stop(f"the largest number of points ({max_points}) is reached")
+
+
+def _record(branch: _Branch, walk: _Walk, a: _Point, b: _Point, s_ab: float,
+            deadline: float) -> None:
+    """Locate and record the bifurcations between consecutive points ``a`` and ``b``."""
+    index = len(walk.points) - 1
+    if a.cycle.cyclic() != b.cycle.cyclic():
+        try:
+            lo, hi = _locate(branch, a, b, s_ab, "signature change", deadline)
+        except ConvergenceError:
+            lo, hi = a, b
+        walk.bifurcations.append(_bifurcation(branch, "signature change", lo, hi, index))
+        return
+    for kind in _smooth_kinds(a, b):
+        try:
+            lo, hi = _locate(branch, a, b, s_ab, kind, deadline)
+        except (ConvergenceError, ValueError):
+            lo, hi = a, b
+        walk.bifurcations.append(_bifurcation(branch, kind, lo, hi, index))
+
