@@ -146,3 +146,21 @@ def write_atomic(path: str | PathLike[str], write: Callable[[Path], Any]) -> Non
         tmp.replace(path)
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def read_dataset(path: str | PathLike[str], option: str):
+    """The whole netCDF file at `path` as an :class:`xarray.Dataset`, loaded and closed.
+
+    Raises
+    ------
+    FivdiscError
+        The file cannot be read as netCDF (the message names `option` and the file).
+    """
+    import xarray as xr
+
+    try:
+        with xr.open_dataset(path) as ds:
+            return ds.load()
+    except (OSError, ValueError) as exc:
+        raise FivdiscError(f"{option} {path}: cannot be read as a netCDF file "
+                           f"({' '.join(str(exc).split())[:120]})") from None

@@ -286,13 +286,9 @@ def open_branch(path: str | PathLike[str]) -> Branch:
     FivdiscError
         The file is not a branch.
     """
-    import xarray as xr
+    from fivdisc.files import read_dataset
 
-    try:
-        with xr.open_dataset(path) as ds:
-            ds.load()
-    except (OSError, ValueError) as exc:
-        raise FivdiscError(f"{path}: cannot be read as a netCDF file ({exc})") from None
+    ds = read_dataset(path, "branch")
     if ds.attrs.get("content") != CONTENT:
         raise FivdiscError(f"{path} is not a continuation branch (fivdisc continue -o)")
     return Branch(ds)

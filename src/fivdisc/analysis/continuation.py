@@ -51,7 +51,7 @@ from fivdisc.errors import CaseError, ConvergenceError, FivdiscError
 from fivdisc.integration import Integration
 from fivdisc.model import Model, build_model, model_at
 
-__all__ = ["Bifurcation", "check_key", "continue_orbit"]
+__all__ = ["Bifurcation", "check_key", "continue_orbit", "doubled_start"]
 
 # A corrector may move the point at most this many step lengths from the predictor.
 _MAX_CORRECTION = 0.5
@@ -312,22 +312,26 @@ class _Branch:
         return self.finish(pt, a.tangent, 1.0)
 
 
-def _start_point(branch: _Branch, orbit: PeriodicOrbit, direction: float) -> _Point:
+def _start_point(branch: _Branch, orbit: PeriodicOrbit, direction: float,
+                 along: np.ndarray | None) -> _Point:
     """The first point: the orbit moved to the middle of its longest interval without a
     switch in which no slider sticks (so that the point stays away from switches along
-    the branch, and no coordinate of it is held by a sticking slider)."""
+    the branch, and no coordinate of it is held by a sticking slider). With ``along``
+    (a state direction: branch switching) the orbit's point is kept and the first
+    tangent is ``along``."""
     model = branch.base
-    cyc = one_period(model, orbit.state, orbit.phases, orbit.period, branch.rtol, branch.atol)
-    times = np.r_[0.0, cyc.switch_times, orbit.period]
-    gaps = np.where(cyc.stick_free, np.diff(times), -1.0)
-    i = int(np.argmax(gaps))
-    shift = times[i] + 0.5 * gaps[i]
     x, phases = orbit.state, orbit.phases
-    if shift > 0:
-        run = Integration(model, x, duration=shift, output_rate=1.0 / shift,
-                          rtol=branch.rtol, atol=branch.atol, phases=phases)
-        run.run_to(shift)
-        x, phases = run.out_y[1, : model.state_size].copy(), run.ph.copy()
+    if along is None:
+        cyc = one_period(model, x, phases, orbit.period, branch.rtol, branch.atol)
+        times = np.r_[0.0, cyc.switch_times, orbit.period]
+        gaps = np.where(cyc.stick_free, np.diff(times), -1.0)
+        i = int(np.argmax(gaps))
+        shift = times[i] + 0.5 * gaps[i]
+        if shift > 0:
+            run = Integration(model, x, duration=shift, output_rate=1.0 / shift,
+                              rtol=branch.rtol, atol=branch.atol, phases=phases)
+            run.run_to(shift)
+            x, phases = run.out_y[1, : model.state_size].copy(), run.ph.copy()
     branch.shooting = Shooting(model, phases, branch.rtol, branch.atol, branch.scale)
     shot = branch.shooting.shoot(x, orbit.period)
     branch.set_free(shot, x)
@@ -337,7 +341,47 @@ def _start_point(branch: _Branch, orbit: PeriodicOrbit, direction: float) -> _Po
     mult, trivial = branch.shooting.stability(shot)
     residual = branch.shooting.residual(shot, x, orbit.period)
     pt = _Point(z, x, shot, jac, np.zeros_like(z), mult, trivial, residual, 0)
-    return branch.finish(pt, None, direction)
+    pt = branch.finish(pt, None, direction)
+    if along is not None:
+        t = np.zeros_like(z)
+        t[: branch.m] = along[branch.free] / branch.scale[branch.free]
+        pt.tangent = t / np.linalg.norm(t)
+    return pt
+
+
+def doubled_start(case: Case, state: np.ndarray, period: float, phases: np.ndarray,
+                  rtol: float = 1e-12, atol: float | None = None
+                  ) -> tuple[PeriodicOrbit, np.ndarray]:
+    """The start of the branch of doubled orbits at a period-doubling point: the orbit's
+    point taken with twice its period, and the direction in which the doubled orbits
+    leave it (the eigenvector of the multiplier nearest -1).
+
+    Returns
+    -------
+    orbit : PeriodicOrbit
+        The orbit at the point with period ``2 period`` (its multipliers are those of
+        the doubled period).
+    along : ndarray
+        The direction, for :func:`continue_orbit`'s ``along``.
+    """
+    atol = atol if atol is not None else rtol * 1e-7
+    model = build_model(case)
+    shooting = Shooting(model, phases, rtol, atol)
+    shot = shooting.shoot(state, period)
+    mult, vecs = np.linalg.eig(shot.monodromy)
+    i = int(np.argmin(np.abs(mult + 1.0)))
+    if abs(mult[i] + 1.0) > 0.05:
+        raise FivdiscError(f"the point is no period-doubling point: no multiplier is near -1 "
+                           f"(the nearest is {mult[i]:.4f})")
+    along = np.real(vecs[:, i])
+    double = shooting.shoot(state, 2.0 * period)
+    dmult, trivial = shooting.stability(double)
+    orbit = PeriodicOrbit(period=2.0 * period, state=state.copy(), phases=phases.copy(),
+                          monodromy=double.monodromy, multipliers=dmult, trivial=trivial,
+                          residual=shooting.residual(double, state, 2.0 * period),
+                          iterations=0, verdict=verdict_of(dmult, trivial),
+                          start="at a period-doubling point, twice its period")
+    return orbit, along
 
 
 # --- bifurcations ---------------------------------------------------------------------------
@@ -460,6 +504,7 @@ def continue_orbit(
     to: float,
     *,
     orbit: PeriodicOrbit | None = None,
+    along: np.ndarray | None = None,
     max_points: int = 200,
     step: float = 0.02,
     max_step: float = 0.1,
@@ -488,6 +533,9 @@ def continue_orbit(
         The orbit to start from (at the case's value of ``key``). Default: found as
         :func:`~fivdisc.analysis.orbits.periodic_orbit` finds it, with ``search`` as its
         keyword arguments (``transient``, ``period``, ``guess``, ``phases``, ...).
+    along : ndarray, optional
+        Branch switching: the first step leaves ``orbit``'s point in this state
+        direction instead of along the branch through it (see :func:`doubled_start`).
     max_points : int
         Most points on the branch (the first included).
     step, max_step, min_step : float
@@ -558,7 +606,7 @@ def continue_orbit(
     walk = _Walk()
     with progress_bar(progress, total=max_points, desc=f"continuing in {key}",
                       unit="point") as bar:
-        walk.points.append(_start_point(branch, orbit, direction))
+        walk.points.append(_start_point(branch, orbit, direction, along))
         bar.update()
         _walk(branch, walk, to, max_points, step, max_step, min_step, deadline, bar)
     return Branch.from_walk(branch, walk, orbit.start)

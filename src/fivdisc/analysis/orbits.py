@@ -583,13 +583,9 @@ def saved_start(path: str | PathLike[str]) -> tuple[Case | None, np.ndarray, np.
     start : str
         Where it came from, for the orbit's ``start``.
     """
-    import xarray as xr
+    from fivdisc.files import read_dataset
 
-    try:
-        with xr.open_dataset(path) as ds:
-            ds.load()
-    except (OSError, ValueError) as exc:
-        raise FivdiscError(f"--from {path}: cannot be read as a netCDF file ({exc})") from None
+    ds = read_dataset(path, "--from")
     text = ds.attrs.get("case")
     case = Case.from_toml(text) if text else None
     if ds.attrs.get("content") == "periodic orbit" and "state" in ds:

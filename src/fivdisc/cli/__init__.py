@@ -48,7 +48,17 @@ def cli() -> None:
 
 
 def _register() -> None:
-    from fivdisc.cli import dynamics, examples, modes, plot, reproduce, simulate, stability, sweep
+    from fivdisc.cli import (
+        continuation,
+        dynamics,
+        examples,
+        modes,
+        plot,
+        reproduce,
+        simulate,
+        stability,
+        sweep,
+    )
 
     cli.add_command(modes.modes)
     cli.add_command(simulate.simulate)
@@ -56,6 +66,7 @@ def _register() -> None:
     cli.add_command(stability.stability)
     cli.add_command(dynamics.orbit)
     cli.add_command(dynamics.lyapunov)
+    cli.add_command(continuation.continuation)
     cli.add_command(sweep.sweep)
     cli.add_command(sweep.separation_map)
     cli.add_command(sweep.bifurcation)

@@ -1,0 +1,154 @@
+"""``fivdisc continue``: a branch of periodic orbits followed in one case key, with its
+bifurcations."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from fivdisc.cli._case import CASE
+
+
+@click.command(name="continue")
+@click.argument("case_file", type=CASE, required=False)
+@click.option("--key", required=True,
+              help="The numeric case key to continue in (speed.value, slider.normal_damping, "
+              "sliders.1.preload, friction.decay, disc.damping_ratio, ...).")
+@click.option("--to", "target", type=float, required=True,
+              help="The key's value where the continuation stops [the key's unit]; its side "
+              "of the case's value sets the direction.")
+@click.option("--from", "from_file", type=click.Path(dir_okay=False, exists=True,
+                                                     path_type=Path),
+              help="Start from a file instead of the case's orbit: an orbit (fivdisc orbit "
+              "-o), a simulation result (its final state) or a branch (fivdisc continue -o; "
+              "its last point, or --bifurcation K). Without CASE_FILE, the case stored in "
+              "the file is used.")
+@click.option("--bifurcation", "which", type=int,
+              help="With --from BRANCH: start at its bifurcation K (from 0); at a period "
+              "doubling, continue the branch of doubled orbits born there.")
+@click.option("--points", type=int, default=200, show_default=True,
+              help="Most points on the branch.")
+@click.option("--step", type=float, default=0.02, show_default=True,
+              help="First arclength step (relative change of the orbit, period and key).")
+@click.option("--max-step", type=float, default=0.1, show_default=True,
+              help="Largest arclength step.")
+@click.option("--transient", type=float,
+              help="Transient run before the first orbit is searched [s] (default: the "
+              "case's simulation.duration).")
+@click.option("--period", type=float, help="A guess of the first orbit's period [s].")
+@click.option("--rtol", type=float, default=1e-12, show_default=True,
+              help="Integration tolerance of the shooting runs.")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print the points and bifurcations as JSON.")
+@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
+              help="Write the branch to a netCDF file (.nc), for fivdisc plot.")
+@click.option("--progress/--no-progress", default=True, show_default=True,
+              help="Show the Newton iterations and the points on a terminal.")
+def continuation(case_file: Path | None, key: str, target: float, from_file: Path | None,
+                 which: int | None, points: int, step: float, max_step: float,
+                 transient: float | None, period: float | None, rtol: float, as_json: bool,
+                 output: Path | None, progress: bool) -> None:
+    """Follow a periodic orbit of CASE_FILE (constant speed) as --key goes --to a value.
+
+    Pseudo-arclength continuation of the shooting equations, with the exact monodromy
+    across every switch: each point's period, event signature, Floquet multipliers and
+    amplitude measures; folds, period doublings, torus bifurcations and changes of the
+    event signature (stick phases appearing, grazing, ...) located to 1e-6 in the key.
+    CASE_FILE is a TOML file or a packaged example.
+    """
+    from fivdisc.analysis.continuation import continue_orbit
+    from fivdisc.errors import ConvergenceError, FivdiscError
+    from fivdisc.files import check_output
+
+    inputs = [p for p in (case_file, from_file) if p is not None]
+    out = check_output(output, "-o", (".nc",), inputs=inputs) if output else None
+    if which is not None and from_file is None:
+        raise FivdiscError("--bifurcation needs --from BRANCH (a file of fivdisc continue -o)")
+    for name, value in (("--points", points),):
+        if value < 1:
+            raise FivdiscError(f"{name} = {value} is invalid: must be >= 1")
+    try:
+        case, orbit, along, search = _start(case_file, from_file, which, key, target, rtol,
+                                            transient, period)
+        branch = continue_orbit(case, key, target, orbit=orbit, along=along,
+                                max_points=points, step=step, max_step=max_step, rtol=rtol,
+                                progress=progress, **search)
+    except ConvergenceError as exc:
+        click.echo(f"error: no periodic orbit to start from: {exc}", err=True)
+        sys.exit(1)
+    if out is not None:
+        branch.to_netcdf(out)
+    click.echo(branch.to_json() if as_json else str(branch))
+    if branch.lost:
+        sys.exit(1)
+
+
+def _checked(case, key: str, target: float):
+    """The case, once its key and the target are known to be valid."""
+    from fivdisc.analysis.continuation import check_key
+    from fivdisc.errors import CaseError, FivdiscError
+
+    if case.speed.profile != "constant":
+        raise FivdiscError(f"continue needs a constant disc speed (speed.profile = "
+                           f"'constant'), not {case.speed.profile!r}: with a varying speed "
+                           "the system is not autonomous and has no periodic orbits")
+    check_key(case, key, "--key")
+    try:
+        case.replace({key: target})
+    except CaseError as exc:
+        raise CaseError(f"--to {target!r} is invalid for {key}: {exc}") from None
+    return case
+
+
+def _start(case_file, from_file, which, key, target, rtol, transient, period):
+    """The case, the orbit to start from (None: searched as fivdisc orbit does), the
+    branch-switching direction, and the search's options; the key and the target are
+    checked before any orbit is computed."""
+    from fivdisc.analysis.branch import CONTENT, open_branch
+    from fivdisc.analysis.continuation import doubled_start
+    from fivdisc.analysis.orbits import periodic_orbit, saved_start
+    from fivdisc.case import load_case
+    from fivdisc.errors import FivdiscError
+
+    case = load_case(case_file) if case_file is not None else None
+    search = {"transient": transient, "period": period}
+    if from_file is None:
+        if case is None:
+            raise FivdiscError("continue needs CASE_FILE or --from FILE")
+        return _checked(case, key, target), None, None, search
+    from fivdisc.files import read_dataset
+
+    if read_dataset(from_file, "--from").attrs.get("content") == CONTENT:
+        br = open_branch(from_file)
+        case = case or br.case
+        if br.key != key:
+            raise FivdiscError(f"--key {key} differs from the branch's key {br.key}: a branch "
+                               "is continued in its own key")
+        phases = br.dataset["phase"].values
+        if which is None:
+            value = float(br.parameter[-1])
+            state, per, kind = br.dataset["state"].values[-1], float(br.period[-1]), ""
+        else:
+            bifs = br.bifurcations()
+            if not 0 <= which < len(bifs):
+                raise FivdiscError(f"--bifurcation {which} is invalid: the branch has "
+                                   f"{len(bifs)} bifurcation(s), numbered from 0")
+            b = bifs[which]
+            value, state, per, kind = b["parameter"], b["state"], b["period"], b["kind"]
+        case = _checked(case, key, target).replace({key: value})
+        if kind == "period doubling":
+            orbit, along = doubled_start(case, state, per, phases, rtol=rtol)
+            return case, orbit, along, {}
+        orbit = periodic_orbit(case, state, period=per, phases=phases, rtol=rtol,
+                               start=f"from the branch in {from_file}")
+        return case, orbit, None, {}
+    stored, state, phases, saved_period, start = saved_start(from_file)
+    case = case or stored
+    if case is None:
+        raise FivdiscError(f"--from {from_file} stores no case: give CASE_FILE")
+    _checked(case, key, target)
+    orbit = periodic_orbit(case, state, period=period or saved_period, phases=phases,
+                           rtol=rtol, start=start)
+    return case, orbit, None, {}
