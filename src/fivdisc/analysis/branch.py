@@ -271,12 +271,6 @@ class Branch:
                          f"T = {b['period']:.9g} s: {b['note']}")
         return "\n".join(lines)
 
-    def plot(self, measure: str = "period", **options: Any):
-        """:func:`fivdisc.plots.plot_branch` of this branch."""
-        from fivdisc.plots import plot_branch
-
-        return plot_branch(self, measure, **options)
-
 
 def open_branch(path: str | PathLike[str]) -> Branch:
     """Read a branch written by :meth:`Branch.to_netcdf` (``fivdisc continue -o``).

@@ -113,7 +113,9 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
 
     A simulation result (``fivdisc simulate``, or a run of ``fivdisc reproduce``) is drawn
     as --kind says; a stability map (``fivdisc stability -o map.nc``) or a separation map
-    (a run of Fig. 3 or 27 of ``fivdisc reproduce``) as a map.
+    (a run of Fig. 3 or 27 of ``fivdisc reproduce``) as a map; a branch of periodic orbits
+    (``fivdisc continue -o``) against its key, --var naming the measure (period, phi_dot,
+    normal_force_min, ...) and --slider the slider.
     """
     from fivdisc.extras import require
 
@@ -121,14 +123,21 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
     import xarray as xr
 
     from fivdisc import plots
-    from fivdisc.files import check_output, figure_suffixes, write_atomic
-    from fivdisc.limits import check_raster
+    from fivdisc.files import check_output, figure_suffixes, read_dataset
     from fivdisc.result import open_result, run_groups
 
     out = check_output(output or result.with_name(f"{result.stem}-{kind}.png"), "-o",
                        figure_suffixes(), inputs=[result])
     if not result.exists():
         raise FileNotFoundError(2, "No such file", str(result))
+    from fivdisc.analysis.branch import CONTENT
+
+    if read_dataset(result, "plot").attrs.get("content") == CONTENT:
+        fig = _branch(result, var, slider, (("--run", run), ("--probe", probe),
+                                            ("--window", window_text), ("--fmax", fmax),
+                                            ("--segment", segment)))
+        _save(fig, out, dpi)
+        return
     groups = _groups(result, run_groups)
     if run is not None and run not in groups:
         raise FivdiscError(f"--run {run!r} is invalid: {result} holds "
@@ -168,8 +177,14 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
         window = parse_window(window_text, one["time"].values)
         fig = plots.plot_kind(ds, kind, var=name, probe=probe, slider=slider, window=window,
                               fmax=fmax, segment=segment)
+    _save(fig, out, dpi)
 
+
+def _save(fig, out: Path, dpi: int) -> None:
     import matplotlib.pyplot as plt
+
+    from fivdisc.files import write_atomic
+    from fivdisc.limits import check_raster
 
     try:
         check_raster(fig, dpi)
@@ -177,6 +192,22 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
     finally:
         plt.close(fig)
     click.echo(f"wrote {out}")
+
+
+def _branch(path: Path, var: str | None, slider: int, unused):
+    """The figure of a branch (fivdisc continue -o): --var is the measure."""
+    from fivdisc.analysis.branch import open_branch
+    from fivdisc.branch_plots import BRANCH_MEASURES, plot_branch
+
+    given = [name for name, value in unused if value is not None]
+    if given:
+        raise FivdiscError(f"{given[0]} is not used for {path}: it is a branch of periodic "
+                           "orbits, drawn against its key (--var picks the measure)")
+    measure = var or "period"
+    if measure not in BRANCH_MEASURES:
+        raise FivdiscError(f"--var {measure!r} is invalid for a branch: must be one of "
+                           f"{', '.join(BRANCH_MEASURES)}")
+    return plot_branch(open_branch(path), measure, slider)
 
 
 def _groups(path: Path, run_groups) -> list[str]:

@@ -1,0 +1,133 @@
+"""Figures of a branch of periodic orbits (:func:`fivdisc.continue_orbit`): a measure of
+the orbits against the continued key, stable solid and unstable dashed, bifurcations
+marked and labelled; and the same laid over a brute-force bifurcation diagram."""
+
+from __future__ import annotations
+
+import itertools
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from fivdisc.analysis.branch import Branch
+from fivdisc.analysis.cycle import MEASURES
+from fivdisc.errors import FivdiscError
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = ["BRANCH_MEASURES", "draw_branch", "plot_branch"]
+
+#: What :func:`plot_branch` can draw: the period, or a measure per slider, as its
+#: largest (``_max``) or smallest (``_min``) value over a period, or both (no suffix).
+BRANCH_MEASURES = ("period", *MEASURES, *(f"{m}_{e}" for m in MEASURES for e in ("max", "min")))
+# Short labels of the bifurcations on a figure.
+_MARKS = {"fold": ("LP", "s"), "period doubling": ("PD", "D"), "torus": ("NS", "o"),
+          "branch point": ("BP", "^"), "signature change": ("DIB", "v")}
+
+
+def _columns(branch: Branch, measure: str, slider: int) -> list[tuple[str, np.ndarray, str]]:
+    """(name, values, unit) of the curves a measure draws."""
+    ds = branch.dataset
+    if measure not in BRANCH_MEASURES:
+        raise FivdiscError(f"measure = {measure!r} is invalid: must be one of "
+                           f"{', '.join(BRANCH_MEASURES)}")
+    if measure == "period":
+        return [("period", ds["period"].values * 1e3, "ms")]
+    count = ds.sizes["slider"]
+    if not 0 <= slider < count:
+        raise FivdiscError(f"slider = {slider} is invalid: the branch has {count} slider"
+                           f"{'s' if count > 1 else ''}, numbered from 0")
+    names = [measure] if measure.endswith(("_max", "_min")) else [f"{measure}_max",
+                                                                   f"{measure}_min"]
+    return [(n, ds[n].values[:, slider], ds[n].attrs.get("units", "")) for n in names]
+
+
+def draw_branch(ax: Axes, branch: Branch, measure: str = "period", slider: int = 0,
+                color: str = "C0", labels: bool = True) -> None:
+    """Draw a measure of a branch on existing axes: stable stretches solid, unstable
+    dashed, bifurcations marked (LP fold, PD period doubling, NS torus, BP branch point,
+    DIB a change of the event signature) and, with ``labels``, named."""
+    x = branch.parameter
+    stable = branch.stable
+    curves = _columns(branch, measure, slider)
+    for _name, y, _ in curves:
+        # Split where the stability changes; each piece shares its end point with the next.
+        cuts = np.flatnonzero(np.diff(stable.astype(int))) + 1
+        bounds = np.r_[0, cuts, x.size]
+        for a, b in itertools.pairwise(bounds):
+            piece = slice(a, min(b + 1, x.size))
+            ax.plot(x[piece], y[piece], color=color, lw=1.4,
+                    linestyle="-" if stable[a] else "--")
+    for b in branch.bifurcations():
+        label, marker = _MARKS.get(b["kind"], ("?", "x"))
+        i = b["point"]
+        j = min(i + 1, x.size - 1)
+        for _, y, _ in curves:
+            # The value at the bifurcation, between the points that bracket it.
+            if x[j] != x[i]:
+                frac = np.clip((b["parameter"] - x[i]) / (x[j] - x[i]), 0.0, 1.0)
+            else:
+                frac = 0.0
+            yb = y[i] + frac * (y[j] - y[i])
+            ax.plot([b["parameter"]], [yb], marker=marker, color="C3", ms=6, mfc="none",
+                    mew=1.3, linestyle="none")
+            if labels:
+                ax.annotate(label, (b["parameter"], yb), textcoords="offset points",
+                            xytext=(4, 4), fontsize=8, color="C3")
+
+
+def plot_branch(branch: Branch, measure: str = "period", slider: int = 0,
+                ax: Axes | None = None) -> Figure:
+    """A branch of periodic orbits against its key.
+
+    Parameters
+    ----------
+    branch : Branch
+        From :func:`~fivdisc.analysis.continuation.continue_orbit` or
+        :func:`~fivdisc.analysis.branch.open_branch`.
+    measure : str
+        One of :data:`BRANCH_MEASURES`: ``"period"`` [ms], or a measure per slider
+        (``"phi_dot"``: its largest and smallest value over a period; ``"phi_dot_max"``
+        only the largest).
+    slider : int
+        Which slider's measure.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (default: a new figure).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from fivdisc.extras import require
+
+    require("plot", "a branch figure")
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+
+    if ax is None:
+        fig = Figure(figsize=(7.0, 4.5), layout="constrained")
+        ax = fig.add_subplot()
+    else:
+        fig = ax.figure
+    draw_branch(ax, branch, measure, slider)
+    ds = branch.dataset
+    par = ds["parameter"]
+    unit = par.attrs.get("units", "")
+    ax.set_xlabel(f"{branch.key} [{unit}]" if unit else branch.key)
+    curves = _columns(branch, measure, slider)
+    unit = curves[0][2]
+    if measure == "period":
+        what = "period"
+    else:
+        base = measure.removesuffix("_max").removesuffix("_min")
+        what = MEASURES[base][0] + ("" if ds.sizes["slider"] == 1 else f", slider {slider}")
+        what += {"_max": ", largest", "_min": ", smallest"}.get(measure[-4:], ", range")
+    ax.set_ylabel(f"{what} [{unit}]" if unit and unit != "1" else what)
+    ax.set_title(f"periodic orbits continued in {branch.key}", fontsize=10)
+    ax.legend(handles=[Line2D([], [], color="C0", ls="-", label="stable"),
+                       Line2D([], [], color="C0", ls="--", label="unstable")],
+              loc="best", fontsize=8, frameon=False)
+    ax.grid(alpha=0.3)
+    return fig
