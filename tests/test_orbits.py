@@ -31,7 +31,7 @@ LIGHT = Case(disc={"density": 720.0, "modes": [[0, 0]]},
              slider={"mass": 1.0, "normal_damping": 20.0}, speed={"value": 1.0})
 
 
-def _rigid_disc_closed_form():
+def _rigid_disc_closed_form(omega: float = OMEGA):
     """Period of the stick-slip cycle and the disc mode's multipliers, by hand.
 
     Normal force: N = N0 / (1 + k_z g^2 / K) (disc mode K q = -N g, slider spring
@@ -43,7 +43,7 @@ def _rigid_disc_closed_form():
     lasts (pi + 2 arcsin(Omega / (A w))) / w. The disc mode obeys
     (M + m g^2) q'' + c_z g^2 q' + (K + k_z g^2) q = -g N0 whatever the slider does.
     """
-    model = build_model(RIGID)
+    model = build_model(RIGID.replace({"speed.value": omega}))
     kern = model.kernel
     g = kern.shape[0, 0]
     mass_modal = 1.0 / kern.disc[lay.D_MINV, 0]
@@ -53,8 +53,8 @@ def _rigid_disc_closed_form():
     normal = n0 / (1.0 + kz * g * g / stiff_modal)
     w = np.sqrt(kphi / inertia)
     d = r * (MU_S - MU_K) * normal / kphi
-    amp = np.hypot(d, OMEGA / w)
-    period = 2.0 * d / OMEGA + (np.pi + 2.0 * np.arcsin(OMEGA / (amp * w))) / w
+    amp = np.hypot(d, omega / w)
+    period = 2.0 * d / omega + (np.pi + 2.0 * np.arcsin(omega / (amp * w))) / w
     lam = np.roots([mass_modal + m * g * g, cz * g * g, stiff_modal + kz * g * g])
     return period, np.exp(lam * period)
 

@@ -38,11 +38,11 @@ STATUS = {
 _TANGENT_STEP = 0.5
 
 
-def tangent_step(model: Model) -> float:
-    """Largest step [s] that resolves the tangent dynamics: half the shortest time
-    scale of the model (the disc's natural frequencies, the sliders' normal and in-plane
-    oscillators, every damping rate; the spin's shift l Omega of a disc frequency is small
-    against it for the speeds of brake squeal and left out).
+def tangent_step(model: Model, h_omega: float = _TANGENT_STEP) -> float:
+    """Largest step [s] that resolves the tangent dynamics: ``h_omega`` (default half)
+    the shortest time scale of the model (the disc's natural frequencies, the sliders'
+    normal and in-plane oscillators, every damping rate; the spin's shift l Omega of a
+    disc frequency is small against it for the speeds of brake squeal and left out).
 
     The integrator's steps follow the state alone (so that tangents do not change the
     trajectory); where the state hardly moves (near an equilibrium, a disc mode at rest)
@@ -59,7 +59,7 @@ def tangent_step(model: Model) -> float:
         kern.row("cphi") / kern.row("inertia"),
     ]
     fastest = max(float(np.max(r, initial=0.0)) for r in rates)
-    return _TANGENT_STEP / fastest
+    return h_omega / fastest
 
 
 class Integration:

@@ -42,6 +42,15 @@ _HALVINGS = 6
 _MAX_DIVISOR = 12
 # A return at T/k closer than this (the residual's measure) is solved again at T/k.
 _CLOSES = 1e-4
+# h omega of the shooting runs' step cap (integration.tangent_step): the monodromy's
+# eigenvalues are then right to about 1e-8 at rtol 1e-12. With the default 0.5, where the
+# cap sets the steps (a stick phase, a disc mode at rest) the disc mode's multipliers of
+# the rigid-disc oscillator were off by up to 4e-6, depending on where the steps fell
+# (1e-8 at 0.1, 3e-7 at 0.25).
+_SHOOTING_STEP = 0.15
+# A converged orbit whose residual is above this fraction of the tolerance gets one more
+# Newton step.
+_POLISH = 1e-2
 @dataclass(frozen=True)
 class PeriodicOrbit:
     """A periodic orbit found by :func:`periodic_orbit`.
@@ -238,8 +247,8 @@ class Shooting:
         self.rtol, self.atol = rtol, atol
         self.scale = energy_scales(model) if scale is None else scale
         # Steps capped at tangent_step, so that directions the orbit hardly excites are
-        # integrated stably at any rtol.
-        cap = tangent_step(model)
+        # integrated stably and accurately at any rtol.
+        cap = tangent_step(model, _SHOOTING_STEP)
         if model.case.simulation.max_step > 0:
             cap = min(cap, model.case.simulation.max_step)
         self.cap = cap
@@ -331,12 +340,18 @@ def _newton(shooting: Shooting, x0: np.ndarray, period: float, tol: float,
     residual = shooting.residual(shot, x0, period)
     iterations = 0
     reason = ""
-    while residual >= tol:
-        if iterations >= max_iterations:
+    polish = True
+    while residual >= tol or (polish and residual > _POLISH * tol):
+        if residual < tol:
+            # Converged: one more step, kept only if it lowers the residual, takes the
+            # period from the tolerance's accuracy to the integration's.
+            polish = False
+        elif iterations >= max_iterations:
             reason = f"the iteration budget ({max_iterations} Newton iterations) ran out"
             break
         if time.monotonic() > deadline:
-            reason = "the time budget ran out"
+            if residual >= tol:
+                reason = "the time budget ran out"
             break
         iterations += 1
         free = shot.free
@@ -362,7 +377,8 @@ def _newton(shooting: Shooting, x0: np.ndarray, period: float, tol: float,
                 x0, period, shot, residual = trial_x, float(trial_t), trial, trial_res
                 break
         else:
-            reason = "no Newton step reduces the residual (the guess is too far)"
+            if residual >= tol:
+                reason = "no Newton step reduces the residual (the guess is too far)"
             break
         if bar is not None:
             bar.update()
@@ -456,12 +472,12 @@ def periodic_orbit(
     rtol, atol : float
         Integration tolerances of the shooting runs. The step size follows the state
         alone, so a tangent direction the orbit hardly excites (a disc mode at rest on
-        the orbit) is integrated less accurately than the state: on the rigid-disc
-        stick-slip oscillator the multipliers' moduli are off by 4e-6 at rtol 1e-10,
-        2e-7 at 1e-11 and 1e-9 at 1e-12. The default 1e-12 makes them right to better
-        than 1e-6, enough to tell whether a multiplier 1e-4 from the unit circle (as
-        on the paper's Fig. 13 orbit) lies inside or outside it. ``atol`` defaults to
-        ``1e-7 rtol``.
+        the orbit) is integrated less accurately than the state, and its steps are capped
+        at 0.15 of the model's shortest time scale: on the rigid-disc stick-slip
+        oscillator the multipliers' moduli are off by 4e-6 at rtol 1e-10, 2e-7 at 1e-11
+        and below 1e-7 at 1e-12. The default 1e-12 makes them right to better than 1e-6,
+        enough to tell whether a multiplier 1e-4 from the unit circle lies inside or
+        outside it. ``atol`` defaults to ``1e-7 rtol``.
     tol : float
         Convergence: scaled residual ``|phi_T(x0) - x0|`` below this.
     max_iterations : int

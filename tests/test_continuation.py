@@ -1,0 +1,200 @@
+"""Continuation of periodic orbits: branches against closed forms and independent solves,
+the minimal period, failures that are not results, the command line and its files."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from fivdisc.analysis.branch import open_branch
+from fivdisc.analysis.continuation import continue_orbit
+from fivdisc.analysis.orbits import periodic_orbit
+from fivdisc.cli import cli
+from fivdisc.errors import CaseError, ConvergenceError, FivdiscError
+from test_orbits import LIGHT, RIGID, _rigid_disc_closed_form
+
+
+@pytest.fixture(scope="module")
+def rigid_orbit():
+    return periodic_orbit(RIGID, transient=4.0)
+
+
+@pytest.fixture(scope="module")
+def rigid_branch(rigid_orbit):
+    return continue_orbit(RIGID, "speed.value", 3.0, orbit=rigid_orbit, max_points=60)
+
+
+def test_rigid_disc_branch_follows_the_closed_form(rigid_branch):
+    """The rigid-disc stick-slip oscillator's period is known in closed form at every belt
+    speed (test_orbits): each continued point's period equals it to 1e-9 (the shooting
+    residual's tolerance is 1e-8 of the orbit's size; the period converges quadratically
+    below it), and its disc-mode multipliers equal exp(lambda T) to 1e-6 (the accuracy of
+    the monodromy at rtol 1e-12, test_orbits). The stick phase persists over the whole
+    range, as the closed form's stick duration 2 d / Omega > 0 says: no signature change."""
+    br = rigid_branch
+    assert br.stop_reason.startswith("reached")
+    assert br.parameter[0] == pytest.approx(1.0)
+    assert br.parameter[-1] == pytest.approx(3.0, rel=1e-12)
+    assert np.all(np.diff(br.parameter) > 0)
+    for p, period, mult in zip(br.parameter, br.period, br.multipliers, strict=True):
+        expected, disc = _rigid_disc_closed_form(p)
+        assert period == pytest.approx(expected, rel=1e-9)
+        big = mult[np.abs(mult) > 0.5]
+        big = big[np.abs(big - 1.0) > 1e-6]
+        assert np.sort_complex(big) == pytest.approx(np.sort_complex(disc), abs=1e-6)
+    assert br.stable.all()
+    assert br.bifurcations() == []
+    sig = {br.signature(i) for i in range(len(br))}
+    assert len(sig) == 1
+    phases = next(iter(sig))[0].split(" > ")
+    assert phases[0] == phases[-1] and phases.count("stick") == 1
+
+
+def test_branch_points_agree_with_independent_orbit_solves(rigid_branch):
+    """At three points of the branch, periodic_orbit started afresh (a transient from rest
+    at that speed, nothing taken from the branch) converges to the same period to 1e-9:
+    the orbit is the global attractor of the damped oscillator, so the transient finds it."""
+    br = rigid_branch
+    for i in (1, len(br) // 2, len(br) - 1):
+        case = RIGID.replace({"speed.value": float(br.parameter[i])})
+        alone = periodic_orbit(case, transient=4.0)
+        assert alone.period == pytest.approx(br.period[i], rel=1e-9)
+
+
+def test_branch_is_continuous_in_both_directions(rigid_orbit):
+    """Down in the speed from the same orbit: the parameter decreases monotonically and
+    the periods follow the closed form, so no point jumped to another orbit."""
+    br = continue_orbit(RIGID, "speed.value", 0.5, orbit=rigid_orbit, max_points=120)
+    assert br.parameter[-1] == pytest.approx(0.5, rel=1e-12)
+    assert np.all(np.diff(br.parameter) < 0)
+    for p, period in zip(br.parameter, br.period, strict=True):
+        assert period == pytest.approx(_rigid_disc_closed_form(p)[0], rel=1e-9)
+
+
+def test_continuation_in_a_slider_key_matches_independent_solves():
+    """A branch in the slider's normal damping of the light-disc case: at its last point
+    an independent periodic_orbit (transient from rest at that value) gives the same
+    period to 1e-9, and the branch's measures bracket that orbit's phi_dot."""
+    start = periodic_orbit(LIGHT, transient=2.0)
+    br = continue_orbit(LIGHT, "slider.normal_damping", 40.0, orbit=start, max_points=15)
+    assert br.parameter[-1] == pytest.approx(40.0, rel=1e-12)
+    alone = periodic_orbit(LIGHT.replace({"slider.normal_damping": 40.0}), transient=2.0)
+    assert alone.period == pytest.approx(br.period[-1], rel=1e-9)
+    ds = br.dataset
+    assert np.all(ds["phi_dot_max"].values >= ds["phi_dot_min"].values)
+    # A sticking slider moves with the disc: the largest angular velocity is the speed.
+    assert ds["phi_dot_max"].values[:, 0] == pytest.approx(LIGHT.speed.value, rel=1e-6)
+
+
+def test_a_multiple_of_the_period_is_reduced_to_the_minimal_period():
+    """Started with three times the closed-form period as its guess, Newton converges on
+    the orbit traversed three times; it is reported at its minimal period, with the
+    multipliers of that period (the disc mode's exp(lambda T), not their cubes)."""
+    period, disc = _rigid_disc_closed_form()
+    first = periodic_orbit(RIGID, transient=4.0)
+    orbit = periodic_orbit(RIGID, first.state, period=3.0 * period, phases=first.phases)
+    assert orbit.period == pytest.approx(period, rel=1e-9)
+    others = np.delete(orbit.multipliers, orbit.trivial)
+    big = others[np.abs(others) > 0.5]
+    assert np.sort_complex(big) == pytest.approx(np.sort_complex(disc), abs=1e-6)
+
+
+def test_an_orbit_that_does_not_converge_is_no_result():
+    """No Newton iteration allowed from a guess off the orbit: ConvergenceError, whose
+    result is marked not converged and whose text labels no multiplier."""
+    period, _ = _rigid_disc_closed_form()
+    first = periodic_orbit(RIGID, transient=4.0)
+    guess = first.state.copy()
+    guess[RIGID_PHI_DOT] += 0.05
+    with pytest.raises(ConvergenceError, match="iteration budget") as info:
+        periodic_orbit(RIGID, guess, period=period, phases=first.phases, max_iterations=0)
+    orbit = info.value.result
+    assert not orbit.converged
+    assert orbit.verdict == "not converged"
+    assert "flow direction" not in str(orbit)
+    assert orbit.to_dict()["converged"] is False
+
+
+RIGID_PHI_DOT = 4  # q, phi, z, qdot, phidot, zdot for one mode and one slider
+
+
+def test_orbit_command_exits_1_when_not_converged(tmp_path):
+    path = tmp_path / "rigid.toml"
+    path.write_text(RIGID.replace({"simulation.duration": 4.0}).to_toml())
+    res = CliRunner().invoke(cli, ["orbit", str(path), "--json", "--no-progress",
+                                   "--period", "1e-3", "--window", "0.01"])
+    assert res.exit_code == 1
+    data = json.loads(res.stdout)
+    assert data["converged"] is False
+    assert "not converged" in res.stderr and "residual" in res.stderr
+
+
+def test_orbit_and_branch_files_round_trip(tmp_path):
+    """fivdisc orbit -o, then --from that file; fivdisc continue -o, plot and --from."""
+    case = tmp_path / "rigid.toml"
+    case.write_text(RIGID.replace({"simulation.duration": 4.0}).to_toml())
+    orbit_nc = tmp_path / "orbit.nc"
+    runner = CliRunner()
+    res = runner.invoke(cli, ["orbit", str(case), "--no-progress", "-o", str(orbit_nc)])
+    assert res.exit_code == 0, res.output
+    res = runner.invoke(cli, ["orbit", "--from", str(orbit_nc), "--json", "--no-progress"])
+    assert res.exit_code == 0, res.output
+    data = json.loads(res.stdout)
+    assert data["period"] == pytest.approx(_rigid_disc_closed_form()[0], rel=1e-9)
+    assert str(orbit_nc) in data["start"]
+    branch_nc = tmp_path / "branch.nc"
+    res = runner.invoke(cli, ["continue", "--from", str(orbit_nc), "--key", "speed.value",
+                              "--to", "1.5", "--no-progress", "-o", str(branch_nc)])
+    assert res.exit_code == 0, res.output
+    br = open_branch(branch_nc)
+    assert br.key == "speed.value"
+    assert br.parameter[-1] == pytest.approx(1.5)
+    assert br.period[-1] == pytest.approx(_rigid_disc_closed_form(1.5)[0], rel=1e-9)
+    res = runner.invoke(cli, ["continue", "--from", str(branch_nc), "--key", "speed.value",
+                              "--to", "2.0", "--json", "--no-progress"])
+    assert res.exit_code == 0, res.output
+    again = json.loads(res.stdout)
+    assert again["points"][0]["parameter"] == pytest.approx(1.5)
+    assert again["points"][-1]["parameter"] == pytest.approx(2.0)
+    png = tmp_path / "branch.png"
+    res = runner.invoke(cli, ["plot", str(branch_nc), "--var", "phi_dot", "-o", str(png)])
+    assert res.exit_code == 0, res.output
+    assert png.stat().st_size > 0
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--key", "speed.profile", "--to", "1"], "is not a number"),
+    (["--key", "disc.modes", "--to", "1"], "is not a number"),
+    (["--key", "simulation.impact", "--to", "1"], "is not a number"),
+    (["--key", "speed.valeu", "--to", "1"], "did you mean 'speed.value'"),
+    (["--key", "speed.value", "--to", "-1"], "must be >= 0"),
+    (["--key", "speed.value", "--to", "inf"], "finite"),
+    (["--key", "slider.mass", "--to", "0"], "slider.mass"),
+])
+def test_continue_refuses_bad_input_before_any_work(tmp_path, args, message):
+    case = tmp_path / "rigid.toml"
+    case.write_text(RIGID.to_toml())
+    res = CliRunner().invoke(cli, ["continue", str(case), "--no-progress", *args])
+    assert res.exit_code == 2
+    assert message in res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1
+
+
+def test_continue_needs_an_autonomous_case_and_a_periodic_start(rigid_orbit):
+    moving = RIGID.replace({"speed.profile": "decelerating", "speed.initial": 1.0,
+                            "speed.duration": 10.0})
+    with pytest.raises(FivdiscError, match="constant disc speed"):
+        continue_orbit(moving, "speed.initial", 2.0)
+    with pytest.raises(CaseError, match="own value"):
+        continue_orbit(RIGID, "speed.value", 1.0, orbit=rigid_orbit)
+    period, _ = _rigid_disc_closed_form()
+    try:
+        periodic_orbit(RIGID, rigid_orbit.state + 0.01, period=period,
+                       phases=rigid_orbit.phases, max_iterations=0)
+    except ConvergenceError as exc:
+        unconverged = exc.result
+    with pytest.raises(ConvergenceError, match="not a converged periodic orbit"):
+        continue_orbit(RIGID, "speed.value", 2.0, orbit=unconverged)
