@@ -9,6 +9,7 @@ The public API::
     result.to_netcdf("run.nc"); fivdisc.open_result("run.nc") == result
     print(fivdisc.linear_stability(case))               # constant-speed cases
     print(fivdisc.periodic_orbit(case))                 # Floquet multipliers
+    print(fivdisc.continue_orbit(case, "speed.value", 4.0))   # a branch of orbits
     print(fivdisc.lyapunov(case, n=3))                  # Lyapunov exponents
 
 Plotting lives in :mod:`fivdisc.plots`, parameter sweeps in :mod:`fivdisc.sweep` and the
@@ -25,6 +26,8 @@ from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from fivdisc.analysis.branch import Branch, open_branch
+    from fivdisc.analysis.continuation import continue_orbit
     from fivdisc.analysis.energy import energy_balance
     from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium
     from fivdisc.analysis.lyapunov import LyapunovSpectrum, lyapunov
@@ -38,7 +41,13 @@ if TYPE_CHECKING:
     )
     from fivdisc.analysis.trajectories import separation_stats
     from fivdisc.case import Case, load_case
-    from fivdisc.errors import CaseError, FivdiscError, ModeError, SimulationError
+    from fivdisc.errors import (
+        CaseError,
+        ConvergenceError,
+        FivdiscError,
+        ModeError,
+        SimulationError,
+    )
     from fivdisc.model import Model, build_model
     from fivdisc.plate import AnnularPlate, PlateMode
     from fivdisc.result import Result, Summary, open_result
@@ -49,8 +58,10 @@ if TYPE_CHECKING:
 
 __all__ = [
     "AnnularPlate",
+    "Branch",
     "Case",
     "CaseError",
+    "ConvergenceError",
     "Equilibrium",
     "FivdiscError",
     "LinearStability",
@@ -66,12 +77,14 @@ __all__ = [
     "__version__",
     "build_model",
     "classify",
+    "continue_orbit",
     "dominant_frequency",
     "energy_balance",
     "find_peaks",
     "linear_stability",
     "load_case",
     "lyapunov",
+    "open_branch",
     "open_result",
     "periodic_orbit",
     "perturbation_test",
@@ -87,6 +100,8 @@ __all__ = [
 _HOMES = {
     name: module
     for module, names in {
+        "fivdisc.analysis.branch": ("Branch", "open_branch"),
+        "fivdisc.analysis.continuation": ("continue_orbit",),
         "fivdisc.analysis.energy": ("energy_balance",),
         "fivdisc.analysis.equilibrium": ("Equilibrium", "sliding_equilibrium"),
         "fivdisc.analysis.lyapunov": ("LyapunovSpectrum", "lyapunov"),
@@ -99,7 +114,9 @@ _HOMES = {
         ),
         "fivdisc.analysis.trajectories": ("separation_stats",),
         "fivdisc.case": ("Case", "load_case"),
-        "fivdisc.errors": ("CaseError", "FivdiscError", "ModeError", "SimulationError"),
+        "fivdisc.errors": (
+            "CaseError", "ConvergenceError", "FivdiscError", "ModeError", "SimulationError"
+        ),
         "fivdisc.model": ("Model", "build_model"),
         "fivdisc.plate": ("AnnularPlate", "PlateMode"),
         "fivdisc.result": ("Result", "Summary", "open_result"),
