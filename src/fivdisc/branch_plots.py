@@ -131,3 +131,28 @@ def plot_branch(branch: Branch, measure: str = "period", slider: int = 0,
               loc="best", fontsize=8, frameon=False)
     ax.grid(alpha=0.3)
     return fig
+
+
+def overlay_branch(ax: Axes, branch: Branch, key: str, variable: str, slider: int,
+                   maxima: bool) -> None:
+    """Lay a branch over a brute-force bifurcation diagram of ``variable`` of ``slider``
+    over ``key``: the largest value over a period for a diagram of maxima, else the
+    largest and smallest (the span the section's values lie in).
+
+    Raises
+    ------
+    FivdiscError
+        The branch is in another key, or the variable is not one of its measures.
+    """
+    if branch.key != key:
+        raise FivdiscError(f"the branch is continued in {branch.key}, the sweep in {key}: "
+                           "they cannot share an axis")
+    if variable not in ("phi", "phi_dot", "normal_force"):
+        raise FivdiscError(f"a branch keeps phi, phi_dot and normal_force per slider, not the "
+                           f"section's variable {variable!r}")
+    draw_branch(ax, branch, f"{variable}_max" if maxima else variable, slider, color="C1")
+    from matplotlib.lines import Line2D
+
+    ax.legend(handles=[Line2D([], [], color="C1", ls="-", label="periodic orbits, stable"),
+                       Line2D([], [], color="C1", ls="--", label="periodic orbits, unstable")],
+              loc="best", fontsize="small", frameon=False)

@@ -286,6 +286,13 @@ def separation_map(
     help="The section to draw, by its stored name [default: the sweep file's first "
     "[[reduce.section]]].",
 )
+@click.option(
+    "--branch",
+    "branch_file",
+    type=click.Path(dir_okay=False, exists=True, path_type=Path),
+    help="A branch of periodic orbits in the swept key (fivdisc continue -o) to lay over "
+    "the diagram, stable solid and unstable dashed.",
+)
 @_scheduler_option
 @_workers_option
 @_progress_option
@@ -294,6 +301,7 @@ def bifurcation(
     output: Path | None,
     store: Path | None,
     section: str | None,
+    branch_file: Path | None,
     scheduler: str | None,
     workers: int | None,
     progress: bool,
@@ -316,11 +324,24 @@ def bifurcation(
     from fivdisc.sweep.bifurcation import check_diagram
 
     spec = load_sweep(sweep_file)
-    check_diagram(spec, section)
+    chosen = check_diagram(spec, section)
+    branch = None
+    if branch_file is not None:
+        from fivdisc.analysis.branch import open_branch
+
+        branch = open_branch(branch_file)
+        swept = next(iter(spec.axes))
+        if branch.key != swept:
+            raise FivdiscError(f"--branch {branch_file} is continued in {branch.key}, the "
+                               f"sweep in {swept}: they cannot share an axis")
+        if chosen["variable"] not in ("phi", "phi_dot", "normal_force"):
+            raise FivdiscError(f"--branch: a branch keeps phi, phi_dot and normal_force per "
+                               f"slider, not the section's variable {chosen['variable']!r}")
     store = check_output(store or default_output(sweep_file, ".zarr"), "--store", ZARR,
                          inputs=[sweep_file], kind="directory")
     figure = check_output(output or default_output(sweep_file, ".png"), "-o",
                           figure_suffixes(), inputs=[sweep_file])
     report = _run(spec, store, scheduler, workers, progress)
-    plot_bifurcation(report.store, figure, section=section, name=sweep_file.stem)
+    plot_bifurcation(report.store, figure, section=section, name=sweep_file.stem,
+                     branch=branch)
     click.echo(f"wrote {figure}")

@@ -78,6 +78,7 @@ def plot_bifurcation(
     path: str | PathLike[str] | None = None,
     section: str | None = None,
     name: str | None = None,
+    branch=None,
 ) -> Figure:
     """Draw the bifurcation diagram of a sweep over one key.
 
@@ -96,6 +97,9 @@ def plot_bifurcation(
         Name of the section to draw (default: the sweep's first).
     name
         Name of the case, for the title (default: the store's name without suffix).
+    branch : Branch or path, optional
+        A branch of periodic orbits in the same key (:func:`fivdisc.continue_orbit`, or
+        its netCDF file) to lay over the diagram, stable solid and unstable dashed.
 
     Returns
     -------
@@ -139,6 +143,13 @@ def plot_bifurcation(
         top = bottom = fig.add_subplot()
     top.plot(xs, ys, linestyle="none", marker=".", ms=_DOT, mew=0.0, color="k",
              rasterized=ys.size > 20_000)
+    if branch is not None:
+        from fivdisc.analysis.branch import Branch, open_branch
+        from fivdisc.branch_plots import overlay_branch
+
+        branch = branch if isinstance(branch, Branch) else open_branch(branch)
+        overlay_branch(top, branch, key, chosen.variable, chosen.slider or 0,
+                       chosen.at == "maxima")
     variable = VARIABLES[chosen.variable]
     label = f"{variable.long_name}{chosen.selection}"
     top.set_ylabel(f"{label} [{variable.units}]" if variable.units != "1" else label)
