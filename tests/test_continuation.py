@@ -198,3 +198,95 @@ def test_continue_needs_an_autonomous_case_and_a_periodic_start(rigid_orbit):
         unconverged = exc.result
     with pytest.raises(ConvergenceError, match="not a converged periodic orbit"):
         continue_orbit(RIGID, "speed.value", 2.0, orbit=unconverged)
+
+
+# --- switches inside one step, and a branch that ends at a stick split ----------------------
+
+# The rigid-disc oscillator, undamped in the normal direction, at a crawling disc speed:
+# started sticking with the disc mode ringing, the friction needed to stick is nearly
+# constant while the normal force oscillates at the disc mode's 237 Hz; the first trough
+# of mu_s N that falls below the needed friction starts a slip.
+_GRAZE = RIGID.replace({"slider.normal_damping": 0.0, "speed.value": 0.01})
+_GRAZE_SPAN = 0.004  # [s]: one period of the disc mode, 4.2 ms
+
+
+def _graze_run(phi0: float, max_step: float = 0.0):
+    from fivdisc._kernels import layout as lay
+    from fivdisc.integration import Integration
+    from fivdisc.model import build_model
+
+    model = build_model(_GRAZE)
+    y = np.zeros(model.state_size)
+    y[model.n + 2] = -0.1  # the disc mode's velocity [m/s]: it rings
+    y[model.index("phi")] = phi0
+    y[model.index("phi_dot")] = 0.01
+    run = Integration(model, y, duration=_GRAZE_SPAN, output_rate=1.0 / _GRAZE_SPAN,
+                      rtol=1e-6, atol=1e-12, max_step=max_step,
+                      phases=np.array([lay.STICK]))
+    run.run_to(_GRAZE_SPAN)
+    times, _ = run.events()
+    return times, run.out_y[1, : model.state_size], int(run.ist[1])
+
+
+def test_a_switch_inside_one_step_is_found():
+    """The slider is started sticking at the angle phi0* where the trough of the static
+    limit just touches the needed friction (found by bisection with steps capped at
+    0.1 us, so that every trough is resolved), plus 1e-7 of it: the event function dips
+    below zero for a few microseconds only (its depth is 1e-7 of the needed friction, so
+    the dip's width is of order sqrt(1e-7) of the disc mode's period), while the steps of
+    the free run at rtol 1e-6 are of order 100 us. The free run finds the slip at the
+    same time as the capped run, to 1 ns (the slip's time at a shallow trough is sensitive
+    to the dense output's error at rtol 1e-6), and ends in the same state to 1e-4
+    (the state's error at rtol 1e-6 over 4 ms, relative)."""
+    cap = 1e-7
+    lo, hi = 0.0, 0.06
+    for _ in range(30):
+        mid = 0.5 * (lo + hi)
+        if _graze_run(mid, cap)[0].size:
+            hi = mid
+        else:
+            lo = mid
+    phi0 = hi * (1.0 + 1e-7)
+    capped, end_capped, _ = _graze_run(phi0, cap)
+    free, end_free, steps = _graze_run(phi0)
+    assert capped.size == 1 and 0.2 * _GRAZE_SPAN < capped[0] < 0.8 * _GRAZE_SPAN
+    assert _GRAZE_SPAN / steps > 50e-6  # the free run's mean step: far wider than the dip
+    assert free.size == 1
+    assert free[0] == pytest.approx(capped[0], abs=1e-9)
+    assert end_free == pytest.approx(end_capped, rel=1e-4, abs=1e-10)
+    # Below the threshold no trough reaches the needed friction: no switch at all.
+    assert _graze_run(lo * (1.0 - 1e-7))[0].size == 0
+
+
+@pytest.mark.slow
+def test_fig13_branch_ends_where_its_stick_phase_splits():
+    """The Fig. 13 orbit continued up in the disc speed: near 6.576 rad/s the friction
+    needed to stick touches mu_s N at an interior maximum of the stick phase, the slider
+    slips there and the flow map jumps, so the orbit ends. The continuation locates the
+    signature change to 1e-6; plain runs from the last orbit's point with steps capped at
+    0.1 us (independent of the continuation and of the kernel's dip search) show one
+    stick phase 2e-6 below the located speed and a split one 2e-6 above it."""
+    from fivdisc.analysis.cycle import one_period
+    from fivdisc.model import build_model
+    from fivdisc.paper.cases import FIGURES
+
+    case = FIGURES[13].case
+    orbit = periodic_orbit(case, transient=5.0, window=0.05)
+    br = continue_orbit(case, "speed.value", 8.0, orbit=orbit, max_points=40)
+    assert "does not persist past the signature change" in br.stop_reason
+    (end,) = [b for b in br.bifurcations() if b["kind"] == "signature change"]
+    assert end["signature_before"] == ("slip+ > stick > slip+",)
+    assert end["signature_after"][0].count("stick") == 2
+    x, period = end["state"], end["period"]
+    phases = br.dataset["phase"].values
+    for factor, sticks in ((1 - 2e-6, 1), (1 + 2e-6, 2)):
+        model = build_model(case.replace({"speed.value": end["parameter"] * factor}))
+        cyc = one_period(_capped(model), x, phases, period, 1e-12, 1e-19)
+        assert cyc.signature[0].count("stick") == sticks
+
+
+def _capped(model):
+    """The model with its case's largest step set to 0.1 us."""
+    from dataclasses import replace
+
+    return replace(model, case=model.case.replace({"simulation.max_step": 1e-7}))

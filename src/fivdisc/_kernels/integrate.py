@@ -191,6 +191,68 @@ def locate(i, lo, hi, g_lo, g_hi, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist)
     return hi
 
 
+@njit(cache=True, inline="always")
+def _predicted_dip(a, b, c, r):
+    """Where the parabola through an event function's values ``a``, ``b``, ``c`` at the
+    fractions ``-r``, 0 and 1 of the step (the previous step's start, this step's ends)
+    has its minimum, if inside the step and deep enough that the function may cross zero
+    there although both ends are positive: the fraction, else 2."""
+    gamma = (a - b + (c - b) * r) / (r * (1.0 + r))
+    if not gamma > 0.0:
+        return 2.0
+    beta = c - b - gamma
+    vertex = -beta / (2.0 * gamma)
+    if not 0.0 < vertex < 1.0:
+        return 2.0
+    low = b - beta * beta / (4.0 * gamma)
+    # The parabola is an estimate: the function is searched if its predicted minimum is
+    # below the depth of the predicted dip, not only below zero.
+    if low < min(b, c) - low:
+        return vertex
+    return 2.0
+
+
+@njit(cache=True, _nrt=False)
+def _dip(i, vertex, g0, g1, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist):
+    """Search the dense output of event ``i``, positive at both ends of the step, for a
+    dip below zero: successive parabolic interpolation on its minimum from ``vertex``.
+    Returns the fraction where it crosses zero (on the far side, by :func:`locate`), or
+    2 if its minimum inside the step is positive."""
+    # The bracket (xa, ga) < (xm, gm) > (xb, gb): the lowest point and its neighbours.
+    xa, xm, xb = 0.0, vertex, 1.0
+    ga, gb = g0, g1
+    gm = _event_at(xm, i, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist)
+    for _ in range(12):
+        if gm <= 0.0:
+            return locate(i, xa, xm, ga, gm, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist)
+        if gm > ga or gm > gb:
+            return 2.0  # no minimum between the outer points
+        da = (xm - xa) * (gm - gb)
+        db = (xm - xb) * (gm - ga)
+        den = 2.0 * (da - db)
+        if den == 0.0:
+            return 2.0
+        x = xm - ((xm - xa) * da - (xm - xb) * db) / den
+        if not xa < x < xb or abs(x - xm) < 1e-12 / h:
+            return 2.0
+        g = _event_at(x, i, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist)
+        if g <= 0.0:
+            if x < xm:
+                return locate(i, xa, x, ga, g, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt,
+                              ist)
+            return locate(i, xm, x, gm, g, t, h, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist)
+        if x < xm:
+            if g < gm:
+                xb, gb, xm, gm = xm, gm, x, g
+            else:
+                xa, ga = x, g
+        elif g < gm:
+            xa, ga, xm, gm = xm, gm, x, g
+        else:
+            xb, gb = x, g
+    return 2.0
+
+
 @njit(cache=True, _nrt=False)
 def _sample_states(t0, t1, h, rc, ph, sg, ctl, out_y, out_aux, ist):
     """Sample the dense output of the step [t0, t0 + h] at output times in (t0, t1]: the
@@ -325,6 +387,10 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
     evn = np.empty(n_ev)
     evt = np.empty(n_ev)
     probes = np.empty((_PROBES, n_ev))
+    # Event values at the previous step's start, for the dip predicted from three values
+    # (inf: none since the start of this call, a switch or a kink).
+    ev_old = np.full(n_ev, np.inf)
+    h_old = 0.0
     err_vec = np.empty(ns)
     rtol = ctl[C_RTOL]
     atol = ctl[C_ATOL]
@@ -428,6 +494,19 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
                     have_rc = True
                 th = locate(i, 0.0, 1.0, ev_prev[i], evn[i], t, hs, rc, ph, sg, mdl, wk,
                             dy, ytmp, evt, ist)
+            elif (ev_prev[i] > 0.0 and ev_old[i] < np.inf
+                  and _predicted_dip(ev_old[i], ev_prev[i], evn[i], h_old / hs) <= 1.0):
+                # Positive at both ends, but the parabola through this and the previous
+                # step's values dips inside the step: an excursion through zero narrower
+                # than the step (a brief slip inside a stick, a grazing), which the ends
+                # and the probes below can miss. Its minimum is searched for.
+                if not have_rc:
+                    dense_coefficients(y, ynew, k, hs, rc)
+                    have_rc = True
+                th = _dip(i, _predicted_dip(ev_old[i], ev_prev[i], evn[i], h_old / hs),
+                          ev_prev[i], evn[i], t, hs, rc, ph, sg, mdl, wk, dy, ytmp, evt, ist)
+                if th > 1.0:
+                    continue
             elif ev_prev[i] > 0.0 and min(ev_prev[i], evn[i]) < 2.0 * abs(evn[i] - ev_prev[i]):
                 # Both ends positive but close to zero for the change over the step: the
                 # function may dip below zero and back inside it (a brief separation or
@@ -491,6 +570,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
                     ev_prev, ev_t, ev_i, ist, fst)
             t = t_e
             _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
+            ev_old[:] = np.inf
             ist[I_RHS] += 1
             if tan is not None:
                 tangent.saltation(MODE_EVENT, which, t, ypre, ph_start, sgpre, ev_start, y,
@@ -533,7 +613,9 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
         for i in range(ns):
             k[0, i] = k[6, i]
         for i in range(n_ev):
+            ev_old[i] = ev_prev[i]
             ev_prev[i] = evn[i]
+        h_old = hs
         if tan is not None:
             tangent.accept(tv, tk, tvn)
         t = t_new
@@ -546,6 +628,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
             _switch(MODE_KINK, NO_EVENT, t, y, ph, sg, ph, ev_prev, mdl, wk, dy, k, ev_prev, ev_t,
                     ev_i, ist, fst)
             _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
+            ev_old[:] = np.inf
             ist[I_RHS] += 1
             if tan is not None:
                 tangent.saltation(MODE_KINK, NO_EVENT, t, ypre, ph_start, sgpre, ev_prev, y, ph, sg,

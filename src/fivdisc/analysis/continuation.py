@@ -649,13 +649,20 @@ def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
         try:
             b = branch.step_from(a, ds, deadline)
             if float(b.tangent @ a.tangent) < _MIN_COSINE:
-                raise ConvergenceError("the tangent turned too far", reason="turn")
+                reason = "the tangent turned by more than 60 degrees"
+                raise ConvergenceError(reason, reason=reason)
         except ConvergenceError as exc:
             ds *= 0.5
             if ds < min_step:
                 _, _, p = branch.unpack(a.z)
-                walk.stop = _Stop(f"the orbit is lost at {branch.key} = {p:.9g}: {exc.reason}",
-                                  lost=True)
+                end = _vanishing(branch, a, len(walk.points) - 1)
+                if end is None:
+                    walk.stop = _Stop(f"the orbit is lost at {branch.key} = {p:.9g}: "
+                                      f"{exc.reason}", lost=True)
+                else:
+                    walk.bifurcations.append(end)
+                    walk.stop = _Stop(f"the orbit does not persist past the signature change "
+                                      f"at {branch.key} = {end.parameter:.9g}")
                 return
             continue
         _, period, _ = branch.unpack(b.z)
@@ -683,6 +690,54 @@ def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
         elif b.iterations >= 5:
             ds = max(ds * 0.5, min_step)
     walk.stop = _Stop(f"the largest number of points ({max_points}) is reached")
+
+
+def _vanishing(branch: _Branch, a: _Point, index: int) -> Bifurcation | None:
+    """Where the branch is lost just after ``a``: if the flow from ``a``'s point changes
+    its event signature within a relative change of the key of 1e-3 ahead, that change
+    is where the orbit ends (the flow map jumps there, as where a stick phase splits);
+    it is located by bisection on the key with ``a``'s point held, which is within the
+    smallest step of the orbit. None if the signature does not change."""
+    x, period, p = branch.unpack(a.z)
+    ahead = np.sign(a.tangent[-1]) or 1.0
+    key = a.cycle.cyclic()
+    scale = max(abs(p), branch.ps * 1e-3)
+
+    def cycle(q: float) -> Cycle:
+        return one_period(branch.model(q), x, branch.shooting.phases, period, branch.rtol,
+                          branch.atol)
+
+    lo, hi, far = p, None, None
+    for k in range(11):
+        q = p + ahead * scale * 1e-6 * 2.0**k
+        try:
+            c = cycle(q)
+        except FivdiscError:
+            continue
+        if c.cyclic() != key:
+            hi, far = q, c
+            break
+        lo = q
+    if hi is None:
+        return None
+    while abs(hi - lo) > _LOCATE * scale:
+        mid = 0.5 * (lo + hi)
+        c = cycle(mid)
+        if c.cyclic() == key:
+            lo = mid
+        else:
+            hi, far = mid, c
+    shot = branch.shooter(hi).shoot(x, period)
+    after, _ = branch.shooting.stability(shot)
+    sides = [f"slider {j}: {u} -> {v}" for j, (u, v) in
+             enumerate(zip(a.cycle.signature, far.signature, strict=True)) if u != v]
+    return Bifurcation(kind="signature change", parameter=0.5 * (lo + hi), period=period,
+                       state=x.copy(), before=a.multipliers, after=after,
+                       signature_before=a.cycle.signature, signature_after=far.signature,
+                       point=index,
+                       note="the event signature changes (" + "; ".join(sides) + ") and the "
+                       "orbit does not persist past it (multipliers after: of the flow map "
+                       "from the last orbit's point)")
 
 
 def _record(branch: _Branch, walk: _Walk, a: _Point, b: _Point, s_ab: float,
