@@ -265,7 +265,12 @@ def test_fig13_branch_ends_where_its_stick_phase_splits():
     slips there and the flow map jumps, so the orbit ends. The continuation locates the
     signature change to 1e-6; plain runs from the last orbit's point with steps capped at
     0.1 us (independent of the continuation and of the kernel's dip search) show one
-    stick phase 2e-6 below the located speed and a split one 2e-6 above it."""
+    stick phase 2e-6 below the located speed and a split one 2e-6 above it.
+
+    Beside it, at 6.58 rad/s, lies an orbit of six cycles whose period is 3e-5 from six
+    times the one-cycle orbit's (a transient of 3 s finds it): the branch does not jump
+    onto it. Its points move continuously (each within a tenth of the state's size of
+    the previous), every period stays a one-cycle period, and it ends at the split."""
     from fivdisc.analysis.cycle import one_period
     from fivdisc.model import build_model
     from fivdisc.paper.cases import FIGURES
@@ -274,6 +279,12 @@ def test_fig13_branch_ends_where_its_stick_phase_splits():
     orbit = periodic_orbit(case, transient=5.0, window=0.05)
     br = continue_orbit(case, "speed.value", 8.0, orbit=orbit, max_points=40)
     assert "does not persist past the signature change" in br.stop_reason
+    six = periodic_orbit(case.replace({"speed.value": 6.58}), transient=3.0, window=0.05)
+    assert six.period == pytest.approx(6 * br.period[-1], rel=1e-4)
+    assert np.all(np.abs(6 * br.period / six.period - 1) > 1e-5)
+    states = br.dataset["state"].values
+    steps = np.linalg.norm(np.diff(states, axis=0), axis=1)
+    assert np.all(steps < 0.1 * np.linalg.norm(states[1:], axis=1))
     (end,) = [b for b in br.bifurcations() if b["kind"] == "signature change"]
     assert end["signature_before"] == ("slip+ > stick > slip+",)
     assert end["signature_after"][0].count("stick") == 2
@@ -290,3 +301,49 @@ def _capped(model):
     from dataclasses import replace
 
     return replace(model, case=model.case.replace({"simulation.max_step": 1e-7}))
+
+
+def test_a_branch_is_laid_over_a_brute_force_diagram(tmp_path, rigid_branch):
+    """fivdisc bifurcation --branch: the sweep's section values (phi_dot at its maxima,
+    which on the stick-slip orbit is the disc speed) and the branch's largest phi_dot
+    share the axes; a branch in another key is refused in one line before the sweep."""
+    branch_nc = tmp_path / "branch.nc"
+    rigid_branch.to_netcdf(branch_nc)
+    sweep = tmp_path / "speed.toml"
+    sweep.write_text("""
+mode = "grid"
+[base.disc]
+modes = [[0, 0]]
+[base.slider]
+rotational_damping = 0.0
+normal_damping = 5.0
+[base.friction]
+static = 0.8
+kinetic_max = 0.5
+kinetic_min = 0.5
+decay = 0.0
+[base.simulation]
+duration = 0.5
+output_rate = 5000.0
+[axes]
+"speed.value" = "1.0:2.0:2"
+[[reduce.section]]
+variable = "phi_dot"
+at = "maxima"
+after = 0.3
+max_points = 50
+""")
+    png = tmp_path / "diagram.png"
+    runner = CliRunner()
+    res = runner.invoke(cli, ["bifurcation", str(sweep), "--branch", str(branch_nc),
+                              "--workers", "1", "--no-progress", "-o", str(png)])
+    assert res.exit_code == 0, res.output
+    assert png.stat().st_size > 0
+    other = tmp_path / "other.nc"
+    br = open_branch(branch_nc)
+    br.dataset.attrs["key"] = "slider.mass"
+    br.to_netcdf(other)
+    res = runner.invoke(cli, ["bifurcation", str(sweep), "--branch", str(other),
+                              "--workers", "1", "--no-progress", "-o", str(png)])
+    assert res.exit_code == 2
+    assert "cannot share an axis" in res.stderr
