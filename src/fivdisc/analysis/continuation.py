@@ -11,9 +11,10 @@ the start, the unknowns are ``z = (x, T, p)`` and the equations
   previous point's (which fixes it on the orbit);
 * ``t_prev . (z - z_prev) = ds``: a step ``ds`` along the previous tangent.
 
-The predictor is ``z_prev + ds t_prev``; Newton's corrector takes the monodromy (exact
-across every switch) for ``d phi_T / dx``, the vector field for ``d phi_T / dT`` and a
-central difference for ``d phi_T / dp``. A corrector that needs more than
+The predictor is ``z_prev + ds t_prev``; a chord Newton corrector takes the previous
+point's Jacobian: the monodromy (exact across every switch) for ``d phi_T / dx``, the
+vector field for ``d phi_T / dT`` and a central difference for ``d phi_T / dp``; each
+converged point gets its own, for its multipliers and tangent. A corrector that needs more than
 :data:`_MAX_CORRECTION` of ``ds`` to converge, or whose tangent turns by more than 60
 degrees, is refused and the step halved: so the branch moves continuously and never
 jumps to a nearby orbit (orbits of nearly the same period coexist in the paper's cases).
@@ -57,13 +58,13 @@ __all__ = ["Bifurcation", "check_key", "continue_orbit", "doubled_start"]
 _MAX_CORRECTION = 0.5
 # Cosine of the largest turn of the tangent between consecutive points (60 degrees).
 _MIN_COSINE = 0.5
-_MAX_NEWTON = 8
+_MAX_NEWTON = 10
 # Relative step of the central difference d phi_T / dp.
 _DP = 1e-6
 # Relative accuracy in the parameter to which bifurcations are located.
 _LOCATE = 1e-6
-# A point converged to a residual above this fraction of the tolerance gets one more
-# Newton step (_Branch._polish).
+# A converged point is refined while its residual falls, to below this fraction of the
+# tolerance (_Branch.correct).
 _POLISH = 1e-2
 # A multiplier whose imaginary part is below this (relative) is taken as real.
 _REAL = 1e-6
@@ -245,19 +246,32 @@ class _Branch:
 
     def correct(self, z_pred: np.ndarray, row: np.ndarray, target: float, ref: _Point,
                 step: float, deadline: float) -> _Point:
-        """Newton on the gap, the phase condition about ``ref`` and ``row . z = target``,
-        from ``z_pred``; each correction bounded (module docstring).
+        """Chord Newton on the gap, the phase condition about ``ref`` and
+        ``row . z = target``, from ``z_pred``, each correction bounded (module docstring).
+
+        The iterations take ``ref``'s Jacobian, factorised once, and runs of the flow map
+        without tangents; once the residual is below the tolerance they go on while it
+        falls, to below 1e-2 of it (the tolerance bounds the period's error only to about
+        itself), and the monodromy of the converged point comes from one run with
+        tangents (the state's trajectory is the same with and without them).
 
         Raises
         ------
         ConvergenceError
             Not converged, or a correction too large (``reason`` says which).
         """
+        from scipy.linalg import lu_factor, lu_solve
+
+        m = self.m
         phase = self.phase_row(ref.shot)
-        x_ref = ref.z[: self.m]
-        dp = ref.jac[: self.m, self.m + 1]
+        x_ref = ref.z[:m]
+        lhs = np.vstack([ref.jac, row])
+        lhs[m, :m] = phase
+        lhs[m, m:] = 0.0
+        factors = lu_factor(lhs)
         z = z_pred.copy()
-        reason = f"no convergence in {_MAX_NEWTON} Newton iterations"
+        best = None
+        reason = f"no convergence in {_MAX_NEWTON} iterations"
         for it in range(_MAX_NEWTON + 1):
             x, period, p = self.unpack(z)
             if not period > 0:
@@ -265,53 +279,38 @@ class _Branch:
                 break
             shooting = self.shooter(p)
             try:
-                shot = shooting.shoot(x, period)
+                shot = shooting.shoot(x, period, tangents=False)
             except FivdiscError as exc:
                 reason = str(exc)
                 break
-            residual = shooting.residual(shot, x, period)
             if not np.array_equal(shot.free, self.free):
                 reason = "the orbit's point reached a switch"
                 break
+            residual = shooting.residual(shot, x, period)
+            if best is not None and residual >= best[1]:
+                break  # converged, and no longer falling: keep the best
             if residual < self.tol:
-                dp = self.dgap_dp(x, period, p)
-                jac = self.jacobian(shot, shooting, dp, phase)
-                if residual > _POLISH * self.tol:
-                    z, x, shot, jac, residual = self._polish(z, x, shot, jac, residual, row,
-                                                             target, phase, x_ref, shooting)
-                mult, trivial = self.shooting.stability(shot)
-                return _Point(z, x, shot, jac, np.zeros_like(z), mult, trivial, residual, it)
-            if it == _MAX_NEWTON or time.monotonic() > deadline:
-                reason = (f"no convergence in {_MAX_NEWTON} Newton iterations" if
-                          it == _MAX_NEWTON else "the time budget ran out")
+                best = (z, residual, it)
+                if residual < _POLISH * self.tol:
+                    break
+            elif it == _MAX_NEWTON or time.monotonic() > deadline:
+                reason = (f"no convergence in {_MAX_NEWTON} iterations" if it == _MAX_NEWTON
+                          else "the time budget ran out")
                 break
-            jac = self.jacobian(shot, shooting, dp, phase)
-            lhs = np.vstack([jac, row])
-            rhs = -np.r_[self.gap_of(shot, x), phase @ (z[: self.m] - x_ref), row @ z - target]
-            dz = np.linalg.solve(lhs, rhs)
-            z = z + dz
-            if np.linalg.norm(z - z_pred) > _MAX_CORRECTION * step:
+            rhs = -np.r_[self.gap_of(shot, x), phase @ (z[:m] - x_ref), row @ z - target]
+            z = z + lu_solve(factors, rhs)
+            if best is None and np.linalg.norm(z - z_pred) > _MAX_CORRECTION * step:
                 reason = "the corrector left the neighbourhood of the predictor"
                 break
-        raise ConvergenceError(reason, reason=reason)
-
-    def _polish(self, z, x, shot, jac, residual, row, target, phase, x_ref, shooting):
-        """One more Newton step from a converged point, kept if it lowers the residual:
-        the residual's tolerance bounds the period's error only to about itself, and a
-        step from just below it takes the period to the integration's accuracy."""
-        rhs = -np.r_[self.gap_of(shot, x), phase @ (z[: self.m] - x_ref), row @ z - target]
-        z2 = z + np.linalg.solve(np.vstack([jac, row]), rhs)
-        x2, period2, p2 = self.unpack(z2)
-        shooting = self.shooter(p2)
-        try:
-            shot2 = shooting.shoot(x2, period2)
-        except FivdiscError:
-            return z, x, shot, jac, residual
-        residual2 = shooting.residual(shot2, x2, period2)
-        if residual2 >= residual or not np.array_equal(shot2.free, self.free):
-            return z, x, shot, jac, residual
-        return z2, x2, shot2, self.jacobian(shot2, shooting, jac[: self.m, self.m + 1],
-                                           phase), residual2
+        if best is None:
+            raise ConvergenceError(reason, reason=reason)
+        z, residual, it = best
+        x, period, p = self.unpack(z)
+        shooting = self.shooter(p)
+        shot = shooting.shoot(x, period)
+        jac = self.jacobian(shot, shooting, self.dgap_dp(x, period, p), phase)
+        mult, trivial = self.shooting.stability(shot)
+        return _Point(z, x, shot, jac, np.zeros_like(z), mult, trivial, residual, it)
 
     def finish(self, point: _Point, previous: np.ndarray | None, sign: float) -> _Point:
         point.tangent = self.tangent(point.jac, previous, sign)
@@ -590,8 +589,8 @@ def continue_orbit(
     Notes
     -----
     The method is in the module's docstring and on the documentation's continuation
-    page. Step control: after a point that took at most 2 Newton iterations the step
-    grows by 1.5, after 5 or more it halves; a refused or failed step is halved, and a
+    page. Step control: after a point that took at most 3 corrector iterations the step
+    grows by 1.5, after 7 or more it halves; a refused or failed step is halved, and a
     step below ``min_step`` ends the branch as lost.
     """
     from fivdisc.analysis.branch import Branch
@@ -685,9 +684,9 @@ def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
         if passed:
             walk.stop = _Stop(f"reached {branch.key} = {to:.9g}")
             return
-        if b.iterations <= 2:
+        if b.iterations <= 3:
             ds = min(ds * 1.5, max_step)
-        elif b.iterations >= 5:
+        elif b.iterations >= 7:
             ds = max(ds * 0.5, min_step)
     walk.stop = _Stop(f"the largest number of points ({max_points}) is reached")
 
