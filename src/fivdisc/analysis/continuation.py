@@ -693,10 +693,11 @@ def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
 
 def _vanishing(branch: _Branch, a: _Point, index: int) -> Bifurcation | None:
     """Where the branch is lost just after ``a``: if the flow from ``a``'s point changes
-    its event signature within a relative change of the key of 1e-3 ahead, that change
-    is where the orbit ends (the flow map jumps there, as where a stick phase splits);
-    it is located by bisection on the key with ``a``'s point held, which is within the
-    smallest step of the orbit. None if the signature does not change."""
+    its event signature within a relative change of the key of 1e-3 ahead, the orbit
+    ends at that change (the flow map jumps there, as where a stick phase splits). It is
+    bracketed with ``a``'s point held, then located to 1e-6 by bisection on the orbits
+    themselves: the last value at which the corrector finds the orbit with ``a``'s
+    signature. None if the signature does not change."""
     x, period, p = branch.unpack(a.z)
     ahead = np.sign(a.tangent[-1]) or 1.0
     key = a.cycle.cyclic()
@@ -719,20 +720,45 @@ def _vanishing(branch: _Branch, a: _Point, index: int) -> Bifurcation | None:
         lo = q
     if hi is None:
         return None
+    # Refined on the orbits themselves: the last value at which the corrector still finds
+    # the orbit with its signature, the flow from that orbit's point changing its
+    # signature at the upper end of the bracket (where the corrector fails short of the
+    # change, the held point decides).
+    deadline = time.monotonic() + 600.0
+    last, lo = a, p
+
+    def beyond(q: float) -> Cycle | None:
+        x_last, period_last, _ = branch.unpack(last.z)
+        c = one_period(branch.model(q), x_last, branch.shooting.phases, period_last,
+                       branch.rtol, branch.atol)
+        return c if c.cyclic() != key else None
+
+    far = beyond(hi)
+    if far is None:
+        return None
     while abs(hi - lo) > _LOCATE * scale:
         mid = 0.5 * (lo + hi)
-        c = cycle(mid)
-        if c.cyclic() == key:
-            lo = mid
+        try:
+            pt = branch.at_value(last, mid, deadline)
+        except ConvergenceError:
+            pt = None
+        if pt is not None and pt.cycle.cyclic() == key:
+            last, lo = pt, mid
+            far = beyond(hi) or far
+            continue
+        changed = beyond(mid)
+        if changed is not None:
+            hi, far = mid, changed
         else:
-            hi, far = mid, c
+            lo = mid
+    x, period, _ = branch.unpack(last.z)
     shot = branch.shooter(hi).shoot(x, period)
     after, _ = branch.shooting.stability(shot)
     sides = [f"slider {j}: {u} -> {v}" for j, (u, v) in
-             enumerate(zip(a.cycle.signature, far.signature, strict=True)) if u != v]
+             enumerate(zip(last.cycle.signature, far.signature, strict=True)) if u != v]
     return Bifurcation(kind="signature change", parameter=0.5 * (lo + hi), period=period,
-                       state=x.copy(), before=a.multipliers, after=after,
-                       signature_before=a.cycle.signature, signature_after=far.signature,
+                       state=x.copy(), before=last.multipliers, after=after,
+                       signature_before=last.cycle.signature, signature_after=far.signature,
                        point=index,
                        note="the event signature changes (" + "; ".join(sides) + ") and the "
                        "orbit does not persist past it (multipliers after: of the flow map "
