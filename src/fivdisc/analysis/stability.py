@@ -168,13 +168,18 @@ def linear_stability(case: Case | Model) -> LinearStability:
     order = np.lexsort((-lam.imag, -lam.real))
     lam = lam[order]
     vec = vec[:, order]
+    return LinearStability(eq, jac, lam, vec, dominant_coordinates(model, vec))
+
+
+def dominant_coordinates(model: Model, vectors: np.ndarray) -> tuple[str, ...]:
+    """Per eigenvector (columns, variables ``(q, phi, qdot, phidot)``), the coordinate
+    with the largest share of its kinetic energy (``"C01"``, ..., ``"phi"``)."""
     size = model.n + model.n_sliders
     inertia = np.append(model.modal_mass, model.kernel.row("inertia"))
     # Velocity part of an eigenvector is lambda times its displacement part.
-    energy = inertia[:, None] * np.abs(vec[size:, :]) ** 2
+    energy = inertia[:, None] * np.abs(vectors[size:, :]) ** 2
     names = (*model.labels, *_angle_names(model))
-    dominant = tuple(names[i] for i in np.argmax(energy, axis=0))
-    return LinearStability(eq, jac, lam, vec, dominant)
+    return tuple(names[i] for i in np.argmax(energy, axis=0))
 
 
 @dataclass(frozen=True)
