@@ -28,29 +28,70 @@ from fivdisc.errors import CaseError, SimulationError
 COUPLING_TOLERANCE = 0.01
 
 
-def _follow(previous: list[np.ndarray], lam: np.ndarray) -> np.ndarray:
-    """Order of `lam` that continues the branches whose last values are `previous`."""
+def follow(lam: np.ndarray) -> np.ndarray:
+    """Eigenvalues at successive parameter values reordered into branches.
+
+    Parameters
+    ----------
+    lam : ndarray
+        ``(values, k)`` complex eigenvalues, each row in any order; rows of NaN (no
+        equilibrium) break the branches, which resume from the last finite row.
+
+    Returns
+    -------
+    ndarray
+        The same rows, reordered: column b is branch b. The first finite row is ordered
+        by the imaginary part's sign (positive first) and magnitude.
+
+    Notes
+    -----
+    Row i + 1 is assigned to the branches so that the sum of the distances
+    ``|lambda_b(i + 1) - (2 lambda_b(i) - lambda_b(i - 1))|`` to the branches' linear
+    extrapolations is least (:func:`scipy.optimize.linear_sum_assignment`).
+    """
     from scipy.optimize import linear_sum_assignment
 
-    guess = previous[-1] if len(previous) < 2 else 2.0 * previous[-1] - previous[-2]
-    cost = np.abs(guess[:, None] - lam[None, :])
-    _, order = linear_sum_assignment(cost)
-    return order
+    out = np.array(lam, dtype=complex)
+    history: list[np.ndarray] = []
+    last = None
+    for i, row in enumerate(out):
+        if not np.isfinite(row).all():
+            history = []
+            continue
+        if last is None:
+            out[i] = row[np.lexsort((np.abs(row.imag), row.imag < 0))]
+        else:
+            prior = history or [last]
+            guess = prior[-1] if len(prior) < 2 else 2.0 * prior[-1] - prior[-2]
+            _, order = linear_sum_assignment(np.abs(guess[:, None] - row[None, :]))
+            out[i] = row[order]
+        last = out[i]
+        history = [*history[-1:], out[i]]
+    return out
 
 
 def _existence_limit(points: ParameterPoints, inside: float, outside: float,
                      guess: Equilibrium) -> float:
-    """Value of the key where the smallest normal force of the equilibrium reaches zero,
-    between `inside` (the equilibrium exists) and `outside` (it does not); `inside`
-    itself when the slip equations have no solution beyond it to bracket the root."""
+    """Value of the key between `inside` (the equilibrium exists) and `outside` (it does
+    not) where it ceases to exist: where the smallest normal force of the solution of the
+    slip equations reaches zero, or where that solution itself is lost (a fold); `inside`
+    if the solution jumps between the two."""
     from scipy.optimize import brentq
 
-    def least_force(value: float) -> float:
-        eq = points.equilibrium(points.model((value,)), guess, contact=False)
-        return np.nan if eq is None else float(np.min(eq.normal_force))
+    last = [guess]
 
-    far = least_force(outside)
-    if not far <= 0.0:
+    def least_force(value: float) -> float:
+        eq = points.equilibrium(points.model((value,)), last[0], contact=False)
+        if eq is None:
+            # No solution at all counts as outside: Brent's method then converges on
+            # the edge of the solutions, the fold.
+            return -1.0
+        last[0] = eq
+        return float(np.min(eq.normal_force))
+
+    if least_force(outside) > 0.0:
+        # The solution jumped between the two values (a pole of the disc's static
+        # compliance at a critical speed lies between them): no bracket to refine.
         return inside
     span = abs(outside - inside)
     return float(brentq(least_force, inside, outside, xtol=1e-13 * max(span, abs(inside)),
@@ -115,9 +156,8 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
     lam = np.full((values.size, size), np.nan + 1j * np.nan)
     force = np.full((values.size, ns), np.nan)
     angle = np.full((values.size, ns), np.nan)
-    modes: tuple[str, ...] = ()
+    first_model = first_vectors = None
     limits: list[float] = []
-    history: list[np.ndarray] = []
     guess = None
     bar = None
     if progress:
@@ -131,25 +171,26 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
         if point is None:
             if guess is not None:
                 limits.append(_existence_limit(points, values[i - 1], value, guess))
-            history = []
+            guess = None
             continue
         model, eq, jac = point
         if guess is None and i > 0:
             # The equilibrium reappears: the limit lies between the last two values.
             limits.append(_existence_limit(points, value, values[i - 1], eq))
         guess = eq
-        here, vectors = np.linalg.eig(jac)
-        if not modes:
-            start = np.lexsort((np.abs(here.imag), here.imag < 0))
-            here, vectors = here[start], vectors[:, start]
-            modes = dominant_coordinates(model, vectors)
+        if first_model is None:
+            lam[i], first_vectors = np.linalg.eig(jac)
+            first_model = model
         else:
-            here = here[_follow(history or [lam[_last_valid(lam, i)]], here)]
-        lam[i] = here
-        history = [*history[-1:], here]
+            lam[i] = np.linalg.eigvals(jac)
         force[i], angle[i] = eq.normal_force, eq.phi
     if bar is not None:
         bar.close()
+    raw = lam[np.isfinite(lam).all(axis=1)][0]
+    lam = follow(lam)
+    start = lam[np.isfinite(lam).all(axis=1)][0]
+    which = [int(np.argmin(np.abs(raw - v))) for v in start]
+    modes = dominant_coordinates(first_model, first_vectors[:, which])
     return _dataset(case, key, values, lam, modes, force, angle, limits)
 
 
