@@ -11,6 +11,7 @@ cannot change it (the sliders' dampers).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import cache
 
 import numpy as np
 
@@ -37,7 +38,11 @@ _SLIDER_ARRAYS = {
 def reduced_indices(model: Model) -> np.ndarray:
     """Kernel-state indices of the slip equations' variables ``(q, phi, qdot, phidot)``:
     in contact the sliders' own z, zdot are slaved to the disc."""
-    n, ns = model.n, model.n_sliders
+    return _reduced(model.n, model.n_sliders)
+
+
+@cache
+def _reduced(n: int, ns: int) -> np.ndarray:
     half = n + 2 * ns
     return np.r_[0 : n + ns, half : half + n + ns]
 
@@ -48,7 +53,7 @@ def slip_jacobian(model: Model, state: np.ndarray) -> np.ndarray:
     ph, sg = slip_phases(model)
     jac = dyn.complex_step_jacobian(0.0, state, ph, sg, model.kernel_args)
     idx = reduced_indices(model)
-    return jac[np.ix_(idx, idx)]
+    return jac[idx][:, idx]
 
 
 def check_keys(case: Case, keys: Sequence[str], options: Sequence[str]) -> None:
@@ -144,6 +149,7 @@ class ParameterPoints:
         """Model at one point, by patching the base model where that is exact."""
         updates = {key: float(v) for key, v in zip(self.keys, values, strict=True)}
         model = self.base
+        rows: dict[str, np.ndarray] = {}
         for key, value in updates.items():
             parts = key.split(".")
             if key == "speed.value":
@@ -151,14 +157,12 @@ class ParameterPoints:
             elif parts[0] in ("slider", "sliders") and parts[-1] in _SLIDER_ARRAYS:
                 j = 0 if parts[0] == "slider" else int(parts[1])
                 name = _SLIDER_ARRAYS[parts[-1]]
-                row = model.kernel.row(name).copy()
-                row[j] = value
-                model = model.with_sliders(**{name: row})
+                rows.setdefault(name, model.kernel.row(name).copy())[j] = value
             elif parts[0] == "friction" and parts[-1] in lay.FRICTION_SLOTS:
                 model = model.with_friction(**{parts[-1]: value})
             else:
                 return build_model(self.case.replace(updates))
-        return model
+        return model.with_sliders(**rows) if rows else model
 
     def equilibrium(self, model: Model, guess: Equilibrium | None = None,
                     contact: bool = True) -> Equilibrium | None:
