@@ -148,7 +148,15 @@ def _trace(g: _Growth, start: np.ndarray, direction: np.ndarray, step: float
             d = new - p
             t = min(((1.0 if d[k] > 0 else 0.0) - p[k]) / d[k] for k in range(2) if d[k] != 0
                     and not 0.0 <= new[k] <= 1.0)
-            path.append(np.clip(p + t * d, 0.0, 1.0))
+            end = np.clip(p + t * d, 0.0, 1.0)
+            # On the crossed edge, the curve's exact end lies within the step.
+            k = 1 if 0.0 < end[1] < 1.0 else 0
+            a, b = end.copy(), end.copy()
+            a[k], b[k] = max(end[k] - h, 0.0), min(end[k] + h, 1.0)
+            ga, gb = g(a), g(b)
+            if np.isfinite(ga) and np.isfinite(gb) and (ga < 0) != (gb < 0):
+                end = _zero_between(g, a, b, ga, gb)
+            path.append(end)
             return path, False
         if len(path) > 2 and np.linalg.norm(new - start) < h:
             path += [new, start]
@@ -210,9 +218,28 @@ def stability_boundary(
     lo = np.array([xr_[0], yr_[0]])
     span = np.array([xr_[1] - xr_[0], yr_[1] - yr_[0]])
     g = _Growth(points, lo, span)
+    return _dataset(case, g, zero_curves(g, seeds, step), (xkey, xr_), (ykey, yr_))
+
+
+def zero_curves(g, seeds: int = 12, step: float = 0.02
+                ) -> list[tuple[list[np.ndarray], bool]]:
+    """Every curve where the continuous function `g` of the unit square changes sign.
+
+    Parameters
+    ----------
+    g : callable
+        ``g(u)`` of a point ``u`` (2 values in [0, 1]); NaN where undefined.
+    seeds, step
+        As for :func:`stability_boundary`.
+
+    Returns
+    -------
+    list of (list of ndarray, bool)
+        Per curve, its points in order and whether it is closed.
+    """
     found = _seeds(g, seeds)
     covered: set[tuple] = set()
-    branches: list[tuple[list[np.ndarray], bool]] = []
+    curves: list[tuple[list[np.ndarray], bool]] = []
     for edge, seed in sorted(found.items()):
         if edge in covered:
             continue
@@ -220,16 +247,15 @@ def stability_boundary(
         grad = np.array([(g(seed + e * d) - g(seed - e * d)) / (2 * e)
                          for d in (np.array([1.0, 0.0]), np.array([0.0, 1.0]))])
         along = np.array([-grad[1], grad[0]])
-        forward, closed = _trace(g, seed, along, step)
-        path = forward
+        path, closed = _trace(g, seed, along, step)
         if not closed:
             backward, _ = _trace(g, seed, -along, step)
-            path = backward[::-1] + forward[1:]
+            path = backward[::-1] + path[1:]
         for p, q in itertools.pairwise(path):
             covered |= _edges_crossed(p, q, seeds)
         covered.add(edge)
-        branches.append((path, closed))
-    return _dataset(case, g, branches, (xkey, xr_), (ykey, yr_))
+        curves.append((path, closed))
+    return curves
 
 
 def _dataset(case: Case, g: _Growth, branches, x, y) -> xr.Dataset:
