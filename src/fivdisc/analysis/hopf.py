@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import xarray as xr
 
 from fivdisc._kernels import layout as lay
 from fivdisc._kernels import tangent as tan
@@ -153,8 +154,8 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, lam_lo: com
     )
 
 
-def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "key"
-                ) -> list[HopfPoint]:
+def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "key",
+                branches: xr.Dataset | None = None) -> list[HopfPoint]:
     """Hopf points of the sliding equilibrium along one numeric key.
 
     Parameters
@@ -169,6 +170,9 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
         the spacing of `values` can cancel out unseen: refine the values to find them.
     option : str
         What names `key` in error messages.
+    branches : xarray.Dataset, optional
+        The branches of :func:`~fivdisc.analysis.eigenbranches.eigen_branches` over the
+        same key and values, if already computed.
 
     Returns
     -------
@@ -191,7 +195,8 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
     """
     from fivdisc.analysis.eigenbranches import eigen_branches
 
-    branches = eigen_branches(case, key, values, option=option)
+    if branches is None:
+        branches = eigen_branches(case, key, values, option=option)
     values = branches[key].values
     lam = branches["growth_rate"].values + 2j * np.pi * branches["frequency"].values
     points = ParameterPoints(case, [key])
