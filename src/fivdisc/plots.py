@@ -523,7 +523,7 @@ def plot_kind(data: xr.Dataset | object, kind: str = "timeseries", var: str | No
 
 @_drawing
 def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None,
-                       boundary: xr.Dataset | None = None) -> Figure:
+                       boundary: xr.Dataset | Sequence[xr.Dataset] | None = None) -> Figure:
     """Stability map of :func:`fivdisc.analysis.stability.stability_map` (paper Fig. 3).
 
     The field is always drawn: with one map the grid is shaded stable against unstable;
@@ -539,9 +539,10 @@ def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None,
         The map's dataset.
     ax : matplotlib Axes, optional
         Where to draw.
-    boundary : xarray.Dataset, optional
+    boundary : xarray.Dataset or sequence of them, optional
         Exact boundary curves of :func:`fivdisc.analysis.boundary.stability_boundary`
-        over the same keys, drawn on top (black).
+        over the same keys (one per curve value, with `curve_key`), drawn on top
+        (black, dashed).
     """
     fig, ax = _axes(ax)
     xkey, ykey = ds.attrs["x_key"], ds.attrs["y_key"]
@@ -581,11 +582,12 @@ def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None,
             absent.append(f"{text} ({state})" if text else state)
             if text:
                 ax.plot([], [], color=color, lw=8, alpha=0.3, label=f"{text}: {state}")
-    if boundary is not None:
-        for b in np.unique(boundary["branch"].values):
-            sel = boundary["branch"].values == b
-            ax.plot(boundary[xkey].values[sel], boundary[ykey].values[sel], color="k",
-                    lw=1.0, ls="--", label="exact boundary" if b == 0 else None)
+    exact = [boundary] if isinstance(boundary, xr.Dataset) else list(boundary or [])
+    for k, one in enumerate(exact):
+        for b in np.unique(one["branch"].values):
+            sel = one["branch"].values == b
+            ax.plot(one[xkey].values[sel], one[ykey].values[sel], color="k", lw=1.0,
+                    ls="--", label="exact boundary" if k == b == 0 else None)
     ax.set_xlabel(axis_label(ds[xkey]))
     ax.set_ylabel(axis_label(ds[ykey]))
     ax.set_xlim(x[0], x[-1])
