@@ -45,10 +45,11 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
     if boundary_spec and (x_spec or y_spec or curve_spec):
         raise FivdiscError("--boundary takes its own two keys: leave out --x, --y and --curves")
     if x_spec is None and y_spec is None and not boundary_spec:
-        for option, given in (("--curves", curve_spec), ("-o", output)):
-            if given is not None:
-                raise FivdiscError(f"{option} is used only with --x, --y or --boundary "
-                                   "(KEY=START:STOP:N)")
+        if curve_spec is not None:
+            raise FivdiscError("--curves is used only by a stability map: give --x and --y "
+                               "too (KEY=START:STOP:N)")
+        if output is not None:
+            raise FivdiscError("-o is used only by a scan: give --x (and --y) or --boundary")
         res = linear_stability(case)
         if as_json:
             import json
