@@ -221,3 +221,18 @@ def test_stability_command_refuses_a_case_without_sliding_equilibrium():
                                    "--no-progress"])
     assert out.exit_code == 2 and "no sliding equilibrium" in out.output
     assert len(out.output.strip().splitlines()) == 1
+
+
+def test_plot_command_draws_saved_branches_and_boundaries(tmp_path):
+    runner = CliRunner()
+    for args, name in ((["--x", "rotational_damping=0:3:8"], "br.nc"),
+                       (["--boundary", "normal_damping=0:12", "rotational_damping=0:3"],
+                        "b.nc")):
+        saved = tmp_path / name
+        out = runner.invoke(cli, ["stability", "fig03a", *args, "-o", str(saved),
+                                  "--no-progress"])
+        assert out.exit_code == 0, out.output
+        figure = tmp_path / f"{name}.png"
+        out = runner.invoke(cli, ["plot", str(saved), "-o", str(figure)])
+        assert out.exit_code == 0, out.output
+        assert figure.read_bytes()[:4] == b"\x89PNG"

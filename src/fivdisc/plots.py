@@ -53,6 +53,7 @@ __all__ = [
     "plot_phase_portrait",
     "plot_spectrogram",
     "plot_spectrum",
+    "plot_stability_boundary",
     "plot_stability_map",
     "plot_timeseries",
 ]
@@ -605,6 +606,38 @@ def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None,
 
 
 @_drawing
+def plot_stability_boundary(ds: xr.Dataset, ax: Axes | None = None) -> Figure:
+    """The curves of :func:`fivdisc.analysis.boundary.stability_boundary` in their box,
+    each labelled with its critical mode and frequency.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The boundary's dataset.
+    ax : matplotlib Axes, optional
+        Where to draw.
+    """
+    fig, ax = _axes(ax)
+    xkey, ykey = ds.attrs["x_key"], ds.attrs["y_key"]
+    for b in np.unique(ds["branch"].values):
+        sel = ds["branch"].values == b
+        modes = ", ".join(dict.fromkeys(ds["mode"].values[sel]))
+        ax.plot(ds[xkey].values[sel], ds[ykey].values[sel], lw=1.5,
+                label=f"{modes}, {np.median(ds['frequency'].values[sel]):.1f} Hz")
+    ax.set_xlim(*ds.attrs["x_range"])
+    ax.set_ylim(*ds.attrs["y_range"])
+    ax.set_xlabel(axis_label(ds[xkey]))
+    ax.set_ylabel(axis_label(ds[ykey]))
+    if ds.sizes["point"]:
+        ax.legend(loc="best", fontsize="small")
+    else:
+        ax.text(0.5, 0.5, "no stability boundary in the box", transform=ax.transAxes,
+                ha="center", va="center", fontsize="large", alpha=0.6)
+    _title(ax, ds, "exact stability boundary")
+    return fig
+
+
+@_drawing
 def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None) -> Figure:
     """Frequency and growth rate of every eigenvalue branch against the key
     (:func:`fivdisc.analysis.eigenbranches.eigen_branches`).
@@ -619,7 +652,8 @@ def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None) -> Figure:
     ds : xarray.Dataset
         The branches.
     hopf : sequence of HopfPoint, optional
-        Hopf points to mark.
+        Hopf points to mark; by default those stored in `ds` (``hopf``,
+        ``hopf_frequency``: ``fivdisc stability --x`` writes them), if any.
     """
     import matplotlib.pyplot as plt
 
@@ -643,15 +677,20 @@ def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None) -> Figure:
             ax.axvline(value, color="0.4", ls=":", lw=1.0)
         for value in ds["existence_limit"].values:
             ax.axvline(value, color="0.5", lw=2.0)
-    for hp in hopf or []:
-        top.plot(hp.value, hp.frequency, "ko", ms=5)
-        bottom.plot(hp.value, 0.0, "ko", ms=5)
+    if hopf is not None:
+        marks = [(hp.value, hp.frequency) for hp in hopf]
+    else:
+        marks = list(zip(ds["hopf"].values, ds["hopf_frequency"].values, strict=True)
+                     ) if "hopf" in ds else []
+    for value, frequency in marks:
+        top.plot(value, frequency, "ko", ms=5)
+        bottom.plot(value, 0.0, "ko", ms=5)
     bottom.axhline(0.0, color="k", lw=0.5)
     top.set_ylabel("frequency [Hz]")
     bottom.set_ylabel("growth rate [1/s]")
     bottom.set_xlabel(axis_label(ds[key]))
     top.legend(loc="best", fontsize="small", ncols=2)
     _title(top, ds, "eigenvalue branches (thick: unstable)",
-           detail="dotted: mode coupling; dots: Hopf points" if len(ds["coupling"]) or hopf
+           detail="dotted: mode coupling; dots: Hopf points" if len(ds["coupling"]) or marks
            else "")
     return fig
