@@ -180,15 +180,32 @@ def test_existence_limit_where_the_reference_normal_force_vanishes():
     assert np.isnan(ds["growth_rate"].values[-1]).all()
 
 
-def test_branches_match_plain_eigenvalues_at_every_value():
-    case = Case(speed={"value": 1.0})
-    values = np.linspace(0.5, 3.0, 6)
-    ds = eigen_branches(case, "slider.rotational_damping", values)
+@pytest.mark.parametrize(("example", "updates", "key", "values"), [
+    ("default", {"speed.value": 1.0}, "slider.rotational_damping", (0.5, 3.0)),
+    ("two-pads", {}, "sliders.1.preload", (200.0, 800.0)),
+    ("damped-disc", {}, "disc.damping_ratio", (0.0, 0.01)),
+    ("damped-disc", {"disc.damping_frame": "space"}, "speed.value", (1.0, 20.0)),
+    ("stribeck", {"speed.value": 2.0}, "friction.stribeck_velocity", (0.05, 0.5)),
+    ("measured-friction", {"speed": {"profile": "constant", "value": 2.0}}, "speed.value",
+     (0.5, 10.0)),
+])
+def test_branches_match_plain_eigenvalues_at_every_value(example, updates, key, values):
+    """Several sliders, damping in either frame, every friction law, keys the model is
+    patched for and keys it is rebuilt for: at every value the followed equilibrium and
+    eigenvalues equal a plain solve of the case rebuilt there."""
+    from fivdisc.case import load_case
+
+    case = load_case(path(example)).replace(updates)
+    values = np.linspace(*values, 5)
+    ds = eigen_branches(case, key, values)
     lam = ds["growth_rate"].values + 2j * np.pi * ds["frequency"].values
-    for row, v in zip(lam, values, strict=True):
-        plain = linear_stability(case.replace({"slider.rotational_damping": v})).eigenvalues
-        assert np.allclose(np.sort_complex(row), np.sort_complex(plain), rtol=1e-9,
-                           atol=1e-9 * np.abs(plain).max())
+    for i, v in enumerate(values):
+        plain = linear_stability(case.replace({key: v}))
+        # The same Jacobian solved twice: agreement to round-off of the spectral radius.
+        assert np.allclose(np.sort_complex(lam[i]), np.sort_complex(plain.eigenvalues),
+                           rtol=1e-9, atol=1e-9 * np.abs(plain.eigenvalues).max())
+        np.testing.assert_allclose(ds["normal_force"].values[i],
+                                   plain.equilibrium.normal_force, rtol=1e-10)
 
 
 @pytest.mark.parametrize(("key", "values", "match"), [
