@@ -87,3 +87,9 @@ def test_bad_boxes_are_refused():
         stability_boundary(case, (X, (0.0, 1.0)), (X, (0.0, 3.0)))
     with pytest.raises(CaseError, match=r"slider\.rotational_damping = -1"):
         stability_boundary(case, (X, (0.0, 1.0)), (Y, (-1.0, 3.0)))
+
+
+def test_a_box_without_sliding_equilibrium_is_refused():
+    case = load_case(path("fig10"))  # a decelerating disc: no equilibrium
+    with pytest.raises(CaseError, match="no sliding equilibrium"):
+        stability_boundary(case, (X, (0.0, 12.0)), (Y, (0.0, 3.0)))

@@ -203,7 +203,7 @@ def stability_boundary(
     ------
     CaseError
         Non-numeric or repeated keys, an empty range, an end outside a key's allowed
-        values, or too few seeds.
+        values, too few seeds, or no sliding equilibrium at the box's first corner.
     """
     xkey, ykey = x[0], y[0]
     xr_, yr_ = check_values("x", xkey, x[1]), check_values("y", ykey, y[1])
@@ -215,6 +215,7 @@ def stability_boundary(
     check_keys(case, [xkey, ykey], ["x", "y"])
     check_box(case, [(xkey, xr_), (ykey, yr_)])
     points = ParameterPoints(case, [xkey, ykey])
+    points.require_equilibrium((xr_[0], yr_[0]), "--boundary")
     lo = np.array([xr_[0], yr_[0]])
     span = np.array([xr_[1] - xr_[0], yr_[1] - yr_[0]])
     g = _Growth(points, lo, span)

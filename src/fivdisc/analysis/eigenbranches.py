@@ -20,7 +20,6 @@ from fivdisc.analysis.equilibrium import Equilibrium
 from fivdisc.analysis.points import ParameterPoints, check_box, check_keys, check_values
 from fivdisc.analysis.stability import dominant_coordinates
 from fivdisc.case import Case
-from fivdisc.errors import CaseError, SimulationError
 
 # Two branches' frequencies count as merged (a coupling) within this fraction of the
 # frequency: inside a flutter region of an undamped system they are equal, damping
@@ -143,15 +142,7 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
     check_keys(case, [key], [option])
     check_box(case, [(key, values)])
     points = ParameterPoints(case, [key])
-    first = points.model((values[0],))
-    if points.equilibrium(first) is None:
-        from fivdisc.analysis.equilibrium import sliding_equilibrium
-
-        try:
-            sliding_equilibrium(first)
-        except SimulationError as err:
-            raise CaseError(f"{option} = {key}: no sliding equilibrium at its first value "
-                            f"{values[0]:g} ({err})") from None
+    points.require_equilibrium((values[0],), option)
     size, ns = points.size, points.base.n_sliders
     lam = np.full((values.size, size), np.nan + 1j * np.nan)
     force = np.full((values.size, ns), np.nan)
@@ -201,9 +192,11 @@ def _last_valid(lam: np.ndarray, i: int) -> int:
 
 def mode_couplings(lam: np.ndarray, tolerance: float = COUPLING_TOLERANCE
                    ) -> list[tuple[int, int, int]]:
-    """Where pairs of branches couple: ``(index, first, second)`` with `index` the first
-    value at which the two positive frequencies agree within `tolerance` (relative)
-    after disagreeing, and the growth rates part there.
+    """Where pairs of branches couple: ``(index, first, second)`` at each edge of an
+    interval of values where the two positive frequencies agree within `tolerance`
+    (relative) and the growth rates are further apart than just outside it; `index` is
+    the edge's value inside the interval (where the modes merge, and where they part
+    again).
 
     Parameters
     ----------

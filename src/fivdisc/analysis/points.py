@@ -176,6 +176,20 @@ class ParameterPoints:
                 self._cache[key] = None
         return self._cache[key]
 
+    def require_equilibrium(self, values: Sequence[float], option: str) -> None:
+        """Refuse, in one line, a scan whose start has no sliding equilibrium.
+
+        Raises
+        ------
+        CaseError
+            Naming `option`, the point and why (not constant speed, contact lost, ...).
+        """
+        try:
+            sliding_equilibrium(self.model(values))
+        except SimulationError as err:
+            where = ", ".join(f"{k} = {v:g}" for k, v in zip(self.keys, values, strict=True))
+            raise CaseError(f"{option}: no sliding equilibrium at {where} ({err})") from None
+
     def linearise(self, values: Sequence[float], guess: Equilibrium | None = None
                   ) -> tuple[Model, Equilibrium, np.ndarray] | None:
         """Model, equilibrium and slip Jacobian at one point (None: no equilibrium)."""
