@@ -222,3 +222,38 @@ def test_bad_scans_are_refused_before_any_work(key, values, match):
 def test_no_equilibrium_at_the_start_is_refused():
     with pytest.raises(CaseError, match="no sliding equilibrium"):
         eigen_branches(Case(), "speed.value", [915.0, 930.0])
+
+
+def test_hopf_eigenvector_in_the_full_layout_on_a_flexible_disc():
+    """On the paper's disc: the equilibrium state is a rest point of the slip equations,
+    the eigenvector solves J v = lambda v on every free row of the full Jacobian, and its
+    z rows are the change of the disc's w under the slider (from the plate's mode shapes,
+    independent of the kernel)."""
+    from fivdisc._kernels import dynamics as dyn
+    from fivdisc.analysis.equilibrium import slip_phases
+    from fivdisc.case import load_case
+
+    case = load_case(path("fig03a"))
+    hp = hopf_points(case, "slider.rotational_damping", np.linspace(0.0, 3.0, 16))[0]
+    model = build_model(hp.case)
+    ph, sg = slip_phases(model)
+    jac = dyn.complex_step_jacobian(0.0, hp.state, ph, sg, model.kernel_args)
+    n, free = model.n, np.r_[0 : model.n + 1, model.n + 2 : 2 * model.n + 3]
+    residual = jac[np.ix_(free, free)] @ hp.eigenvector[free] - hp.eigenvalue * hp.eigenvector[free]
+    # Complex-step Jacobian exact to round-off: residual ~ eps |J| |v|.
+    assert np.linalg.norm(residual) < 1e-9 * abs(hp.eigenvalue)
+    slider = hp.case.sliders[0]
+    theta = slider.angle
+
+    def w(y):
+        shape = model.shape_matrix([slider.track_radius], [theta + y[n]])[0]
+        return float(shape @ y[:n])
+
+    z = model.index("z")
+    assert hp.state[z] == pytest.approx(w(hp.state), rel=1e-12)
+    for part in (hp.eigenvector.real, hp.eigenvector.imag):
+        # Steps of 1e-7 (m, rad) on a static deflection of ~1e-3 m: round-off ~1e-12 and
+        # truncation ~(l * 1e-7)^2 of the change; measured agreement ~1e-7 relative.
+        h = 1e-7 / np.abs(part[: n + 1]).max()
+        change = (w(hp.state + h * part) - w(hp.state - h * part)) / (2 * h)
+        assert part[z] == pytest.approx(change, rel=1e-6)

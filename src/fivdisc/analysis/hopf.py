@@ -146,7 +146,8 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, lam_lo: com
     state, vector = _full_layout(model, eq, vec[:, pick])
     return HopfPoint(
         key=key, value=root, omega=float(lam[pick].imag),
-        direction=1 if lam_hi.real > lam_lo.real else -1, rate=float(rate),
+        direction=1 if (lam_hi.real - lam_lo.real) / (hi - lo) > 0.0 else -1,
+        rate=float(rate),
         eigenvalue=complex(lam[pick]), state=state, eigenvector=vector,
         mode=dominant_coordinates(model, vec[:, [pick]])[0],
         on_boundary=bool(np.all(others < 0.0)), equilibrium=eq,
