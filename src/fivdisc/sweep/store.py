@@ -306,7 +306,11 @@ def _read_attrs(path: Path) -> dict[str, Any]:
             f"{path} has damaged metadata ({path / 'zarr.json'}: {_brief(exc)}); {rerun}"
         ) from None
     if "sweep_hash" not in attrs and attrs.get("fivdisc_kind") != "sweep":
-        raise SweepError(f"{path} exists and is not a fivdisc sweep store")
+        if not all((path / name / "zarr.json").is_file() for name in ("done", "checksum")):
+            raise SweepError(f"{path} exists and is not a fivdisc sweep store")
+        raise _DamagedGroup(  # a sweep store's arrays, its group's attributes lost
+            f"{path} has damaged metadata ({path / 'zarr.json'}: no sweep attributes); {rerun}"
+        )
     if attrs.get("store_format") not in _READABLE_FORMATS:
         raise SweepError(
             f"{path} was written by another version of fivdisc (store format "
