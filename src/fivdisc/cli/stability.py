@@ -38,7 +38,7 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
     from fivdisc.analysis.stability import linear_stability, parse_range, stability_map
     from fivdisc.case import Case, load_case
     from fivdisc.extras import require
-    from fivdisc.files import check_output, figure_suffixes, write_atomic
+    from fivdisc.files import check_output, figure_suffixes, write_atomic, write_netcdf
 
     case = load_case(case_file) if case_file else Case()
     if x_spec is None and y_spec is None:
@@ -77,7 +77,7 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
     if case_file is not None:
         ds.attrs["case_name"] = case_file.stem
     if not figure:
-        write_atomic(out, ds.to_netcdf)
+        write_netcdf(out, ds.to_netcdf)
     else:
         from fivdisc.plots import plot_stability_map
 
