@@ -1040,7 +1040,7 @@ def open_sweep(path: str | PathLike[str]) -> xr.Dataset:
     data = xr.open_zarr(path, consolidated=False, chunks=None)
     layout = _layout(attrs)
     arrays, _ = _arrays(path, layout)
-    for name in list(data.data_vars):
+    for name in [n for n in data.data_vars if n in arrays]:
         values, _ = _readable(arrays[name], layout.grid)
         data[name] = data[name].copy(data=values.reshape(layout.arrays[name][0]))
     data = data.load()
