@@ -178,7 +178,7 @@ class _LocalPool:
     def abort(self) -> None:
         # ProcessPoolExecutor has no public way (before Python 3.14) to stop tasks that
         # are running; terminate its processes so an interrupted sweep exits at once.
-        processes = list(getattr(self._pool, "_processes", {}).values())
+        processes = list((getattr(self._pool, "_processes", None) or {}).values())
         self._pool.shutdown(wait=False, cancel_futures=True)
         for process in processes:
             process.terminate()
