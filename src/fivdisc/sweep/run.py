@@ -3,7 +3,9 @@
 Workers only compute; the coordinating process (the one calling :func:`run_sweep`)
 writes every result to the store, so the store has a single writer. Points already
 complete in the store are skipped, which makes an interrupted sweep resumable by
-running it again.
+running it again. A point whose local worker process dies (``os._exit``, a signal) is
+run again alone once the pool is restarted; if its worker dies again, the point is
+stored as failed with how the worker died, and the sweep goes on.
 """
 
 from __future__ import annotations
