@@ -142,27 +142,34 @@ def test_damaged_variables_are_reported_and_rebuilt(store: Path, damage: str, na
     result = CliRunner().invoke(cli, ["sweep", "--verify", str(store)])
     assert result.exit_code == 1 and name in result.stdout
 
-    # Resuming rebuilds the variable; only the points whose values it held are lost.
+    # Resuming rebuilds the variable's metadata; only the points whose values a deleted
+    # variable held are lost (a truncated zarr.json leaves the chunk files).
     with store_lock(store):
         SweepStore.open(store, SPEC)
     health = verify_store(store)
     assert health.broken == ()
     lost = {"max_normal_force": _mask(*range(N)) & ~_mask(FAILED),  # NaN is the fill value
             "checksum": _mask(*range(N)), "done": _mask(*range(N))}.get(name, _mask())
+    lost = lost if damage == "delete" else _mask()
     np.testing.assert_array_equal(health.complete, ~lost)
     _store(store, np.flatnonzero(lost))
     xr.testing.assert_identical(open_sweep(store), reference)
 
 
-def test_damaged_group_metadata_is_one_line(store: Path) -> None:
+def test_damaged_group_metadata_is_one_line_and_rebuilt_by_a_rerun(store: Path) -> None:
     meta = store / "zarr.json"
     meta.write_bytes(meta.read_bytes()[:100])
-    for call in (verify_store, open_sweep, read_mask,
-                 lambda p: run_sweep(SPEC, p, workers=1, progress=False)):
+    for call in (verify_store, open_sweep, read_mask):
         with pytest.raises(SweepError, match=r"s.zarr has damaged metadata \(.*zarr.json: .*\); "
-                                             r"delete the store to start over$") as info:
+                                             r"rerun the sweep that wrote it to rebuild it from "
+                                             r"the sweep file, or delete the store to start "
+                                             r"over$") as info:
             call(store)
         assert "\n" not in str(info.value)
+    # Every chunk is intact: the rerun rebuilds the group from the sweep, computes nothing.
+    report = run_sweep(SPEC, store, workers=1, progress=False)
+    assert (report.already_done, report.computed) == (N, 0)
+    assert verify_store(store).healthy
 
 
 def test_a_store_of_an_older_format_is_refused(store: Path) -> None:
@@ -216,12 +223,21 @@ def test_the_lock_holds_across_processes_and_ends_with_its_holder(tmp_path: Path
         assert json.loads((tmp_path / "s.zarr.lock.owner").read_text())["pid"] == os.getpid()
 
 
-def test_stale_temporary_stores_are_removed(tmp_path: Path) -> None:
-    stale = tmp_path / "s.zarr.tmp-999999"
-    (stale / "done").mkdir(parents=True)
-    (stale / "zarr.json").write_text("{")
+def test_only_the_temporary_store_a_dead_coordinator_recorded_is_removed(tmp_path: Path
+                                                                         ) -> None:
+    # A coordinator killed while creating the store left its record and temporary store.
+    dead = tmp_path / "s.zarr.tmp-fivdisc-999999"
+    (dead / "done").mkdir(parents=True)
+    (tmp_path / "s.zarr.lock.owner").write_text(json.dumps(
+        {"pid": 999999, "host": "h", "since": "then", "command": "fivdisc sweep",
+         "temporary": dead.name}))
+    # The user's own files of similar names are not the program's.
+    for name in ("s.zarr.tmp-backup", "s.zarr.tmp-123", "s.zarr.tmp-fivdisc-5"):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "keep").write_text("mine")
     _store(tmp_path / "s.zarr")
-    assert sorted(p.name for p in tmp_path.iterdir() if "tmp" in p.name) == []
+    assert sorted(p.name for p in tmp_path.iterdir() if "tmp" in p.name) == [
+        "s.zarr.tmp-123", "s.zarr.tmp-backup", "s.zarr.tmp-fivdisc-5"]
     assert verify_store(tmp_path / "s.zarr").complete.all()
 
 

@@ -5,22 +5,46 @@ one of the command's input files, its directory must exist and be writable, and 
 suffix must be one the command knows how to write. Files are then written under a
 temporary name in the same directory and renamed into place (:func:`write_atomic`), so an
 interrupted or failed write leaves the previous file, or nothing, never half a file.
+
+Every netCDF file fivdisc writes goes through :func:`write_netcdf`, which stores a
+checksum of the data in the file (:func:`netcdf_checksum`, as the attribute
+``fivdisc_checksum``); :func:`check_netcdf` compares it when the file is read or reused.
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
-from collections.abc import Callable, Iterable
+import shutil
+from collections.abc import Callable, Iterable, Iterator
 from os import PathLike
 from pathlib import Path
 from typing import Any, Literal
 
 from fivdisc.errors import FivdiscError
 
-__all__ = ["NETCDF", "ZARR", "check_output", "figure_suffixes", "read_text", "write_atomic"]
+__all__ = [
+    "CHECKSUM",
+    "NETCDF",
+    "ZARR",
+    "OutputError",
+    "check_netcdf",
+    "check_output",
+    "figure_suffixes",
+    "netcdf_checksum",
+    "read_text",
+    "write_atomic",
+    "write_netcdf",
+]
 
 NETCDF = (".nc",)
 ZARR = (".zarr",)
+#: Global attribute of a netCDF file of fivdisc holding :func:`netcdf_checksum`.
+CHECKSUM = "fivdisc_checksum"
+
+
+class OutputError(FivdiscError):
+    """An output could not be written (a full disk, a file size limit, an I/O error)."""
 
 
 def figure_suffixes() -> tuple[str, ...]:
@@ -148,17 +172,146 @@ def write_atomic(path: str | PathLike[str], write: Callable[[Path], Any]) -> Non
         tmp.unlink(missing_ok=True)
 
 
-def read_dataset(path: str | PathLike[str], option: str):
-    """The whole netCDF file at `path` as an :class:`xarray.Dataset`, loaded and closed.
+def _groups(group: Any) -> Iterator[Any]:
+    """A netCDF group and all its subgroups, in a fixed order."""
+    yield group
+    for name in sorted(group.groups):
+        yield from _groups(group.groups[name])
+
+
+def _token(value: Any) -> bytes:
+    """The bytes of an attribute or variable value, with its type and shape."""
+    import numpy as np
+
+    if isinstance(value, str):
+        return b"s" + value.encode()
+    array = np.asarray(value)
+    if array.dtype.kind in "OUS":  # text: one item at a time, each with its length
+        items = [str(v).encode() for v in array.ravel()]
+        body = b"".join(len(i).to_bytes(8, "little") + i for i in items)
+        return f"t{array.shape}".encode() + body
+    return f"{array.dtype.str}{array.shape}".encode() + np.ascontiguousarray(array).tobytes()
+
+
+def netcdf_checksum(path: str | PathLike[str]) -> str:
+    """SHA-256 (hex) of what a netCDF file stores: every group's attributes and variables
+    (name, type, shape, stored values, attributes), except the attribute holding the
+    checksum itself.
+
+    Values are hashed as stored (no scaling, masking or decoding), so that the checksum
+    does not depend on how a reader decodes them.
+
+    Raises
+    ------
+    OSError, RuntimeError
+        The file cannot be read (netCDF4 raises RuntimeError for damaged HDF5 data).
+    """
+    import netCDF4
+
+    digest = hashlib.sha256()
+
+    def update(name: str, value: Any) -> None:
+        token = _token(value)
+        digest.update(len(name).to_bytes(8, "little") + name.encode())
+        digest.update(len(token).to_bytes(8, "little") + token)
+
+    with netCDF4.Dataset(path) as root:
+        for group in _groups(root):
+            update("group", group.path)
+            for name in sorted(group.ncattrs()):
+                if not (group is root and name == CHECKSUM):
+                    update(f"attribute {name}", group.getncattr(name))
+            for name in sorted(group.variables):
+                var = group.variables[name]
+                var.set_auto_maskandscale(False)
+                var.set_auto_chartostring(False)
+                update(f"variable {name}", var[...])
+                for key in sorted(var.ncattrs()):
+                    update(f"attribute {name}.{key}", var.getncattr(key))
+    return digest.hexdigest()
+
+
+def check_netcdf(path: str | PathLike[str]) -> bool:
+    """Check a netCDF file of fivdisc against the checksum stored in it.
+
+    Returns
+    -------
+    bool
+        True if the file holds a checksum and its data match it; False if it holds none
+        (a file of another program, or of a fivdisc before checksums).
 
     Raises
     ------
     FivdiscError
-        The file cannot be read as netCDF (the message names `option` and the file).
+        The data do not match the checksum, or cannot be read; one line naming the file.
+    """
+    import netCDF4
+
+    path = Path(path)
+    try:
+        with netCDF4.Dataset(path) as root:
+            stored = root.getncattr(CHECKSUM) if CHECKSUM in root.ncattrs() else None
+        if stored is None:
+            return False
+        actual = netcdf_checksum(path)
+    except (OSError, RuntimeError, ValueError) as exc:
+        raise FivdiscError(f"{path} is damaged: it cannot be read ({' '.join(str(exc).split())})"
+                           "; write it again") from None
+    if actual != stored:
+        raise FivdiscError(f"{path} is damaged: its data do not match the checksum stored in "
+                           f"it ({CHECKSUM}); write it again")
+    return True
+
+
+def write_netcdf(path: str | PathLike[str], write: Callable[[Path], Any]) -> None:
+    """Write a netCDF file through ``write(temporary_path)`` (e.g. ``dataset.to_netcdf``),
+    store its checksum in it (see :func:`netcdf_checksum`) and rename it to `path`; see
+    :func:`write_atomic`.
+
+    Raises
+    ------
+    OutputError
+        The file could not be written (a full disk, a file size limit, an I/O error: the
+        netCDF library reports them as ``NetCDF: HDF error``); one line with the reason
+        and the space left. `path` is left as it was.
+    """
+    import netCDF4
+
+    def stamped(tmp: Path) -> None:
+        write(tmp)
+        digest = netcdf_checksum(tmp)
+        with netCDF4.Dataset(tmp, "a") as root:
+            root.setncattr(CHECKSUM, digest)
+
+    path = Path(path)
+    try:
+        write_atomic(path, stamped)
+    except (OSError, RuntimeError) as exc:
+        if isinstance(exc, RuntimeError) and not str(exc).startswith("NetCDF"):
+            raise
+        reason = (exc.strerror if isinstance(exc, OSError) and exc.strerror
+                  else " ".join(str(exc).split()))
+        try:
+            free = f"; {shutil.disk_usage(path.parent).free / 1e6:.3g} MB free there"
+        except OSError:
+            free = ""
+        raise OutputError(f"cannot write {path}: {reason}{free}") from exc
+
+
+def read_dataset(path: str | PathLike[str], option: str):
+    """The whole netCDF file at `path` as an :class:`xarray.Dataset`, loaded and closed,
+    after checking it against its checksum (:func:`check_netcdf`).
+
+    Raises
+    ------
+    FivdiscError
+        The file cannot be read as netCDF, or is damaged (the message names `option` and
+        the file).
     """
     import xarray as xr
 
     try:
+        check_netcdf(path)
         with xr.open_dataset(path) as ds:
             return ds.load()
     except (OSError, ValueError) as exc:

@@ -454,11 +454,17 @@ class Result:
         return plot_kind(self.dataset, kind, **options)
 
     def to_netcdf(self, path: str | PathLike[str]) -> None:
-        """Write the dataset to a netCDF file atomically (a temporary file is renamed);
-        :func:`open_result` reads it back."""
-        from fivdisc.files import write_atomic
+        """Write the dataset to a netCDF file atomically (a temporary file is renamed), with
+        a checksum of its data; :func:`open_result` reads it back and checks it.
 
-        write_atomic(path, self.dataset.to_netcdf)
+        Raises
+        ------
+        fivdisc.files.OutputError
+            The file could not be written (e.g. a full disk); `path` is left as it was.
+        """
+        from fivdisc.files import write_netcdf
+
+        write_netcdf(path, self.dataset.to_netcdf)
 
 
 def open_result(path: str | PathLike[str], run: str | None = None) -> Result:
@@ -482,8 +488,9 @@ def open_result(path: str | PathLike[str], run: str | None = None) -> Result:
     Raises
     ------
     FivdiscError
-        The file is not a fivdisc result, or `run` is missing or not one of its runs;
-        one line naming the file and what it holds.
+        The file is not a fivdisc result, its data do not match the checksum stored in it
+        (see :func:`fivdisc.files.check_netcdf`), or `run` is missing or not one of its
+        runs; one line naming the file and what it holds.
     FileNotFoundError
         The file does not exist.
     """
@@ -502,12 +509,18 @@ def open_result(path: str | PathLike[str], run: str | None = None) -> Result:
             raise FivdiscError(f"run = {run!r} is invalid: {path} holds one run; leave run out")
         import xarray as xr
 
+        from fivdisc.files import CHECKSUM, check_netcdf
+
+        check_netcdf(path)
         with xr.open_dataset(path, group=run) as stored:
             ds = stored.load()
+        ds.attrs.pop(CHECKSUM, None)  # the file's, not the run's
     except (OSError, ValueError) as exc:
         raise FivdiscError(f"cannot read {path} as a fivdisc result: {exc}") from None
     kind = ds.attrs.get("fivdisc_kind", "simulation")
-    if kind != "simulation" or "time" not in ds.coords or ds.sizes["time"] < 2:
+    # One sample is a run: a run of less than one output interval, or one that failed at
+    # its start.
+    if kind != "simulation" or "time" not in ds.coords or ds.sizes["time"] < 1:
         what = {"stability_map": "a stability map (fivdisc stability)",
                 "separation_map": "a separation map"}.get(kind, "not a simulation result")
         raise FivdiscError(f"{path}{f' (run {run})' if run else ''} is {what}: read it with "

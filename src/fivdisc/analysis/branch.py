@@ -220,10 +220,11 @@ class Branch:
         return cls(ds)
 
     def to_netcdf(self, path: str | PathLike[str]) -> None:
-        """Write the branch to netCDF (written under a temporary name, then renamed)."""
-        from fivdisc.files import write_atomic
+        """Write the branch to netCDF, with a checksum of its data (written under a
+        temporary name, then renamed)."""
+        from fivdisc.files import write_netcdf
 
-        write_atomic(path, self.dataset.to_netcdf)
+        write_netcdf(path, self.dataset.to_netcdf)
 
     # --- showing ------------------------------------------------------------------------
 

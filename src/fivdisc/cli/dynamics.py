@@ -15,13 +15,13 @@ _NC = click.Path(dir_okay=False, path_type=Path)
 
 def _report(res, case, as_json: bool, out: Path | None) -> None:
     """Print a result (text or JSON) and write it, with its case, to netCDF if asked."""
-    from fivdisc.files import write_atomic
+    from fivdisc.files import write_netcdf
 
     click.echo(res.to_json() if as_json else str(res))
     if out is not None:
         ds = res.to_dataset()
         ds.attrs["case"] = case.to_toml()
-        write_atomic(out, ds.to_netcdf)
+        write_netcdf(out, ds.to_netcdf)
 
 
 @click.command()

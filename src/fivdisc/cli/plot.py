@@ -123,7 +123,7 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
     import xarray as xr
 
     from fivdisc import plots
-    from fivdisc.files import check_output, figure_suffixes, read_dataset
+    from fivdisc.files import check_netcdf, check_output, figure_suffixes, read_dataset
     from fivdisc.result import open_result, run_groups
 
     out = check_output(output or result.with_name(f"{result.stem}-{kind}.png"), "-o",
@@ -155,6 +155,7 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
                                           ("--segment", segment)) if value is not None]
         if given:
             raise FivdiscError(f"{given[0]} is not used for {result}: it is a map, drawn whole")
+        check_netcdf(result)
         with xr.open_dataset(result, group=run) as stored:
             fig = _map(stored.load(), result)
     else:
@@ -169,6 +170,12 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
         if fmax is not None and kind not in ("spectrogram", "spectrum"):
             raise FivdiscError(f"--fmax is not used by --kind {kind}: only by spectrogram and "
                                "spectrum")
+        if one.sizes["time"] < 2:  # read back (open_result), but nothing to draw
+            raise FivdiscError(
+                f"--kind {kind} needs at least 2 samples: {result} holds one (a run shorter "
+                "than its output interval, or one that failed at its start); read it with "
+                "fivdisc.open_result, or simulate longer or with a higher "
+                "simulation.output_rate")
         plots.check_fmax(fmax, 0.5 * (one.sizes["time"] - 1)
                          / float(one["time"].values[-1] - one["time"].values[0]), "--fmax")
         if segment is not None and kind != "spectrogram":

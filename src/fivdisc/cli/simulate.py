@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -24,7 +25,9 @@ def simulate(case_file: Path, output: Path | None, progress: bool) -> None:
     e.g. ``fivdisc simulate fig10 -o fig10.nc``.
 
     A failed run (non-finite state, step-size underflow, endless switching) still
-    writes what was computed, marked as failed, and exits with status 1.
+    writes what was computed, marked as failed, and exits with status 1. If the output
+    cannot be written (a full disk), the run is written to the system's temporary
+    directory instead, where that is possible, and the one-line error names both.
     """
     from fivdisc.case import load_case
     from fivdisc.files import NETCDF, check_output
@@ -37,10 +40,32 @@ def simulate(case_file: Path, output: Path | None, progress: bool) -> None:
     imported = warm_up("xarray", "netcdf")
     result = run(case, progress=progress).named(case_file.stem)
     imported()
-    result.to_netcdf(out)
+    _save(result, out)
     click.echo(f"wrote {out}")
     for line in result.summary().lines()[1:]:
         click.echo(line)
     if not result.ok:
         click.echo(f"error: simulation failed: {result.message}", err=True)
         sys.exit(1)
+
+
+def _save(result, out: Path) -> None:
+    """Write `result` to `out`; if that fails (e.g. a full disk), keep the computed run in
+    the temporary directory if it fits there, and end with one line saying where."""
+    import tempfile
+
+    from fivdisc.files import OutputError
+
+    try:
+        result.to_netcdf(out)
+    except OutputError as exc:
+        kept = Path(tempfile.gettempdir()) / f"fivdisc-{out.stem}-{os.getpid()}.nc"
+        if kept.parent.resolve() == out.parent.resolve():
+            raise OutputError(f"{exc}; the run is lost: free space and run again") from None
+        try:
+            result.to_netcdf(kept)
+        except OutputError:
+            raise OutputError(f"{exc}; the run is lost (it could not be written to {kept} "
+                              "either): free space and run again") from None
+        raise OutputError(f"{exc}; the run is kept in {kept}: move it to {out} when space "
+                          "is freed") from None

@@ -88,10 +88,10 @@ def _target(case_file: Path | None, output: Path | None, default: str) -> tuple[
 
 
 def _write(out: Path, figure, ds) -> None:
-    from fivdisc.files import write_atomic
+    from fivdisc.files import write_atomic, write_netcdf
 
     if figure is None:
-        write_atomic(out, ds.to_netcdf)
+        write_netcdf(out, ds.to_netcdf)
     else:
         write_atomic(out, lambda path: figure.savefig(path, dpi=150))
     click.echo(f"wrote {out}")

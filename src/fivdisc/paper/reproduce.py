@@ -4,7 +4,8 @@
 data behind it, see :func:`fivdisc.paper.figures.compute`), then ``REPORT.md`` and
 a self-contained ``REPORT.html``. Files are written to a temporary name and renamed,
 so an interrupted run leaves no half-written file. A figure whose PNG and netCDF
-exist and whose stored parameters equal the current ones is reused, so a rerun
+exist, whose data match the checksum stored in the netCDF file and whose stored
+parameters equal the current ones is reused, so a rerun
 after an interruption (or with more figures) only computes what is missing.
 
 Figures that show the same simulations (8 and 9, 10 and 11, ...) are computed
@@ -30,7 +31,7 @@ import xarray as xr
 
 from fivdisc.compilation import warm_kernel
 from fivdisc.errors import FivdiscError
-from fivdisc.files import write_atomic
+from fivdisc.files import check_netcdf, write_atomic, write_netcdf
 from fivdisc.paper.cases import CITATION, FIGURES
 from fivdisc.paper.figures import RECIPE, Row, Runs, compute, plot, rows
 from fivdisc.paper.report import figure_blocks, render_html, render_markdown, summary_blocks
@@ -207,7 +208,7 @@ def _make(numbers: list[int], outdir: str, runs: Runs | None = None) -> dict[int
         seconds[number] = time.perf_counter() - start
         data.attrs["seconds"] = seconds[number]
         data.attrs["fivdisc_version"] = version("fivdisc")
-        write_atomic(out / f"{stem}.nc", lambda p, d=data: d.to_netcdf(p, encoding=_encoding(d)))
+        write_netcdf(out / f"{stem}.nc", lambda p, d=data: d.to_netcdf(p, encoding=_encoding(d)))
     return seconds
 
 
@@ -231,13 +232,16 @@ def _encoding(data: xr.DataTree) -> dict[str, dict]:
 
 
 def _stored_attrs(path: Path) -> dict | None:
-    """Attributes of a stored figure dataset; None if it is missing or unreadable."""
+    """Attributes of a stored figure dataset; None if it is missing, unreadable, without a
+    checksum or not matching it (its figure is then computed again)."""
     if not path.exists():
         return None
     try:
+        if not check_netcdf(path):
+            return None
         with xr.open_dataset(path) as data:
             return dict(data.attrs)
-    except (OSError, ValueError):
+    except (OSError, ValueError, FivdiscError):
         return None
 
 

@@ -3,7 +3,9 @@
 Workers only compute; the coordinating process (the one calling :func:`run_sweep`)
 writes every result to the store, so the store has a single writer. Points already
 complete in the store are skipped, which makes an interrupted sweep resumable by
-running it again.
+running it again. A point whose local worker process dies (``os._exit``, a signal) is
+run again alone once the pool is restarted; if its worker dies again, the point is
+stored as failed with how the worker died, and the sweep goes on.
 """
 
 from __future__ import annotations
@@ -107,19 +109,49 @@ def _init_local_worker(parent: int) -> None:
     warm_kernel()
 
 
+class _WorkerDied(Exception):
+    """A local worker process died (``os._exit``, a signal) while computing a point; the
+    message says how."""
+
+
+def _how_it_died(codes: Iterable[int | None]) -> str:
+    """How a pool's worker died, from its processes' exit codes: the pool terminates the
+    others (SIGTERM) once one has died."""
+    dead = [c for c in codes if c not in (None, 0)]
+    own = [c for c in dead if c != -signal.SIGTERM] or dead
+    if not own:
+        return "no exit status known"
+    code = own[0]
+    if code < 0:
+        try:
+            return f"killed by signal {signal.Signals(-code).name}"
+        except ValueError:
+            return f"killed by signal {-code}"
+    return f"exit status {code}"
+
+
 class _LocalPool:
-    """A ProcessPoolExecutor whose workers are warmed and die with the coordinator."""
+    """A ProcessPoolExecutor whose workers are warmed and die with the coordinator; it
+    can be started again after a worker died."""
 
     def __init__(self, workers: int) -> None:
         self.workers = workers
+        self._pool = self._start()
+
+    def _start(self) -> ProcessPoolExecutor:
         # spawn, not fork: the coordinator runs threads (tqdm, zarr's I/O loop) that a
         # forked child would inherit in an arbitrary state.
-        self._pool = ProcessPoolExecutor(
-            max_workers=workers,
+        return ProcessPoolExecutor(
+            max_workers=self.workers,
             mp_context=get_context("spawn"),
             initializer=_init_local_worker,
             initargs=(os.getpid(),),
         )
+
+    def restart(self) -> None:
+        """A new pool in place of one broken by a dead worker."""
+        self._pool.shutdown(wait=True, cancel_futures=True)
+        self._pool = self._start()
 
     def submit(self, index: int, case: Case, *work: Any) -> Any:
         return self._pool.submit(run_point, index, case, *work)
@@ -127,15 +159,18 @@ class _LocalPool:
     def wait(self, futures: Iterable[Any], timeout: float | None) -> set[Any]:
         return wait_local(futures, timeout=timeout, return_when=FIRST_COMPLETED).done
 
+    def wait_all(self, futures: Iterable[Any]) -> set[Any]:
+        return wait_local(futures).done
+
     def outcome(self, future: Any, index: int) -> PointOutcome:
         exc = future.exception()
         if exc is None:
             return future.result()
         if isinstance(exc, BrokenProcessPool):
-            raise FivdiscError(
-                f"a worker process died while computing point {index} ({exc}); "
-                "rerun the same command to resume"
-            )
+            # The exit codes are known once the broken pool has joined its processes.
+            processes = list((getattr(self._pool, "_processes", None) or {}).values())
+            self._pool.shutdown(wait=True)
+            raise _WorkerDied(_how_it_died(p.exitcode for p in processes))
         # run_point catches everything, so this is e.g. a result that failed to pickle
         return PointOutcome(index, None, f"{type(exc).__name__}: {exc}")
 
@@ -145,7 +180,7 @@ class _LocalPool:
     def abort(self) -> None:
         # ProcessPoolExecutor has no public way (before Python 3.14) to stop tasks that
         # are running; terminate its processes so an interrupted sweep exits at once.
-        processes = list(getattr(self._pool, "_processes", {}).values())
+        processes = list((getattr(self._pool, "_processes", None) or {}).values())
         self._pool.shutdown(wait=False, cancel_futures=True)
         for process in processes:
             process.terminate()
@@ -367,6 +402,10 @@ def _drive(
     ahead = _AHEAD_PER_WORKER * pool.workers
     running: dict[Any, int] = {}
     unstored: list[PointOutcome] = []
+    # Points that were running when a local worker died: each is run again alone, and
+    # stored as failed if its worker dies again.
+    suspects: deque[int] = deque()
+    alone: int | None = None
     last_write = time.monotonic()
     with tqdm(
         total=sweep.n_points,
@@ -385,15 +424,41 @@ def _drive(
             bar.update(len(unstored))
             unstored, last_write = [], time.monotonic()
 
+        def collect(finished: Iterable[Any]) -> str | None:
+            """Outcomes of `finished` into `unstored`; how a worker died, if one did."""
+            nonlocal alone
+            died = None
+            for future in finished:
+                index = running.pop(future)
+                try:
+                    unstored.append(pool.outcome(future, index))
+                except _WorkerDied as death:
+                    died = str(death)
+                    if index == alone:
+                        unstored.append(PointOutcome(index, None, (
+                            f"the worker process died while computing this point ({died}), "
+                            "also when it was run again alone")))
+                    else:
+                        suspects.append(index)
+                if index == alone:
+                    alone = None
+            return died
+
         bar.set_postfix(failed=len(failed))
         try:
-            while todo or running:
-                while todo and len(running) < ahead:
+            while todo or running or suspects:
+                if suspects and not running:
+                    alone = suspects.popleft()
+                    running[pool.submit(alone, sweep.cases[alone], *work)] = alone
+                while todo and not suspects and alone is None and len(running) < ahead:
                     index = todo.popleft()
                     running[pool.submit(index, sweep.cases[index], *work)] = index
                 due = last_write + _WRITE_INTERVAL - time.monotonic()
                 finished = pool.wait(running, max(due, 0.0) if unstored else None)
-                unstored += [pool.outcome(f, running.pop(f)) for f in finished]
+                if collect(finished) is not None:
+                    # The whole pool is broken: every running point fails the same way.
+                    collect(pool.wait_all(running))
+                    pool.restart()
                 if unstored and (time.monotonic() - last_write >= _WRITE_INTERVAL or not running):
                     write_unstored()
         except BaseException:

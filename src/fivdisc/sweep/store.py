@@ -34,12 +34,21 @@ Zarr reads a lost chunk file as the fill value, so without the checksum a delete
 would pass for data.
 
 One coordinator writes a store at a time: :func:`store_lock` holds a lock file next
-to the store (``STORE.lock``, through ``filelock``) and records its holder in
-``STORE.lock.owner``. A store is created complete (metadata and coordinates) under a
-temporary name and renamed into place; temporary stores left by a killed coordinator
-are removed by the next. A variable whose metadata is lost or damaged is rebuilt empty
-when the sweep is resumed, and its points recomputed. fivdisc itself reads every
-variable's own metadata, never the consolidated copy, so that damage is seen.
+to the store (``STORE.lock``, next to where a symbolic link leads, through ``filelock``)
+and records its holder in ``STORE.lock.owner``. A store is created complete (metadata
+and coordinates) under a temporary name (recorded in ``STORE.lock.owner``) and renamed
+into place; the next coordinator removes the temporary store of a killed one, and no
+other file.
+
+Everything about the layout (shape, variables, their types and chunks, the coordinates'
+values, the group attributes that describe them) is derived from the sweep definition,
+itself checked against its SHA-256 (``sweep_hash``, which every point's checksum covers):
+:func:`verify_store` reports any difference. Resuming the sweep restores from the sweep
+what differs: the group's metadata (if the store's coordinates and flags are the
+sweep's), the metadata of an array (its chunk files are kept, and the points whose values
+no longer read back to their checksums are recomputed), or a coordinate's values. fivdisc
+itself reads every variable's own metadata, never the consolidated copy, so that damage
+is seen.
 """
 
 from __future__ import annotations
@@ -54,7 +63,7 @@ import socket
 import struct
 import sys
 import warnings
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from importlib.metadata import version
@@ -66,8 +75,8 @@ import numpy as np
 import xarray as xr
 
 from fivdisc.files import write_atomic
-from fivdisc.sweep.reductions import SweepError
-from fivdisc.sweep.spec import Sweep
+from fivdisc.sweep.reductions import BUILTIN, SweepError
+from fivdisc.sweep.spec import Sweep, strides_of
 
 __all__ = [
     "PointOutcome",
@@ -123,6 +132,11 @@ def _open_group(path: Path) -> Any:
     return _require_zarr().open_group(path, mode="r", use_consolidated=False)
 
 
+def _open_array(path: Path, name: str) -> Any:
+    """One array of the store, from its own metadata (readable when the group's is not)."""
+    return _require_zarr().open_array(path / name, mode="r", zarr_format=3)
+
+
 def _consolidate(path: Path) -> None:
     """Write the consolidated metadata that lets ``xarray.open_zarr`` open the store at once.
 
@@ -175,7 +189,10 @@ def _template(sweep: Sweep) -> xr.Dataset:
     from fivdisc.conventions import global_attrs, key_attrs
 
     dims, shape = dims_of(sweep), sweep.shape
-    chunks = (1,) * len(shape)
+    # One dask chunk per variable: only metadata is written (compute=False), and a graph
+    # of one task per point costs seconds per 10,000 points; Zarr's chunks of one point
+    # are set by _encoding.
+    chunks = shape
     data = {
         r.name: (
             dims,
@@ -187,7 +204,7 @@ def _template(sweep: Sweep) -> xr.Dataset:
     for s in sweep.sections:
         data[s.name] = (
             (*dims, s.dim),
-            da.full((*shape, s.max_points), np.nan, chunks=(*chunks, s.max_points)),
+            da.full((*shape, s.max_points), np.nan, chunks=(*shape, s.max_points)),
             s.attrs(),
         )
         data[s.count_name] = (dims, da.zeros(shape, dtype=np.int32, chunks=chunks),
@@ -265,27 +282,47 @@ def _checksum(digest: str, index: int, row: Sequence[Any]) -> int:
     return int.from_bytes(h.digest(), "little") or 1
 
 
+class _DamagedGroup(SweepError):
+    """The group's own metadata (``STORE/zarr.json``) is unreadable or its sweep definition
+    does not match its hash; a rerun of the sweep rebuilds it."""
+
+
 def _read_attrs(path: Path) -> dict[str, Any]:
-    """The group attributes of a sweep store; SweepError if `path` is not one."""
+    """The group attributes of a sweep store; SweepError if `path` is not one.
+
+    The sweep definition is checked against its SHA-256: everything else about the
+    store's layout is derived from it (see :func:`_layout`)."""
     _require_zarr()
     if not path.is_dir():
         raise SweepError(f"{path} is not a sweep store: no such directory")
     if not (path / "zarr.json").is_file():
         raise SweepError(f"{path} exists and is not a Zarr store (it has no zarr.json)")
+    rerun = ("rerun the sweep that wrote it to rebuild it from the sweep file, or delete "
+             "the store to start over")
     try:
         attrs = dict(_open_group(path).attrs)
     except Exception as exc:  # zarr raises several types for damaged metadata
-        raise SweepError(
-            f"{path} has damaged metadata ({path / 'zarr.json'}: {_brief(exc)}); delete the "
-            "store to start over"
+        raise _DamagedGroup(
+            f"{path} has damaged metadata ({path / 'zarr.json'}: {_brief(exc)}); {rerun}"
         ) from None
-    if "sweep_hash" not in attrs:
-        raise SweepError(f"{path} exists and is not a fivdisc sweep store")
+    if "sweep_hash" not in attrs and attrs.get("fivdisc_kind") != "sweep":
+        if not all((path / name / "zarr.json").is_file() for name in ("done", "checksum")):
+            raise SweepError(f"{path} exists and is not a fivdisc sweep store")
+        raise _DamagedGroup(  # a sweep store's arrays, its group's attributes lost
+            f"{path} has damaged metadata ({path / 'zarr.json'}: no sweep attributes); {rerun}"
+        )
     if attrs.get("store_format") not in _READABLE_FORMATS:
         raise SweepError(
             f"{path} was written by another version of fivdisc (store format "
             f"{attrs.get('store_format', 1)}, this version writes {STORE_FORMAT}); write to "
             "a new store, or delete this one to start over"
+        )
+    definition, digest = attrs.get("sweep_definition"), attrs.get("sweep_hash")
+    if not (isinstance(definition, str) and isinstance(digest, str)
+            and hashlib.sha256(definition.encode()).hexdigest() == digest):
+        raise _DamagedGroup(
+            f"{path} has damaged metadata ({path / 'zarr.json'}: its sweep_definition does "
+            f"not match its sweep_hash); {rerun}"
         )
     return attrs
 
@@ -296,47 +333,239 @@ def _differences(stored: str, current: str) -> list[str]:
     return [key for key in sorted(set(old) | set(new)) if old.get(key) != new.get(key)]
 
 
-def _readable(array: Any, grid: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
-    """(values, readable) of a Zarr array of one-point chunks over the sweep's `grid`,
-    chunk by chunk if need be, one row per point in C order (the order of the sweep's
-    points): values ``(n_points,)``, or ``(n_points, max_points)`` for a section's.
+@dataclass(frozen=True)
+class _Layout:
+    """What a store holds, derived from its sweep definition alone.
 
-    A chunk cut short or damaged by a crash raises on decoding; Zarr's error types
-    vary with the codec, hence the broad except. Unreadable points get the fill value.
+    Attributes
+    ----------
+    variables
+        The checksummed variables, in order (see :func:`checksummed`).
+    arrays
+        Every array (data variables and coordinates) -> (shape, chunk shape, dtype);
+        dtype None for a coordinate.
+    coords
+        Every coordinate -> its values.
+    attrs
+        The group attributes that describe the layout -> their values (as JSON data).
     """
-    n = math.prod(grid)
-    rows = (n, *array.shape[len(grid):])
-    try:
-        return np.reshape(array[...], rows), np.ones(n, dtype=bool)
-    except Exception:
-        values = np.full(array.shape, array.fill_value, dtype=array.dtype)
-        ok = np.zeros(tuple(grid), dtype=bool)
-        for index in np.ndindex(*grid):
-            try:
-                values[index] = array[index]
-                ok[index] = True
-            except Exception:
-                continue
-        return values.reshape(rows), ok.ravel()
+
+    variables: list[str]
+    arrays: dict[str, tuple[tuple[int, ...], tuple[int, ...] | None, np.dtype | None]]
+    coords: dict[str, np.ndarray]
+    attrs: dict[str, Any]
+
+    @property
+    def grid(self) -> tuple[int, ...]:
+        return self.arrays["done"][0]
 
 
-def _arrays(path: Path, shapes: dict[str, tuple[int, ...]]) -> tuple[dict[str, Any], list[str]]:
-    """The store's arrays by name, and the names whose metadata is missing, damaged or of
-    another shape than `shapes` gives."""
-    group = _open_group(path)
+def _layout(attrs: dict[str, Any]) -> _Layout:
+    """The layout of a store, from its (hash-checked) sweep definition."""
+    definition = json.loads(attrs["sweep_definition"])
+    mode = definition["mode"]
+    axes = {key: values for key, values in definition["axes"]}
+    sections = definition.get("sections", [])
+    shape = (tuple(len(v) for v in axes.values()) if mode == "grid"
+             else (len(next(iter(axes.values()))),))
+    names = {spec.partition(":")[2] or spec: spec for spec in definition["keep"]}
+    ones = (1,) * len(shape)
+    arrays: dict[str, tuple[tuple[int, ...], tuple[int, ...] | None, np.dtype | None]] = {
+        name: (shape, ones, np.dtype(BUILTIN[spec].dtype if spec in BUILTIN else "float64"))
+        for name, spec in names.items()
+    }
+    variables = list(names)
+    for section in sections:
+        name, points = section["name"], section["max_points"]
+        arrays[name] = ((*shape, points), (*ones, points), np.dtype("float64"))
+        arrays[f"{name}_count"] = (shape, ones, np.dtype("int32"))
+        variables += [name, f"{name}_count"]
+    variables.append("error")
+    arrays |= {"error": (shape, ones, _STRING), "checksum": (shape, ones, np.dtype("uint64")),
+               "done": (shape, ones, np.dtype(bool))}
+    if mode == "grid":
+        coords = {key: _coordinate(values) for key, values in axes.items()}
+    else:
+        coords = {DIM: np.arange(shape[0])} | {k: _coordinate(v) for k, v in axes.items()}
+    arrays |= {name: (values.shape, None, None) for name, values in coords.items()}
+    layout_attrs = {
+        "sweep_mode": mode,
+        "sweep_axes": list(axes),
+        "sweep_shape": list(shape),
+        "sweep_variables": variables,
+        "sweep_sections": sections,
+    }
+    return _Layout(variables, arrays, coords, layout_attrs)
+
+
+def _attribute_damage(attrs: dict[str, Any], layout: _Layout) -> list[str]:
+    """The group attributes describing the layout that do not match the sweep definition."""
+    damaged = []
+    for name, expected in layout.attrs.items():
+        value = attrs.get(name, "[]" if name == "sweep_sections" else None)
+        try:
+            ok = (value if name == "sweep_mode" else json.loads(value)) == expected
+        except (TypeError, ValueError):  # not JSON text
+            ok = False
+        if not ok:
+            damaged.append(f"{name} (group attribute)")
+    return damaged
+
+
+def _arrays(path: Path, layout: _Layout) -> tuple[dict[str, Any], list[str]]:
+    """The store's data arrays by name, and the names of the arrays (coordinates too) whose
+    metadata is missing, damaged or not what the layout says, or whose coordinate values
+    are not the sweep's."""
     arrays: dict[str, Any] = {}
     broken: list[str] = []
-    for name, shape in shapes.items():
+    for name, (shape, chunks, dtype) in layout.arrays.items():
         try:
-            array = group[name]
+            array = _open_array(path, name)
             ok = array.shape == shape
-        except Exception:  # missing directory (KeyError), damaged JSON, bad metadata
+            if name in layout.coords:
+                ok = ok and array[...].tolist() == layout.coords[name].tolist()
+            else:
+                ok = ok and array.chunks == chunks and array.dtype == dtype
+        except Exception:  # missing (KeyError), damaged JSON or chunks: the type varies
             ok = False
-        if ok:
+        if ok and name not in layout.coords:
             arrays[name] = array
-        else:
+        elif not ok:
             broken.append(name)
     return arrays, broken
+
+
+def _decoder(array: Any) -> Callable[[list[bytes]], np.ndarray] | None:
+    """A decoder of chunk files of `array` (their bytes -> their values, one row per
+    chunk), for the codecs fivdisc's stores use (a ``bytes`` or ``vlen-utf8`` codec, then
+    optionally ``zstd``); None for any other. A chunk that does not decode to one chunk's
+    values raises (ValueError or a codec's error)."""
+    from numcodecs import VLenUTF8
+    from numcodecs.zstd import decompress
+
+    meta = array.metadata.to_dict()
+    codecs = [(c["name"], c.get("configuration", {})) for c in meta["codecs"]]
+    if meta["chunk_key_encoding"] != {"name": "default", "configuration": {"separator": "/"}}:
+        return None
+    if [name for name, _ in codecs[1:]] not in ([], ["zstd"]):
+        return None
+    unzip = decompress if len(codecs) == 2 else bytes
+    kind, config = codecs[0]
+    chunk = tuple(array.chunks)
+    size = math.prod(chunk)
+    if kind == "bytes" and array.dtype != _STRING:
+        order = "<" if config.get("endian", "little") == "little" else ">"
+        dtype = array.dtype.newbyteorder(order)
+        nbytes = size * dtype.itemsize
+
+        def numbers(raws: list[bytes]) -> np.ndarray:
+            parts = [unzip(raw) for raw in raws]
+            if any(len(part) != nbytes for part in parts):
+                raise ValueError("a chunk of the wrong size")
+            values = np.frombuffer(b"".join(parts), dtype=dtype).astype(array.dtype)
+            return values.reshape(len(raws), *chunk)
+
+        return numbers
+    if kind == "vlen-utf8" and array.dtype == _STRING:
+        text = VLenUTF8()
+
+        def strings(raws: list[bytes]) -> np.ndarray:
+            values = [text.decode(unzip(raw)) for raw in raws]
+            if any(v.size != size for v in values):
+                raise ValueError("a chunk of the wrong size")
+            flat = np.concatenate(values) if values else np.empty(0, dtype=object)
+            return np.asarray(flat, dtype=_STRING).reshape(len(raws), *chunk)
+
+        return strings
+    return None
+
+
+def _chunk_files(directory: str, depth: int, head: tuple[int, ...] = ()
+                 ) -> Iterator[tuple[tuple[int, ...], str]]:
+    """(chunk index, file) of every chunk file under an array's ``c`` directory."""
+    try:
+        entries = list(os.scandir(directory))
+    except OSError:  # no chunk written yet
+        return
+    for entry in entries:
+        if not entry.name.isdigit():
+            continue
+        index = (*head, int(entry.name))
+        if depth > 1 and entry.is_dir():
+            yield from _chunk_files(entry.path, depth - 1, index)
+        elif depth == 1 and entry.is_file():
+            yield index, entry.path
+
+
+def _read(file: str) -> bytes:
+    with open(file, "rb", buffering=0) as f:
+        return f.read()
+
+
+def _readable(array: Any, grid: Sequence[int], points: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """(values, readable) of a Zarr array of one-point chunks over the sweep's `grid`,
+    one row per point in C order (the order of the sweep's points): values
+    ``(n_points,)``, or ``(n_points, max_points)`` for a section's. Only the points
+    flagged in `points` (default: all) are read; the others get the fill value.
+
+    Chunk files are listed and decoded here rather than read through Zarr, which costs
+    about half a millisecond per chunk (its store reads one file per asynchronous task,
+    and a chunk never written costs as much): the checks of a 300 x 300 sweep took over
+    a minute (see ``benchmarks/bench_store.py``). Arrays of other codecs are read
+    through Zarr. A chunk cut short or damaged fails to decode (the error type varies
+    with the codec, hence the broad excepts); such points are unreadable.
+    """
+    n = math.prod(grid)
+    tail = array.shape[len(grid):]
+    values = np.full((n, *tail), array.fill_value, dtype=array.dtype)
+    ok = np.ones(n, dtype=bool)
+    wanted = np.ones(n, dtype=bool) if points is None else points
+    decode = _decoder(array)
+    if decode is None:
+        for i in np.flatnonzero(wanted):
+            try:
+                values[i] = array[np.unravel_index(i, grid)]
+            except Exception:
+                ok[i] = False
+        return values, ok
+    directory = os.path.join(str(array.store_path.store.root), array.path, "c")
+    rest = "/0" * (array.ndim - len(grid))  # a section's values: one chunk per point
+    if points is None:  # every chunk file there is
+        strides = strides_of(grid)
+        found: list[int] = []
+        files: list[str] = []
+        for chunk, file in _chunk_files(directory, array.ndim):
+            index = chunk[: len(grid)]
+            if any(chunk[len(grid):]) or not all(i < g for i, g in zip(index, grid,
+                                                                       strict=True)):
+                continue  # not a chunk of this array's shape
+            found.append(sum(i * s for i, s in zip(index, strides, strict=True)))
+            files.append(file)
+    else:  # the wanted points' chunk files, where they would be
+        found = np.flatnonzero(wanted).tolist()
+        indices = np.column_stack(np.unravel_index(found, grid)).tolist() if found else []
+        files = [f"{directory}/{'/'.join(map(str, index))}{rest}" for index in indices]
+    read: list[int] = []
+    raws: list[bytes] = []
+    for i, file in zip(found, files, strict=True):
+        try:
+            raws.append(_read(file))
+        except FileNotFoundError:  # never written (Zarr skips chunks of the fill value)
+            continue
+        except OSError:
+            raws.append(b"")
+        read.append(i)
+    found = read
+    try:
+        values[found] = decode(raws).reshape(len(found), *tail)
+    except Exception:  # one chunk or more is damaged: find which
+        for i, raw in zip(found, raws, strict=True):
+            try:
+                values[i] = decode([raw]).reshape(tail)
+            except Exception:
+                ok[i] = False
+    return values, ok
 
 
 @dataclass(frozen=True)
@@ -354,7 +583,9 @@ class StoreHealth:
     failed
         Complete points whose run failed (a non-empty ``error``).
     broken
-        Variables whose metadata is missing or damaged.
+        Variables and coordinates whose metadata is missing or damaged, coordinates whose
+        values are not the sweep's, and group attributes that do not match the sweep
+        definition (named ``NAME (group attribute)``).
     holder
         Who holds the store's lock (a sweep writing it), or None.
     """
@@ -372,45 +603,32 @@ class StoreHealth:
         return not self.damaged.any() and not self.broken
 
 
-def _layout(attrs: dict[str, Any]) -> tuple[list[str], dict[str, tuple[int, ...]]]:
-    """(checksummed variables: see :func:`checksummed`; every variable -> its shape)."""
-    variables = json.loads(attrs["sweep_variables"])
-    keys = json.loads(attrs["sweep_axes"])
-    shape = tuple(json.loads(attrs["sweep_shape"]))
-    shapes = {name: shape for name in [*variables, "checksum", "done"]}
-    for section in json.loads(attrs.get("sweep_sections", "[]")):
-        shapes[section["name"]] = (*shape, section["max_points"])
-    if attrs["sweep_mode"] == "grid":
-        shapes |= {key: (length,) for key, length in zip(keys, shape, strict=True)}
-    else:
-        shapes |= {name: shape for name in [DIM, *keys]}
-    return variables, shapes
-
-
 def _inspect(path: Path, attrs: dict[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray,
                                                           list[str]]:
     """(complete, damaged, failed, broken variables) of a store; see :class:`StoreHealth`.
     The masks are flat, one entry per point."""
-    variables, shapes = _layout(attrs)
-    arrays, broken = _arrays(path, shapes)
-    grid = shapes["done"]
+    layout = _layout(attrs)
+    arrays, broken = _arrays(path, layout)
+    broken += _attribute_damage(attrs, layout)
+    grid = layout.grid
     n = math.prod(grid)
     if "done" in arrays:
         done, done_readable = _readable(arrays["done"], grid)
         done = np.asarray(done, dtype=bool)
     else:
         done, done_readable = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+    # Only the values of points marked done matter: the others are incomplete anyway.
     readable = np.ones(n, dtype=bool)
     columns = {}
-    for name in [*variables, "checksum"]:
+    for name in [*layout.variables, "checksum"]:
         if name in arrays:
-            columns[name], ok = _readable(arrays[name], grid)
+            columns[name], ok = _readable(arrays[name], grid, done & done_readable)
             readable &= ok
         else:
             readable[:] = False
     complete = done & done_readable & readable
     for i in np.flatnonzero(complete):
-        row = [columns[name][i] for name in variables]
+        row = [columns[name][i] for name in layout.variables]
         complete[i] = int(columns["checksum"][i]) == _checksum(attrs["sweep_hash"], int(i), row)
     damaged = ~complete & (done | ~done_readable)
     failed = complete & (columns["error"] != "") if "error" in columns else np.zeros(n, bool)
@@ -476,20 +694,50 @@ def _owner_path(path: Path) -> Path:
     return path.with_name(path.name + ".lock.owner")
 
 
+def _temporary(path: Path, pid: int) -> Path:
+    """Where the coordinator of process `pid` creates the store before renaming it into
+    place; recorded in the lock's owner record, so that only it is ever removed."""
+    return path.with_name(f"{path.name}.tmp-fivdisc-{pid}")
+
+
+def _owner(path: Path) -> dict[str, Any] | None:
+    """The lock holder's record next to the store, or None if there is none or it is damaged."""
+    try:
+        owner = json.loads(_owner_path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return owner if isinstance(owner, dict) else None
+
+
 def _describe_owner(path: Path) -> str:
     """The lock holder recorded next to the store, as text."""
     try:
-        owner = json.loads(_owner_path(path).read_text(encoding="utf-8"))
+        owner = _owner(path) or {}
         return (f"process {owner['pid']} on host {owner['host']} (running since "
                 f"{owner['since']}: {owner['command']})")
-    except (OSError, ValueError, KeyError, TypeError):
+    except (KeyError, TypeError):
         return "another process (it recorded no details)"
+
+
+def _remove_stale_temporary(path: Path) -> None:
+    """Remove the temporary store a dead holder of the lock recorded, and nothing else.
+
+    Called with the lock held: an owner record still there belongs to a holder that
+    died (a live holder keeps the lock); the name is checked against the one its
+    process id gives, so that a damaged record cannot point elsewhere."""
+    owner = _owner(path)
+    if owner is None or not isinstance(owner.get("pid"), int):
+        return
+    stale = _temporary(path, owner["pid"])
+    if owner.get("temporary") == stale.name and stale.is_dir() and not stale.is_symlink():
+        shutil.rmtree(stale, ignore_errors=True)
 
 
 def _holder(path: Path) -> str | None:
     """Who holds the store's lock now, or None."""
     from filelock import FileLock, Timeout
 
+    path = path.resolve()
     if not _lock_path(path).exists():
         return None
     lock = FileLock(_lock_path(path), timeout=0)
@@ -505,9 +753,12 @@ def _holder(path: Path) -> str | None:
 def store_lock(path: str | PathLike[str]) -> Iterator[None]:
     """Hold the lock of a sweep store: one coordinator writes a store at a time.
 
-    The lock is a file next to the store (``STORE.lock``, held through ``filelock``; the
-    operating system releases it when its process dies, however it dies), and the holder's
-    process id, host, start time and command are written to ``STORE.lock.owner``.
+    The lock is a file next to the store, where a symbolic link to it leads
+    (``STORE.lock``, held through ``filelock``; the operating system releases it when its
+    process dies, however it dies), and the holder's process id, host, start time,
+    command and temporary store (:meth:`SweepStore.open` creates a store under that name)
+    are written to ``STORE.lock.owner``. A temporary store recorded there by a holder
+    that died is removed.
 
     Raises
     ------
@@ -516,21 +767,23 @@ def store_lock(path: str | PathLike[str]) -> Iterator[None]:
     """
     from filelock import FileLock, Timeout
 
-    path = Path(path)
+    given, path = Path(path), Path(path).resolve()
     lock = FileLock(_lock_path(path), timeout=0)
     try:
         lock.acquire()
     except Timeout:
         raise SweepError(
-            f"{path} is in use by {_describe_owner(path)}: wait for that sweep to end or "
+            f"{given} is in use by {_describe_owner(path)}: wait for that sweep to end or "
             "stop it, then rerun"
         ) from None
     try:
+        _remove_stale_temporary(path)
         owner = {
             "pid": os.getpid(),
             "host": socket.gethostname(),
             "since": datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M:%S UTC"),
             "command": " ".join(sys.argv),
+            "temporary": _temporary(path, os.getpid()).name,
         }
         write_atomic(_owner_path(path), lambda p: p.write_text(json.dumps(owner),
                                                                encoding="utf-8"))
@@ -562,8 +815,7 @@ class SweepStore:
     def open(cls, path: str | PathLike[str], sweep: Sweep) -> SweepStore:
         """Create the store for `sweep`, or reopen it to resume; hold :func:`store_lock`.
 
-        Temporary stores left next to `path` by a killed coordinator are removed, and
-        variables whose metadata is lost or damaged are rebuilt empty (their points are
+        Variables whose metadata is lost or damaged are rebuilt empty (their points are
         then incomplete and get recomputed).
 
         Raises
@@ -573,19 +825,20 @@ class SweepStore:
         """
         path = Path(path)
         _require_zarr()
-        for stale in path.parent.glob(f"{path.name}.tmp-*"):
-            shutil.rmtree(stale, ignore_errors=True)
-        if path.exists():
-            attrs = _read_attrs(path)
-            if attrs["sweep_hash"] != sweep.digest:
-                fields = ", ".join(_differences(attrs["sweep_definition"], sweep.definition))
-                raise SweepError(
-                    f"{path} holds a different sweep (its definition differs in: {fields}); "
-                    "write to a new store, or delete this one to start over"
-                )
-            _repair(path, sweep, _arrays(path, _layout(attrs)[1])[1], attrs)
-        else:
+        if not path.exists():
             _create(path, sweep)
+            return cls(path, sweep)
+        try:
+            attrs = _read_attrs(path)
+        except _DamagedGroup as exc:
+            attrs = _rebuild_group(path, sweep, str(exc))
+        if attrs["sweep_hash"] != sweep.digest:
+            fields = ", ".join(_differences(attrs["sweep_definition"], sweep.definition))
+            raise SweepError(
+                f"{path} holds a different sweep (its definition differs in: {fields}); "
+                "write to a new store, or delete this one to start over"
+            )
+        _repair(path, sweep, attrs)
         return cls(path, sweep)
 
     def completed(self) -> np.ndarray:
@@ -594,7 +847,7 @@ class SweepStore:
 
     def errors(self, points: np.ndarray) -> dict[int, str]:
         """Point index -> error message of the failed ones among `points`."""
-        errors, _ = _readable(_open_group(self.path)["error"], self.sweep.shape)
+        errors, _ = _readable(_open_array(self.path, "error"), self.sweep.shape, points)
         return {int(i): str(errors[i]) for i in np.flatnonzero(points) if errors[i]}
 
     def write(self, outcomes: Sequence[PointOutcome]) -> None:
@@ -661,8 +914,10 @@ def _encoding(sweep: Sweep, names: Sequence[str]) -> dict[str, dict[str, Any]]:
 
 
 def _create(path: Path, sweep: Sweep) -> None:
-    """Write the empty store under a temporary name and rename it into place."""
-    tmp = path.with_name(f"{path.name}.tmp-{os.getpid()}")
+    """Write the empty store under the temporary name :func:`store_lock` records, and
+    rename it into place (where a symbolic link `path` leads)."""
+    path = path.resolve()
+    tmp = _temporary(path, os.getpid())
     template = _template(sweep)
     try:
         template.to_zarr(
@@ -676,26 +931,84 @@ def _create(path: Path, sweep: Sweep) -> None:
         raise
 
 
-def _repair(path: Path, sweep: Sweep, broken: Sequence[str], attrs: dict[str, Any]) -> None:
-    """Rebuild variables whose metadata is missing or damaged: coordinates from the sweep,
-    data variables empty; the group keeps its attributes `attrs`."""
-    if not broken:
-        return
+def _template_files(sweep: Sweep) -> dict[str, bytes]:
+    """The files of the empty store of `sweep` (metadata, and the coordinates' values), by
+    path in the store, as :func:`_create` writes them."""
+    zarr = _require_zarr()
+    files: dict[str, Any] = {}
     template = _template(sweep)
-    for name in broken:
-        shutil.rmtree(path / name, ignore_errors=True)
-    rebuilt = template[[n for n in broken if n in template.data_vars]]
-    rebuilt = rebuilt.drop_vars([c for c in rebuilt.coords if c not in broken])
-    for name in broken:
-        if name in template.coords and name not in rebuilt:
-            rebuilt[name] = template[name].variable
-    rebuilt.attrs = attrs  # the group's, rewritten unchanged
-    # Data variables are lazy, so only their metadata is written; coordinates are numpy
-    # arrays, whose values compute=False writes too.
-    rebuilt.to_zarr(
-        path, mode="a", compute=False, consolidated=False, zarr_format=3,
-        encoding=_encoding(sweep, [n for n in broken if n in template.data_vars]),
+    template.to_zarr(
+        zarr.storage.MemoryStore(files), mode="w-", compute=False, consolidated=False,
+        zarr_format=3, encoding=_encoding(sweep, list(template.data_vars)),
     )
+    return {key: buffer.to_bytes() for key, buffer in files.items()}
+
+
+# Array metadata a rerun restores from the sweep if it differs (the codecs are left: chunks
+# written with other codecs fail to decode, and their points are recomputed).
+_STRUCTURE = ("shape", "data_type", "chunk_grid", "chunk_key_encoding", "fill_value",
+              "dimension_names", "node_type")
+
+
+def _structure(text: bytes | None) -> dict[str, Any] | None:
+    try:
+        meta = json.loads(text or b"")
+    except ValueError:
+        return None
+    return {key: meta.get(key) for key in _STRUCTURE} if isinstance(meta, dict) else None
+
+
+def _write_files(path: Path, files: dict[str, bytes], names: Sequence[str]) -> None:
+    """Write the template's files of the arrays `names` (and of the group, for "") into
+    the store, each atomically, leaving the arrays' other chunk files as they are."""
+    for key, content in files.items():
+        head = key.rpartition("/")[0].split("/c/")[0].removesuffix("/c")
+        if head in names:
+            target = path / key
+            target.parent.mkdir(parents=True, exist_ok=True)
+            write_atomic(target, lambda p, c=content: p.write_bytes(c))
+
+
+def _rebuild_group(path: Path, sweep: Sweep, damage: str) -> dict[str, Any]:
+    """Rebuild the group's metadata of a store from `sweep`, if the store's coordinates and
+    point flags are those of `sweep` (the points then verify by their checksums, which
+    cover the sweep's hash); one line saying what to delete if not. Returns the rebuilt
+    attributes."""
+    files = _template_files(sweep)
+    attrs = json.loads(files["zarr.json"])["attributes"]
+    layout = _layout(attrs)
+    _, broken = _arrays(path, layout)
+    foreign = [name for name in broken if name in layout.coords or name in ("done", "checksum")]
+    if foreign:
+        raise SweepError(
+            f"{damage.split('; ')[0]}, and it cannot be rebuilt from this sweep: its "
+            f"{', '.join(foreign)} are not this sweep's; delete {path} to start over"
+        )
+    _write_files(path, files, [""])
+    _consolidate(path)
+    return attrs
+
+
+def _repair(path: Path, sweep: Sweep, attrs: dict[str, Any]) -> None:
+    """Restore from `sweep` what a rerun can: the metadata of arrays whose metadata is
+    missing, damaged or not the sweep's (their chunk files are kept; points whose values
+    do not read back to their checksums are recomputed), coordinates whose values are
+    not the sweep's, and group attributes that do not match the sweep's definition."""
+    layout = _layout(attrs)
+    _, broken = _arrays(path, layout)
+    group = bool(_attribute_damage(attrs, layout))
+    files = _template_files(sweep)
+    for name in layout.arrays:
+        meta = path / name / "zarr.json"
+        stored = meta.read_bytes() if meta.is_file() else None
+        if name not in broken and _structure(stored) != _structure(files[f"{name}/zarr.json"]):
+            broken.append(name)
+    if not broken and not group:
+        return
+    for name in broken:
+        if name in layout.coords:  # its values are rewritten whole
+            shutil.rmtree(path / name, ignore_errors=True)
+    _write_files(path, files, [*broken, ""] if group else broken)
     _consolidate(path)
 
 
@@ -721,23 +1034,15 @@ def open_sweep(path: str | PathLike[str]) -> xr.Dataset:
             f"{path} is damaged: variable(s) {', '.join(broken)} are missing or unreadable; "
             "rerun the sweep to rebuild them and recompute their points"
         )
-    # chunks=None: lazily indexed arrays read by Zarr itself, not dask (whose default
-    # scheduler may be a cluster client of this process). consolidated=False: each
-    # variable's own metadata, as checked above.
+    # chunks=None: lazily indexed arrays, replaced by the values read here (quicker than
+    # through Zarr, see _readable). consolidated=False: each variable's own metadata, as
+    # checked above.
     data = xr.open_zarr(path, consolidated=False, chunks=None)
-    shapes = _layout(attrs)[1]
-    for name in list(data.data_vars):
-        try:
-            data[name].load()
-        except Exception:  # damaged chunks: the codec's error type varies
-            values, _ = _readable(_arrays(path, {name: shapes[name]})[0][name],
-                                  shapes["done"])
-            data[name] = data[name].copy(data=values.reshape(shapes[name]))
-    try:
-        data = data.load()
-    except Exception as exc:  # a damaged coordinate chunk
-        raise SweepError(
-            f"{path} has unreadable coordinates ({_brief(exc)}); rerun the sweep to rebuild them"
-        ) from None
-    data["done"] = data["done"].copy(data=complete.reshape(shapes["done"]))
+    layout = _layout(attrs)
+    arrays, _ = _arrays(path, layout)
+    for name in [n for n in data.data_vars if n in arrays]:
+        values, _ = _readable(arrays[name], layout.grid)
+        data[name] = data[name].copy(data=values.reshape(layout.arrays[name][0]))
+    data = data.load()
+    data["done"] = data["done"].copy(data=complete.reshape(layout.grid))
     return data
