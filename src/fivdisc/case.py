@@ -662,6 +662,10 @@ class Simulation(_Table):
         Largest integrator step [s]; 0 means no limit.
     max_switches
         Phase switches (slip, stick, separation) after which the run stops, >= 1.
+    max_steps
+        Integrator steps (accepted and rejected) after which the run stops with status
+        ``too_many_steps``, keeping what was computed, >= 1. The default is about a
+        hundred times the most any of the paper's cases takes.
     min_flight_time
         Shortest flight of a slider that is resolved [s], > 0: a landing impact that
         would release another slider for less than this keeps it in contact (it ends
@@ -687,6 +691,7 @@ class Simulation(_Table):
     atol: Real = _field(1e-9, gt=0)
     max_step: Real = _field(0.0, "s", ge=0)
     max_switches: Count = _field(10_000_000, ge=1)
+    max_steps: Count = _field(1_000_000_000, ge=1)
     min_flight_time: Real = _field(1e-11, "s", gt=0)
     energy_balance: Flag = False
     perturbation: Perturbation = Perturbation()

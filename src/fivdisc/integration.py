@@ -20,6 +20,15 @@ _EVENT_BUFFER = 1 << 15
 # Switches closer than this, this many times in a row, are taken as Zeno/chattering.
 ZENO_DT = 1e-10
 ZENO_COUNT = 1000
+# An accumulation of switches that interleaves tiny spacings with longer ones (a cascade
+# among many sliders) escapes the test above: ZENO_RATE_COUNT switch events within
+# ZENO_RATE_SPAN of simulated time (a mean spacing of 1e-9 s, a thousand times the
+# densest switching of the paper's cases) are taken as Zeno too.
+ZENO_RATE_COUNT = 10_000
+ZENO_RATE_SPAN = 1e-5
+# Work [state values x (sliders + 1)] one kernel call may do before it returns to Python,
+# about 0.05 s: the bound on how long an interrupt or a step budget waits.
+_CALL_WORK = 500_000
 
 STATUS = {
     slots.ST_RUNNING: "running",
@@ -29,6 +38,7 @@ STATUS = {
     slots.ST_UNDERFLOW: "step_size_underflow",
     slots.ST_ZENO: "endless_switching",
     slots.ST_MAX_SWITCHES: "max_switches",
+    slots.ST_TOO_MANY_STEPS: "too_many_steps",
 }
 
 
@@ -116,6 +126,11 @@ class Integration:
         ctl[slots.C_ZENO_COUNT] = ZENO_COUNT
         ctl[slots.C_STOP_MASK] = sum(1 << EVENT_KINDS.index(k) for k in set(stop_on))
         self.ctl = ctl
+        self.max_steps = sim.max_steps
+        self.call_steps = max(20, _CALL_WORK // (size * (n_sl + 1)))
+        self.zeno_sliders: tuple[int, ...] = ()
+        self.zeno_span = 0.0
+        self.zeno_count = 0
         self.fst = np.zeros(slots.N_FSTATE)
         self.fst[slots.F_LAST_SWITCH] = -np.inf
         self.ist = np.zeros(slots.N_ISTATE, dtype=np.int64)
@@ -161,10 +176,28 @@ class Integration:
         self.fst[slots.F_W_PEAK] = 0.0
         return peak
 
+    @property
+    def steps_tried(self) -> int:
+        """Steps tried so far, accepted and rejected."""
+        return int(self.ist[slots.I_STEPS] + self.ist[slots.I_REJECTED])
+
     def advance(self, target: float) -> int:
-        """Integrate until ``t >= target`` (or the end, a failure, a full event buffer);
-        returns the kernel's status. The first call (any target) also chooses the phases
-        at the start."""
+        """Integrate until ``t >= target`` (or the end, a failure, a full event buffer, the
+        call's step budget); returns the status. The first call (any target) also chooses
+        the phases at the start.
+
+        A call tries at most a bounded number of steps (about 0.05 s of work), so that
+        the caller regains control often: a run that cannot make progress is seen to, and
+        an interrupt is handled, within a fraction of a second. Splitting a run into calls
+        changes none of its steps. The run ends as ``too_many_steps`` once
+        ``simulation.max_steps`` steps were tried, and as ``endless_switching`` when its
+        switches accumulate (:data:`ZENO_RATE_COUNT` within :data:`ZENO_RATE_SPAN`).
+        """
+        left = self.max_steps - self.steps_tried
+        if left <= 0 and self.ist[slots.I_STARTED]:
+            self.status = slots.ST_TOO_MANY_STEPS
+            return self.status
+        self.ctl[slots.C_CALL_STEPS] = max(1, min(self.call_steps, left))
         status = kern.run(target, self.mdl, self.ctl, self.fst, self.ist, self.y, self.ph,
                           self.sg, self.k, self.ev_prev, self.breaks, self.out_y, self.out_aux,
                           self.ev_t, self.ev_i, self.tan)
@@ -173,8 +206,55 @@ class Integration:
             self.ev_times.append(self.ev_t[:n_ev].copy())
             self.ev_rows.append(self.ev_i[:n_ev].copy())
             self.ist[slots.I_EVENTS] = 0
+        if status == slots.ST_ZENO:
+            self._name_zeno(ZENO_COUNT)
+        elif status == slots.ST_RUNNING and n_ev and self._accumulating():
+            status = slots.ST_ZENO
+        elif (status == slots.ST_RUNNING and self.t < self.duration
+              and self.steps_tried >= self.max_steps):
+            status = slots.ST_TOO_MANY_STEPS
         self.status = status
         return status
+
+    def _recent(self, count: int) -> tuple[np.ndarray, np.ndarray]:
+        """Times and rows of the last ``count`` events (fewer if there are fewer)."""
+        times, rows, have = [], [], 0
+        for t, r in zip(reversed(self.ev_times), reversed(self.ev_rows), strict=True):
+            times.append(t[-(count - have):])
+            rows.append(r[-(count - have):])
+            have += times[-1].size
+            if have >= count:
+                break
+        if not times:
+            return np.empty(0), np.empty((0, slots.N_EVI), dtype=np.int64)
+        return np.concatenate(times[::-1]), np.concatenate(rows[::-1])
+
+    def _name_zeno(self, count: int) -> None:
+        """Keep the sliders of the last ``count`` events, their number and the time they
+        span."""
+        times, rows = self._recent(count)
+        if times.size:
+            self.zeno_sliders = tuple(int(j) for j in np.unique(rows[:, slots.EVI_SLIDER]))
+            self.zeno_span = float(times[-1] - times[0])
+            self.zeno_count = int(times.size)
+
+    def _accumulating(self) -> bool:
+        """Whether :data:`ZENO_RATE_COUNT` consecutive events among the latest fall within
+        :data:`ZENO_RATE_SPAN` of simulated time."""
+        new = self.ev_times[-1].size
+        times, rows = self._recent(new + ZENO_RATE_COUNT - 1)
+        if times.size < ZENO_RATE_COUNT:
+            return False
+        spans = times[ZENO_RATE_COUNT - 1:] - times[: times.size - ZENO_RATE_COUNT + 1]
+        dense = np.flatnonzero(spans < ZENO_RATE_SPAN)
+        if not dense.size:
+            return False
+        first = int(dense[0])
+        window = rows[first:first + ZENO_RATE_COUNT]
+        self.zeno_sliders = tuple(int(j) for j in np.unique(window[:, slots.EVI_SLIDER]))
+        self.zeno_span = float(spans[first])
+        self.zeno_count = ZENO_RATE_COUNT
+        return True
 
     def run_to(self, target: float) -> int:
         """Advance until ``target`` is reached or the run ends."""

@@ -8,7 +8,6 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from fivdisc import integration
 from fivdisc._kernels import integrate as kern
 from fivdisc._kernels import slots
 from fivdisc.case import Case
@@ -162,37 +161,42 @@ def simulate(
                    bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s [{elapsed}<{remaining}]")
     start = _time.perf_counter()
     status = slots.ST_RUNNING
-    interrupted = False
     limit = Deflection(model)
-    try:
-        # The kernel's step-size controller restarts at each return (the saved outputs
-        # of the paper's cases follow this grid), so the grid is fixed, not adaptive.
-        for chunk in range(1, _CHUNKS + 1):
-            status = run.run_to(sim.duration * chunk / _CHUNKS)
+    with Interrupt() as interrupt:
+        try:
+            # The kernel's step-size controller restarts at each chunk (the saved outputs
+            # of the paper's cases follow this grid), so the grid is fixed, not adaptive;
+            # within a chunk each call is bounded (Integration.advance), and an interrupt
+            # is taken between calls.
+            for chunk in range(1, _CHUNKS + 1):
+                target = sim.duration * chunk / _CHUNKS
+                while not interrupt.requested:
+                    status = run.advance(target)
+                    if bar is not None:
+                        bar.update(run.t - bar.n)
+                    if status != slots.ST_RUNNING or run.t >= target:
+                        break
+                if interrupt.requested or limit.exceeded(run) or status != slots.ST_RUNNING:
+                    break
+        except KeyboardInterrupt:
+            interrupt.requested = True
+        finally:
             if bar is not None:
-                bar.update(run.t - bar.n)
-            if limit.exceeded(run):
-                break
-            if status != slots.ST_RUNNING:
-                break
-    except KeyboardInterrupt:
-        interrupted = True
-    finally:
-        if bar is not None:
-            bar.close()
+                bar.close()
+    interrupted = interrupt.requested
     wall = _time.perf_counter() - start
 
     t_end = run.t
     ph = run.ph
     y = run.y
-    phases = ", ".join(PHASE_NAMES[p] for p in ph)
+    phases = _phases(ph)
     name = STATUS.get(status, "unknown")
     if interrupted:
         name, message = "interrupted", f"interrupted at t = {t_end:.9g} s in {phases}"
     elif limit.when is not None or (name in _BLOW_UPS and limit.beyond(y)):
         name, message = "diverged", limit.message(t_end)
     else:
-        message = _message(name, t_end, phases, sim)
+        message = _message(name, t_end, phases, case, run)
     n_done = run.n_samples
     times = np.minimum(np.arange(n_done) / sim.output_rate, sim.duration)
     ist = run.ist
@@ -302,16 +306,68 @@ class Deflection:
                 "printed_gyroscopic_sign = true)")
 
 
-def _message(name: str, t: float, phase: str, sim) -> str:
+class Interrupt:
+    """While active (a ``with`` block in the main thread), the first SIGINT (Ctrl-C) sets
+    :attr:`requested` instead of raising, so that a run stops between two kernel calls
+    and keeps what it computed; a second one interrupts at once."""
+
+    def __init__(self) -> None:
+        self.requested = False
+        self._previous = None
+
+    def _handle(self, signum, frame) -> None:
+        if self.requested:
+            raise KeyboardInterrupt
+        self.requested = True
+
+    def __enter__(self) -> Interrupt:
+        import signal
+        import threading
+
+        if threading.current_thread() is threading.main_thread():
+            self._previous = signal.signal(signal.SIGINT, self._handle)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._previous is not None:
+            import signal
+
+            signal.signal(signal.SIGINT, self._previous)
+
+
+def _phases(ph: np.ndarray) -> str:
+    """The sliders' phases in a message: each one's, or how many are in each."""
+    if ph.size <= 8:
+        return ", ".join(PHASE_NAMES[p] for p in ph)
+    return ", ".join(f"{np.sum(ph == i)} sliders in {name}"
+                     for i, name in enumerate(PHASE_NAMES) if np.any(ph == i))
+
+
+def _sliders(case: Case, sliders: tuple[int, ...]) -> str:
+    names = [case.slider_key(j) for j in sliders]
+    if len(names) > 8:
+        names = [*names[:8], f"... ({len(names)} sliders)"]
+    return ", ".join(names)
+
+
+def _message(name: str, t: float, phase: str, case: Case, run: Integration) -> str:
+    sim = case.simulation
     where = f"at t = {t:.9g} s in {phase}"
+    if name == "endless_switching":
+        return (f"endless switching (Zeno/chattering) {where}: switches accumulate among "
+                f"{_sliders(case, run.zeno_sliders)} ({run.zeno_count} switches "
+                f"within {run.zeno_span:.3g} s); check the parameters of these sliders "
+                "(an impact cascade between sliders close together, a stiff contact)")
     return {
         "success": f"reached t = {sim.duration} s",
         "stopped": f"stopped early on request at t = {t:.9g} s",
         "nonfinite": f"state became non-finite {where}; try smaller simulation.rtol/atol "
         "or check the parameters",
         "step_size_underflow": f"step size underflow {where}; try looser simulation.rtol/atol",
-        "endless_switching": f"endless switching (Zeno/chattering) {where}: "
-        f"{integration.ZENO_COUNT} switches less than {integration.ZENO_DT} s apart",
-        "max_switches": f"simulation.max_switches = {sim.max_switches} reached {where}",
+        "max_switches": f"simulation.max_switches = {sim.max_switches} reached {where} "
+        f"after {run.ist[slots.I_SWITCHES]} switches",
+        "too_many_steps": f"simulation.max_steps = {sim.max_steps} steps tried {where} "
+        f"(mean step {t / max(run.steps_tried, 1):.3g} s); raise simulation.max_steps, "
+        "loosen simulation.rtol/atol or check the parameters (a stiff spring or damper)",
     }.get(name, f"ended {where}")
 
