@@ -7,12 +7,15 @@ nonlinear-dynamics analyses (:mod:`fivdisc.analysis.orbits`,
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from fivdisc._kernels import integrate as kern
 from fivdisc._kernels import layout as lay
 from fivdisc._kernels import slots
 from fivdisc._kernels import tangent as tan
+from fivdisc.errors import FivdiscError
 from fivdisc.model import Model
 from fivdisc.result import EVENT_KINDS
 
@@ -26,6 +29,9 @@ ZENO_COUNT = 1000
 # densest switching of the paper's cases) are taken as Zeno too.
 ZENO_RATE_COUNT = 10_000
 ZENO_RATE_SPAN = 1e-5
+# Mean step [s per unit of max(1, t)] of a whole kernel call below which the run is taken
+# as stalled (the kernel's own test of a step size underflow: 1e-14 max(1, t)).
+_STALLED = 1e-14
 # Work [state values x (sliders + 1)] one kernel call may do before it returns to Python,
 # about 0.05 s: the bound on how long an interrupt or a step budget waits.
 _CALL_WORK = 500_000
@@ -48,28 +54,84 @@ STATUS = {
 _TANGENT_STEP = 0.5
 
 
+def time_scales(model: Model) -> list[tuple[str, float]]:
+    """The rates [1/s] of the model's fast motions, each with the keys that set it: the
+    disc's natural frequencies and damping rates, each slider's normal and in-plane
+    oscillator (separated) and damping rates. The spin's shift l Omega of a disc frequency
+    is small against them for the speeds of brake squeal and left out."""
+    kern = model.kernel
+    case = model.case
+    labels = np.array(model.labels)
+    scales = [(f"disc.modes {lab} natural frequency", w) for lab, w in zip(labels, model.omega,
+                                                                          strict=True)]
+    scales += [(f"disc.damping_ratio of {lab}", 2.0 * z * w)
+               for lab, z, w in zip(labels, model.damping, model.omega, strict=True)]
+    with np.errstate(all="ignore"):
+        rows = [("sqrt(normal_stiffness / mass)", np.sqrt(kern.row("kz") / kern.row("mass"))),
+                ("sqrt(rotational_stiffness / inertia)",
+                 np.sqrt(kern.row("kphi") / kern.row("inertia"))),
+                ("normal_damping / mass", kern.row("cz") / kern.row("mass")),
+                ("rotational_damping / inertia", kern.row("cphi") / kern.row("inertia"))]
+    for what, rates in rows:
+        scales += [(f"{case.slider_key(j)}: {what}", float(r)) for j, r in enumerate(rates)]
+    return [(what, float(rate)) for what, rate in scales]
+
+
+def fastest_time_scale(model: Model) -> tuple[str, float]:
+    """The largest of :func:`time_scales` (a nan counts as infinite)."""
+    return max(((what, math.inf if math.isnan(r) else r) for what, r in time_scales(model)),
+               key=lambda item: item[1], default=("none", 0.0))
+
+
 def tangent_step(model: Model) -> float:
     """Largest step [s] that resolves the tangent dynamics: half the shortest time
-    scale of the model (the disc's natural frequencies, the sliders' normal and in-plane
-    oscillators, every damping rate; the spin's shift l Omega of a disc frequency is small
-    against it for the speeds of brake squeal and left out).
+    scale of the model (:func:`time_scales`).
 
     The integrator's steps follow the state alone (so that tangents do not change the
     trajectory); where the state hardly moves (near an equilibrium, a disc mode at rest)
     its steps may be far too long for the tangent dynamics, which then are not merely
     inaccurate but unstable. Analyses that carry tangents cap the step at this.
     """
-    kern = model.kernel
-    rates = [
-        model.omega,
-        2.0 * model.damping * model.omega,
-        np.sqrt(kern.row("kz") / kern.row("mass")),
-        np.sqrt(kern.row("kphi") / kern.row("inertia")),
-        kern.row("cz") / kern.row("mass"),
-        kern.row("cphi") / kern.row("inertia"),
-    ]
-    fastest = max(float(np.max(r, initial=0.0)) for r in rates)
-    return _TANGENT_STEP / fastest
+    return _TANGENT_STEP / fastest_time_scale(model)[1]
+
+
+# h |lambda| at the edge of DOPRI5's stability region on the negative real axis (3.3) and
+# the imaginary axis (3.4).
+_STABLE_STEP = 3.3
+
+
+def check_steps(model: Model, duration: float) -> None:
+    """Refuse a run whose fastest time scale needs more steps than
+    ``simulation.max_steps`` allows, before it starts.
+
+    An explicit integrator's step stays within its stability region whatever the
+    tolerance: h <= 3.3 / rate for the fastest rate of :func:`time_scales`, so a run of
+    `duration` [s] takes at least ``duration * rate / 3.3`` steps (a lower bound: contact
+    and friction forces only add to it).
+
+    Raises
+    ------
+    FivdiscError
+        Naming the estimate, the time scale and its keys, and what to change.
+    """
+    what, rate = fastest_time_scale(model)
+    # The spin shifts a disc frequency by l Omega, small against the time scales for the
+    # speeds of brake squeal but not for any speed a profile may reach.
+    bp = model.speed.breakpoints
+    times = np.concatenate([np.linspace(0.0, duration, 1001), bp[bp < duration]])
+    with np.errstate(all="ignore"):
+        spin = float(np.max(model.l, initial=0) * np.max(np.abs(model.speed.omega(times))))
+    if not spin <= rate:
+        what, rate = "speed: the disc's spin (largest Omega) times the largest l", spin
+    steps = duration * rate / _STABLE_STEP
+    budget = model.case.simulation.max_steps
+    if not steps <= budget:
+        raise FivdiscError(
+            f"the run needs at least {steps:.3g} integrator steps, more than "
+            f"simulation.max_steps = {budget}: {what} = {rate:.3g} 1/s limits the step to "
+            f"{_STABLE_STEP / rate:.3g} s over simulation.duration = {duration!r} s; change "
+            "that parameter, shorten the run or raise simulation.max_steps"
+        )
 
 
 class Integration:
@@ -198,6 +260,7 @@ class Integration:
             self.status = slots.ST_TOO_MANY_STEPS
             return self.status
         self.ctl[slots.C_CALL_STEPS] = max(1, min(self.call_steps, left))
+        tried, t0 = self.steps_tried, self.t
         status = kern.run(target, self.mdl, self.ctl, self.fst, self.ist, self.y, self.ph,
                           self.sg, self.k, self.ev_prev, self.breaks, self.out_y, self.out_aux,
                           self.ev_t, self.ev_i, self.tan)
@@ -213,6 +276,11 @@ class Integration:
         elif (status == slots.ST_RUNNING and self.t < self.duration
               and self.steps_tried >= self.max_steps):
             status = slots.ST_TOO_MANY_STEPS
+        elif (status == slots.ST_RUNNING and self.steps_tried - tried >= self.call_steps
+              and self.t - t0 < (self.steps_tried - tried) * _STALLED * max(1.0, self.t)):
+            # A whole call's steps that do not add up to the round-off of t: the
+            # step size has underflowed although each step is accepted.
+            status = slots.ST_UNDERFLOW
         self.status = status
         return status
 

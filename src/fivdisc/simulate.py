@@ -13,7 +13,7 @@ from fivdisc._kernels import slots
 from fivdisc.case import Case
 from fivdisc.compilation import compile_notice
 from fivdisc.errors import SimulationError
-from fivdisc.integration import STATUS, Integration
+from fivdisc.integration import STATUS, Integration, check_steps
 from fivdisc.limits import check_simulation
 from fivdisc.model import Model, build_model
 from fivdisc.result import EVENT_KINDS, PHASE_NAMES, Result, build_dataset
@@ -24,6 +24,8 @@ from fivdisc.warmup import warm_up
 # Failures in which a state beyond the plate theory's range means the model diverged.
 _BLOW_UPS = ("nonfinite", "step_size_underflow")
 _CHUNKS = 200
+#: Largest initial rotation of a slider [rad].
+MAX_PHI = 1e6
 
 
 def initial_state(model: Model, initial=None) -> np.ndarray:
@@ -55,7 +57,7 @@ def initial_state(model: Model, initial=None) -> np.ndarray:
             y = sliding_equilibrium(model).state.copy()
             y[phi] += sim.perturbation.phi
             y[phi_dot] += sim.perturbation.phi_dot
-            return y
+            return _checked(y, phi)
         raise SimulationError(
             f"initial = {initial!r} is invalid: must be 'rest', 'equilibrium', a mapping "
             "or a state array"
@@ -88,8 +90,19 @@ def initial_state(model: Model, initial=None) -> np.ndarray:
                 f"initial state has shape {y.shape}: must be ({model.state_size},) = "
                 "2 (n + 2 S)"
             )
+    return _checked(y, phi)
+
+
+def _checked(y: np.ndarray, phi: slice) -> np.ndarray:
+    """``y``, refused unless finite with slider rotations within :data:`MAX_PHI`."""
     if not np.all(np.isfinite(y)):
         raise SimulationError("initial state is invalid: all values must be finite")
+    largest = float(np.max(np.abs(y[phi]), initial=0.0))
+    if largest > MAX_PHI:
+        raise SimulationError(
+            f"initial phi = {largest:g} rad is invalid: must be within +-{MAX_PHI:g} rad "
+            "(further out a double resolves the slider's angle to no better than 1e-10 rad)"
+        )
     return y
 
 
@@ -142,7 +155,15 @@ def simulate(
                 f"stop_on = {kind!r} is invalid: must be one of {', '.join(EVENT_KINDS)}"
             )
     model = build_model(case, speed)
+    check_steps(model, sim.duration)
     y0 = initial_state(model, initial)
+    limit = Deflection(model)
+    if limit.beyond(y0):
+        raise SimulationError(
+            f"the initial state is invalid: it deflects the disc by {limit.largest:.3g} m, "
+            f"more than {limit.DIVERGED:g} times disc.thickness, where the run would end as "
+            "diverged"
+        )
     run = Integration(model, y0, duration=sim.duration, output_rate=sim.output_rate,
                       stop_on=stop_on, energy=sim.energy_balance)
 
@@ -161,7 +182,6 @@ def simulate(
                    bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s [{elapsed}<{remaining}]")
     start = _time.perf_counter()
     status = slots.ST_RUNNING
-    limit = Deflection(model)
     with Interrupt() as interrupt:
         try:
             # The kernel's step-size controller restarts at each chunk (the saved outputs
