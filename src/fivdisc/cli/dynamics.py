@@ -3,6 +3,7 @@ multipliers, and Lyapunov exponents."""
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import click
@@ -46,15 +47,24 @@ def orbit(case_file: Path, period: float | None, transient: float | None, window
     Runs the case for its duration (or --transient), finds the first return of the
     trajectory and refines the orbit by Newton shooting with the exact monodromy matrix
     (saltation matrices at every switch). CASE_FILE is a TOML file or a packaged example.
+    Exits with status 1 when the period found is shorter than any motion of the model.
     """
+    from fivdisc.analysis.checks import check_orbit_request, check_period
     from fivdisc.analysis.orbits import periodic_orbit
     from fivdisc.case import load_case
+    from fivdisc.errors import FivdiscError
     from fivdisc.files import check_output
 
     case = load_case(case_file)
+    check_orbit_request(case, period=period, transient=transient, window=window, rtol=rtol)
     out = check_output(output, "-o", (".nc",), inputs=[case_file]) if output else None
     res = periodic_orbit(case, period=period, transient=transient, window=window, rtol=rtol,
                          progress=progress)
+    try:
+        check_period(case, res.period, "the period found")
+    except FivdiscError as err:
+        click.echo(f"error: no periodic orbit: {err}", err=True)
+        sys.exit(1)
     _report(res, case, as_json, out)
 
 
@@ -81,7 +91,8 @@ def lyapunov(case_file: Path, count: int, transient: float | None, duration: flo
     """Lyapunov exponents of CASE_FILE by the QR method on the tangent dynamics.
 
     The tangent vectors are carried across every switch by its saltation matrix.
-    CASE_FILE is a TOML file or a packaged example.
+    CASE_FILE is a TOML file or a packaged example. Exits with status 1 when the largest
+    exponent is inconclusive (its uncertainty unknown or larger than itself).
     """
     from fivdisc.analysis.lyapunov import lyapunov as compute
     from fivdisc.case import load_case
@@ -92,3 +103,6 @@ def lyapunov(case_file: Path, count: int, transient: float | None, duration: flo
     res = compute(case, n=count, transient=transient, duration=duration, interval=interval,
                   progress=progress)
     _report(res, case, as_json, out)
+    if not res.conclusive[0]:
+        click.echo(f"error: the largest exponent is inconclusive: {res.verdict(0)}", err=True)
+        sys.exit(1)
