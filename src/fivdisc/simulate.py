@@ -146,9 +146,20 @@ def simulate(
     CaseError
         `speed` is not a profile or a pair of callables, or cannot be represented.
     """
+    if not isinstance(case, Case):
+        raise SimulationError(
+            f"case = {type(case).__name__} is invalid: must be a fivdisc.Case (Case(...), "
+            "Case.model_validate(dict) or load_case(path))"
+        )
     sim = case.simulation
     check_simulation(case)
     speed = SpeedProfile.from_override(speed, sim.duration)
+    if speed is not None and not speed.end >= sim.duration:
+        raise SimulationError(
+            f"speed is invalid: the profile ends at t = {speed.end!r} s, before "
+            f"simulation.duration = {sim.duration!r} s (it would be extrapolated); give "
+            "it over the whole run"
+        )
     for kind in stop_on:
         if kind not in EVENT_KINDS:
             raise SimulationError(
@@ -228,6 +239,8 @@ def simulate(
         "end_time": float(t_end),
         "impact": int(sim.impact),
         "case": case.to_toml(),
+        "speed_source": "case" if speed is None else
+        f"{speed.source} given to simulate (the case's [speed] table is not used)",
         "fivdisc_version": package.__version__,
         "wall_time": wall,
         "n_steps": int(ist[slots.I_STEPS]),
