@@ -254,7 +254,43 @@ def simulate(
     imported()
     ds = build_dataset(model, run.out_y[:n_done], run.out_aux[:n_done], times, run.events(),
                        attrs)
+    ds.attrs["degenerate"] = degenerate(case, ds, limit.largest)
     return Result(ds)
+
+
+# Below these a run's response has no physical meaning (a thousandth of a nanometre; a
+# nanonewton, a millionth of a gram's weight): a case that stays below them is degenerate.
+_NO_DEFLECTION = 1e-12
+_NO_FORCE = 1e-9
+
+
+def degenerate(case: Case, ds, largest_w: float) -> str:
+    """Why the run of `case` (its dataset `ds`) says nothing about friction-induced
+    vibration, in one line ("" if nothing does): no preload or no friction, no probes,
+    or a response that stays below any physical scale (`largest_w` [m]: the largest
+    deflection under the sliders and at the probes)."""
+    reasons = []
+    zero = [f"{case.slider_key(j)}.preload" for j, s in enumerate(case.sliders)
+            if s.preload == 0]
+    if zero:
+        reasons.append(f"{', '.join(zero)} = 0 N (no normal force, so no friction)")
+    law = case.friction
+    coefficients = [law.static, *(v for _, v in law.kinetic_at_rest()),
+                    getattr(law, "kinetic_min", 0.0), *getattr(law, "values", ())]
+    if not any(coefficients):
+        reasons.append("every friction coefficient is 0 (no friction force)")
+    if not case.simulation.probes:
+        reasons.append("simulation.probes = [] (no deflection is recorded)")
+    if ds.sizes["time"] > 1:
+        force = ds["normal_force"].values
+        peak = float(np.nanmax(force)) if np.isfinite(force).any() else math.nan
+        if len(zero) < len(case.sliders) and peak < _NO_FORCE:
+            reasons.append(f"the normal force stays below {_NO_FORCE:g} N (peak {peak:.3g} N)")
+        if largest_w < _NO_DEFLECTION:
+            reasons.append(f"the disc's deflection stays below {_NO_DEFLECTION:g} m (largest "
+                           f"{largest_w:.3g} m): check disc.density, disc.youngs_modulus, "
+                           "the preloads")
+    return "; ".join(reasons)
 
 
 class Deflection:
