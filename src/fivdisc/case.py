@@ -692,8 +692,9 @@ class Simulation(_Table):
         Phase switches (slip, stick, separation) after which the run stops, >= 1.
     max_steps
         Integrator steps (accepted and rejected) after which the run stops with status
-        ``too_many_steps``, keeping what was computed, >= 1. The default is about a
-        hundred times the most any of the paper's cases takes.
+        ``too_many_steps``, keeping what was computed, >= 1; a run estimated to need more
+        is refused before it starts. The default is some minutes of work, about a
+        hundred times what the longest of the paper's cases takes.
     min_flight_time
         Shortest flight of a slider that is resolved [s], > 0: a landing impact that
         would release another slider for less than this keeps it in contact (it ends
@@ -719,7 +720,7 @@ class Simulation(_Table):
     atol: Real = _field(1e-9, gt=0)
     max_step: Real = _field(0.0, "s", ge=0)
     max_switches: Count = _field(10_000_000, ge=1)
-    max_steps: Count = _field(1_000_000_000, ge=1)
+    max_steps: Count = _field(100_000_000, ge=1)
     min_flight_time: Real = _field(1e-11, "s", gt=0)
     energy_balance: Flag = False
     perturbation: Perturbation = Perturbation()

@@ -100,36 +100,61 @@ def tangent_step(model: Model) -> float:
 _STABLE_STEP = 3.3
 
 
-def check_steps(model: Model, duration: float) -> None:
-    """Refuse a run whose fastest time scale needs more steps than
-    ``simulation.max_steps`` allows, before it starts.
+# h omega of a step that meets the tolerance on an oscillation of frequency omega: the
+# local error of DOPRI5 grows as (h omega)^5, so h omega = _ACCURATE rtol^(1/5). The
+# paper's cases take about 4 (0.24 at rtol = 1e-6, 11,500 steps per second against their
+# fastest mode); 8 makes the estimate about half the steps actually taken.
+_ACCURATE = 8.0
 
-    An explicit integrator's step stays within its stability region whatever the
-    tolerance: h <= 3.3 / rate for the fastest rate of :func:`time_scales`, so a run of
-    `duration` [s] takes at least ``duration * rate / 3.3`` steps (a lower bound: contact
-    and friction forces only add to it).
 
-    Raises
-    ------
-    FivdiscError
-        Naming the estimate, the time scale and its keys, and what to change.
+def estimate_steps(model: Model, duration: float) -> tuple[float, str, float]:
+    """A lower estimate of the steps a run of `duration` [s] takes, with the time scale
+    that sets it and its rate [1/s].
+
+    An explicit integrator's step is bounded by its stability region whatever the
+    tolerance, ``h <= 3.3 / rate`` for a decay rate (dampers), and on an oscillation of
+    frequency omega also by the tolerance, ``h omega <= 8 rtol^(1/5)``; the fastest time
+    scale of :func:`time_scales`, or the disc's spin times the largest nodal-diameter
+    count, sets the number of steps. Contact and friction only add to it.
     """
-    what, rate = fastest_time_scale(model)
+    rtol = model.case.simulation.rtol
+    accurate = min(_STABLE_STEP, _ACCURATE * rtol**0.2)
+    oscillating = ("natural frequency", "sqrt(")
+    worst = (0.0, "none", 0.0)
     # The spin shifts a disc frequency by l Omega, small against the time scales for the
     # speeds of brake squeal but not for any speed a profile may reach.
     bp = model.speed.breakpoints
     times = np.concatenate([np.linspace(0.0, duration, 1001), bp[bp < duration]])
     with np.errstate(all="ignore"):
         spin = float(np.max(model.l, initial=0) * np.max(np.abs(model.speed.omega(times))))
-    if not spin <= rate:
-        what, rate = "speed: the disc's spin (largest Omega) times the largest l", spin
-    steps = duration * rate / _STABLE_STEP
+    scales = [*time_scales(model),
+              ("speed: the disc's spin (largest Omega) times the largest l", spin)]
+    for what, rate in scales:
+        rate = math.inf if math.isnan(rate) else rate
+        step = (accurate if any(word in what for word in oscillating) or what.startswith(
+            "speed") else _STABLE_STEP)
+        steps = duration * rate / step
+        if not steps <= worst[0]:
+            worst = (steps, what, rate)
+    return worst
+
+
+def check_steps(model: Model, duration: float) -> None:
+    """Refuse a run whose estimated steps (:func:`estimate_steps`) exceed
+    ``simulation.max_steps``, before it starts.
+
+    Raises
+    ------
+    FivdiscError
+        Naming the estimate, the time scale and its keys, and what to change.
+    """
+    steps, what, rate = estimate_steps(model, duration)
     budget = model.case.simulation.max_steps
     if not steps <= budget:
         raise FivdiscError(
-            f"the run needs at least {steps:.3g} integrator steps, more than "
+            f"the run needs about {steps:.3g} integrator steps, more than "
             f"simulation.max_steps = {budget}: {what} = {rate:.3g} 1/s limits the step to "
-            f"{_STABLE_STEP / rate:.3g} s over simulation.duration = {duration!r} s; change "
+            f"{duration / steps:.3g} s over simulation.duration = {duration!r} s; change "
             "that parameter, shorten the run or raise simulation.max_steps"
         )
 
