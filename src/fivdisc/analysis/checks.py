@@ -77,7 +77,8 @@ def check_orbit_request(case: Case, *, period: float | None = None,
     ------
     FivdiscError
         One line naming the option, its value and what is allowed; also for a disc
-        without modes (nothing to shoot on) and a run whose work estimate exceeds
+        without modes (nothing to shoot on), a window (without a period) shorter than
+        any period, and runs (transient, window, one period) whose work estimate exceeds
         ``simulation.max_steps`` (:func:`fivdisc.integration.check_steps`).
     """
     p_name, t_name, w_name, r_name = names
@@ -93,9 +94,12 @@ def check_orbit_request(case: Case, *, period: float | None = None,
                            "has no disc coordinates to shoot on; give at least one mode")
     if period is not None:
         check_period(case, period, p_name)
+    else:
+        check_period(case, window, w_name)  # no return comes sooner
     from fivdisc.integration import check_steps
     from fivdisc.model import build_model
 
     model = build_model(case)
     run = case.simulation.duration if transient is None else transient
-    check_steps(model, run + window)
+    # The transient, the window searched, and at least one shot over the period.
+    check_steps(model, run + window + (period or 0.0))
