@@ -238,12 +238,17 @@ def test_infinite_and_absurd_options_are_refused(args, words) -> None:
     assert wall < 10
 
 
-def test_orbit_of_a_rigid_disc_is_refused(tmp_path: Path) -> None:
-    path = tmp_path / "rigid.toml"
-    Case(disc={"modes": []}).save(path)
-    result, _ = cli_run(["orbit", str(path)])
+@pytest.mark.parametrize(("tables", "words"), [
+    ({"disc": {"modes": []}}, "disc.modes = [] is invalid for a periodic orbit"),
+    ({"slider": {"preload": 0.0}}, "slider.preload = 0 is invalid for a periodic orbit"),
+], ids=["rigid disc", "no preload"])
+def test_orbit_of_a_system_at_rest_is_refused(tables, words, tmp_path: Path) -> None:
+    path = tmp_path / "c.toml"
+    Case(**tables).save(path)
+    result, wall = cli_run(["orbit", str(path)])
     assert result.exit_code == 2
-    assert "disc.modes = [] is invalid for a periodic orbit" in one_line_error(result)
+    assert words in one_line_error(result)
+    assert wall < 10
 
 
 # --- item 3: no number for a run that is not what it claims ----------------------------------

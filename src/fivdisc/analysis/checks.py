@@ -92,6 +92,9 @@ def check_orbit_request(case: Case, *, period: float | None = None,
     if not case.disc.modes:
         raise FivdiscError("disc.modes = [] is invalid for a periodic orbit: a rigid disc "
                            "has no disc coordinates to shoot on; give at least one mode")
+    if not any(s.preload for s in case.sliders):
+        raise FivdiscError("slider.preload = 0 is invalid for a periodic orbit: without a "
+                           "normal force nothing drives the disc, which stays at rest")
     if period is not None:
         check_period(case, period, p_name)
     else:

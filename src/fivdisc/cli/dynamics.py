@@ -47,7 +47,8 @@ def orbit(case_file: Path, period: float | None, transient: float | None, window
     Runs the case for its duration (or --transient), finds the first return of the
     trajectory and refines the orbit by Newton shooting with the exact monodromy matrix
     (saltation matrices at every switch). CASE_FILE is a TOML file or a packaged example.
-    Exits with status 1 when the period found is shorter than any motion of the model.
+    Exits with status 1 when the period found is shorter than any motion of the model, or
+    Newton shooting did not converge.
     """
     from fivdisc.analysis.checks import check_orbit_request, check_period
     from fivdisc.analysis.orbits import periodic_orbit
@@ -66,6 +67,10 @@ def orbit(case_file: Path, period: float | None, transient: float | None, window
         click.echo(f"error: no periodic orbit: {err}", err=True)
         sys.exit(1)
     _report(res, case, as_json, out)
+    if res.verdict == "not converged" or not res.residual < 1.0:
+        click.echo(f"error: no periodic orbit: Newton shooting did not converge (residual "
+                   f"{res.residual:.3g} after {res.iterations} iterations)", err=True)
+        sys.exit(1)
 
 
 @click.command()
