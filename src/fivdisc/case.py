@@ -286,11 +286,9 @@ class Disc(_Table):
         # Thin-plate theory, and floating point: the plate's stiffness and mass per area
         # must be representable, or the modes overflow.
         h = self.thickness
-        if not h < self.outer_radius - self.inner_radius:
-            raise _rule(
-                "must be < disc.outer_radius - disc.inner_radius = "
-                f"{self.outer_radius - self.inner_radius!r} [m] (a thin plate)",
-                "thickness", h)
+        if not h < self.outer_radius:
+            raise _rule(f"must be < disc.outer_radius = {self.outer_radius!r} [m] (a plate)",
+                        "thickness", h)
         with np.errstate(all="ignore"):
             rigidity = np.float64(self.youngs_modulus) * np.float64(h) ** 3
             per_area = np.float64(self.density) * h

@@ -393,7 +393,10 @@ class Interrupt:
         import signal
         import threading
 
-        if threading.current_thread() is threading.main_thread():
+        # Only over Python's own handler: a process that ignores SIGINT (a sweep's
+        # worker, which its coordinator stops) keeps ignoring it.
+        if (threading.current_thread() is threading.main_thread()
+                and signal.getsignal(signal.SIGINT) is signal.default_int_handler):
             self._previous = signal.signal(signal.SIGINT, self._handle)
         return self
 
