@@ -51,7 +51,9 @@ def check_outcome(result: Result, args: list[str]) -> None:
     assert len(lines) == 1 and lines[0].startswith("error: "), shown
     if result.exit_code == 1:
         assert lines[0].startswith(("error: simulation failed: ", "error: ")), shown
-        assert args[0] == "simulate" or "--verify" in args, shown
+        # documented: a failed simulation, a damaged store, an inconclusive exponent, a
+        # period shorter than any motion of the model
+        assert args[0] in ("simulate", "lyapunov", "orbit") or "--verify" in args, shown
 
 
 def run(args: list[str]) -> Result:
@@ -412,3 +414,86 @@ def _command_line_property(files: dict[str, Path], args: list[str]) -> None:
 test_generated_command_lines = _profile(150, True)(given(args=COMMANDS)(_command_line_property))
 test_generated_command_lines_long = pytest.mark.slow(
     _profile(2000, False)(given(args=COMMANDS)(_command_line_property)))
+
+
+# --- extreme values for every numeric key and option (issue 28, item 7) ----------------------
+
+# Tiny (subnormal, the smallest normal, just above), huge, zero, negative zero, infinite and
+# integers beyond any double's exact range or a TOML integer's.
+EXTREME = st.sampled_from([5e-324, 2.2250738585072014e-308, 1e-300, 1e-30, 1e30, 1e300,
+                           1.7976931348623157e308, 0.0, -0.0, math.inf, -math.inf, -1e308,
+                           9223372036854775807, -9223372036854775807, 10**30])
+# Every numeric key of a case; a speed key also sets its profile.
+NUMERIC_KEYS = [key for key in KEYS if key not in (
+    "disc.modes", "simulation.impact", "simulation.initial_state", "simulation.probes",
+    "simulation.omega_dot_terms", "simulation.printed_gyroscopic_sign")] + [
+    "slider.angle", "disc.damping_ratio", "simulation.min_flight_time", "simulation.max_steps",
+    "speed.value", "speed.initial", "speed.rate", "speed.duration"]
+_PROFILE_OF = {"value": "constant", "rate": "accelerating", "duration": "decelerating",
+               "initial": "decelerating"}
+# The extreme values an option of a command line may take.
+EXTREME_TEXT = EXTREME.map(lambda v: repr(v) if isinstance(v, float) else str(v))
+
+
+@st.composite
+def extreme_cases(draw: st.DrawFn) -> dict[str, Any]:
+    """A short case with one to three numeric keys at extreme values."""
+    tables: dict[str, Any] = {}
+    _set(tables, "simulation.duration", 0.005)
+    _set(tables, "simulation.output_rate", 1000.0)
+    for key in draw(st.lists(st.sampled_from(NUMERIC_KEYS), min_size=1, max_size=3,
+                             unique=True)):
+        if key.startswith("speed."):
+            tables["speed"] = {"profile": _PROFILE_OF[key.split(".")[1]]}
+        _set(tables, key, draw(EXTREME))
+    if draw(st.booleans()):
+        _set(tables, "simulation.initial_state", "equilibrium")
+    return tables
+
+
+# Per example: generous against a loaded machine, far below an unbounded run.
+_EXTREME_BOUND = 60.0
+
+
+def _extreme_case_property(tables: dict[str, Any]) -> None:
+    import time
+
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "case.toml"
+        path.write_text(tomli_w.dumps(tables))
+        start = time.perf_counter()
+        result = run(["simulate", str(path), "-o", str(Path(tmp) / "out.nc"), "--no-progress"])
+        assert time.perf_counter() - start < _EXTREME_BOUND, tables
+        event(f"simulate: exit status {result.exit_code}")
+
+
+EXTREME_COMMANDS = st.one_of(
+    st.tuples(st.sampled_from(["--period", "--window", "--rtol"]), EXTREME_TEXT).map(
+        lambda o: ["orbit", "short.toml", *o]),
+    st.tuples(st.sampled_from(["--transient", "--duration", "--interval", "--n"]),
+              EXTREME_TEXT).map(lambda o: ["lyapunov", "short.toml", *o, "--no-progress"]),
+    st.tuples(st.sampled_from(["--fmax", "--segment", "--probe", "--dpi"]),
+              EXTREME_TEXT).map(lambda o: ["plot", "result.nc", *o, "-o", "{out}/f.png"]),
+)
+
+
+def _extreme_option_property(files: dict[str, Path], args: list[str]) -> None:
+    import time
+
+    with tempfile.TemporaryDirectory() as out, contextlib.chdir(out):
+        short = Path(out) / "short.toml"
+        Case(simulation={"duration": 0.005, "output_rate": 1000.0}).save(short)
+        resolved = [str(short) if a == "short.toml" else
+                    str(files[a]) if a in files else a.format(out=out) for a in args]
+        start = time.perf_counter()
+        result = run(resolved)
+        assert time.perf_counter() - start < _EXTREME_BOUND, args
+        event(f"{args[0]}: exit status {result.exit_code}")
+
+
+# About a minute of CI together (most values are refused before any work).
+test_extreme_case_values = _profile(40, True)(given(extreme_cases())(_extreme_case_property))
+test_extreme_option_values = _profile(30, True)(
+    given(args=EXTREME_COMMANDS)(_extreme_option_property))
+test_extreme_case_values_long = pytest.mark.slow(
+    _profile(500, False)(given(extreme_cases())(_extreme_case_property)))

@@ -246,6 +246,7 @@ def test_the_kernel_lets_other_threads_run():
     model = build_model(Case())
     run = Integration(model, initial_state(model), duration=20.0)
     run.advance(0.0)  # loads the kernel
+    run.call_steps = 10**9  # one call for the whole run, however long
     ticks: list[float] = []
     done = threading.Event()
 

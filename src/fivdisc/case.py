@@ -45,7 +45,7 @@ from pydantic_core import ErrorDetails, PydanticCustomError
 
 from fivdisc.errors import CaseError, nearest
 from fivdisc.files import read_text
-from fivdisc.limits import disc_problem
+from fivdisc.limits import MAX_SLIDERS, disc_problem
 
 __all__ = [
     "AcceleratingSpeed",
@@ -71,6 +71,11 @@ __all__ = [
 ]
 
 _TWO_PI = 2.0 * math.pi
+# Sliders whose angles differ by no more than this [rad] (modulo 2 pi) are in one place.
+_SAME_ANGLE = 1e-12
+_EPS = float(np.finfo(float).eps)
+# Smallest normal double: a product below it has lost its precision.
+_TINY = float(np.finfo(float).tiny)
 _MAX_REPORTED_ERRORS = 3
 _MAX_SHOWN_CHARS = 80
 
@@ -274,6 +279,27 @@ class Disc(_Table):
                 "damping_ratio",
                 self.damping_ratio,
             )
+        return self
+
+    @model_validator(mode="after")
+    def _check_plate(self) -> Disc:
+        # Thin-plate theory, and floating point: the plate's stiffness and mass per area
+        # must be representable, or the modes overflow.
+        h = self.thickness
+        if not h < self.outer_radius:
+            raise _rule(f"must be < disc.outer_radius = {self.outer_radius!r} [m] (a plate)",
+                        "thickness", h)
+        with np.errstate(all="ignore"):
+            rigidity = np.float64(self.youngs_modulus) * np.float64(h) ** 3
+            per_area = np.float64(self.density) * h
+            scale = np.sqrt(rigidity / per_area) / self.outer_radius**2
+        if not (np.isfinite(scale) and scale > 0 and np.isfinite(rigidity)
+                and rigidity >= _TINY and per_area >= _TINY and np.isfinite(per_area)):
+            raise _rule(
+                "with disc.youngs_modulus and disc.density gives a plate whose stiffness "
+                f"E h^3 = {rigidity:.3g} N m or mass per area rho h = {per_area:.3g} kg/m^2 "
+                "is out of floating-point range",
+                "thickness", h)
         return self
 
     @model_validator(mode="after")
@@ -662,6 +688,11 @@ class Simulation(_Table):
         Largest integrator step [s]; 0 means no limit.
     max_switches
         Phase switches (slip, stick, separation) after which the run stops, >= 1.
+    max_steps
+        Integrator steps (accepted and rejected) after which the run stops with status
+        ``too_many_steps``, keeping what was computed, >= 1; a run estimated to need more
+        is refused before it starts. The default is some minutes of work, about a
+        hundred times what the longest of the paper's cases takes.
     min_flight_time
         Shortest flight of a slider that is resolved [s], > 0: a landing impact that
         would release another slider for less than this keeps it in contact (it ends
@@ -687,6 +718,7 @@ class Simulation(_Table):
     atol: Real = _field(1e-9, gt=0)
     max_step: Real = _field(0.0, "s", ge=0)
     max_switches: Count = _field(10_000_000, ge=1)
+    max_steps: Count = _field(100_000_000, ge=1)
     min_flight_time: Real = _field(1e-11, "s", gt=0)
     energy_balance: Flag = False
     perturbation: Perturbation = Perturbation()
@@ -761,7 +793,10 @@ class Case(_Table):
     @model_validator(mode="after")
     def _check_geometry_and_start(self) -> Case:
         a, b = self.disc.inner_radius, self.disc.outer_radius
-        seen: dict[tuple[float, float, str], int] = {}
+        if len(self.sliders) > MAX_SLIDERS:
+            raise _rule(f"must have at most {MAX_SLIDERS} sliders (got {len(self.sliders)}: "
+                        "the work per step grows as the cube of their number)", "sliders",
+                        f"[{len(self.sliders)} tables]")
         for j, slider in enumerate(self.sliders):
             r0 = slider.track_radius
             if not a < r0 < b:
@@ -770,15 +805,19 @@ class Case(_Table):
                     f"{self.slider_key(j)}.track_radius",
                     r0,
                 )
-            place = (r0, round(math.remainder(slider.angle, _TWO_PI), 12), slider.face)
-            if place in seen:
-                raise _rule(
-                    f"puts sliders.{j} where sliders.{seen[place]} is (r = {r0!r} m on the "
-                    f"{slider.face} face): sliders on one face need different angles or radii",
-                    f"sliders.{j}.angle",
-                    slider.angle,
-                )
-            seen[place] = j
+            for i, other in enumerate(self.sliders[:j]):
+                if (other.track_radius, other.face) != (r0, slider.face):
+                    continue
+                # Angles are the same place modulo 2 pi, up to their round-off.
+                gap = abs(math.remainder(slider.angle - other.angle, _TWO_PI))
+                if gap <= _SAME_ANGLE + 8 * _EPS * max(abs(slider.angle), abs(other.angle)):
+                    raise _rule(
+                        f"puts sliders.{j} where sliders.{i} is (r = {r0!r} m on the "
+                        f"{slider.face} face, angles equal modulo 2 pi): sliders on one face "
+                        "need different angles or radii",
+                        f"sliders.{j}.angle",
+                        slider.angle,
+                    )
         for i, probe in enumerate(self.simulation.probes):
             if not a <= probe[0] <= b:
                 raise _rule(
@@ -903,6 +942,13 @@ class Case(_Table):
         CaseError
             An unknown key or an invalid resulting case.
         """
+        if not isinstance(updates, Mapping):
+            raise CaseError(f"updates = {_show(updates)} is invalid: must be a mapping of "
+                            "dotted keys to values, e.g. {'slider.mass': 0.2}")
+        for key in updates:
+            if not isinstance(key, str):
+                raise CaseError(f"updates key {key!r} is invalid: must be a dotted key "
+                                "(str), e.g. 'slider.mass'")
         data = self.model_dump()
         tags = {f"{u.table}.{u.tag}" for u in _UNIONS.values()}
         # Shallow keys first, then a union's tag before its sibling keys.
@@ -989,6 +1035,9 @@ def _parse(text: str, source: str | None) -> Case:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         message = f"invalid TOML: {exc}"
+        raise CaseError(f"{source}: {message}" if source else message) from None
+    except RecursionError:
+        message = "invalid TOML: arrays or tables nested too deeply"
         raise CaseError(f"{source}: {message}" if source else message) from None
     return _validate(data, source)
 

@@ -255,7 +255,8 @@ class Summary:
     sliders : tuple of SliderSummary
         Per slider, in order.
     switches : int
-        Phase switches of all sliders.
+        Switches of the run: instants at which one or more sliders change phase (what
+        ``simulation.max_switches`` counts).
     impacts : int
         Plastic impacts at re-contact (0 when ``simulation.impact`` is off).
     max_abs_w : float
@@ -266,6 +267,12 @@ class Summary:
         The disc's thickness h [m] (nan if the file does not say). Linear plate theory
         assumes |w| small against h: the printed summary warns when ``max_abs_w``
         exceeds it (runs end as diverged beyond 25 h, see ``simulate``).
+    phase_changes : int
+        Phase changes of all sliders (the rows of the event table; one switch may change
+        several sliders' phases); -1 if not known.
+    degenerate : str
+        Why the case is degenerate (no preload, no friction, no probes, a response below
+        any physical scale; see :func:`fivdisc.simulate.degenerate`), "" if it is not.
     """
 
     status: str
@@ -276,6 +283,8 @@ class Summary:
     max_abs_w: float
     wall_time: float
     disc_thickness: float = float("nan")
+    phase_changes: int = -1
+    degenerate: str = ""
 
     @property
     def separations(self) -> int:
@@ -307,11 +316,16 @@ class Summary:
         for j, s in enumerate(self.sliders):
             spent = ", ".join(f"{k} {v:.4g} s" for k, v in s.time_in_phase.items())
             out.append(f"{f'slider {j} ' if several else ''}time in phase: {spent}")
-        out.append(f"switches: {self.switches}, separations: {self.separations}, "
+        changes = (f" ({self.phase_changes} phase changes)"
+                   if self.phase_changes not in (-1, self.switches) else "")
+        out.append(f"switches: {self.switches}{changes}, separations: {self.separations}, "
                    f"impacts: {self.impacts}")
         peaks = ", ".join(f"{s.peak_normal_force:.6g}" for s in self.sliders)
-        out.append(f"peak normal force: {peaks} N, largest |w| at probes: "
-                   f"{self.max_abs_w:.6g} m")
+        at_probes = ("not recorded" if np.isnan(self.max_abs_w)
+                     else f"{self.max_abs_w:.6g} m")
+        out.append(f"peak normal force: {peaks} N, largest |w| at probes: {at_probes}")
+        if self.degenerate:
+            out.append(f"warning: degenerate case: {self.degenerate}")
         if self.max_abs_w > self.disc_thickness:
             out.append(f"warning: |w| reached {self.max_abs_w / self.disc_thickness:.3g} "
                        "times the disc thickness, beyond the small deflections of linear "
@@ -431,7 +445,9 @@ class Result:
             status=self.status,
             end_time=float(ds.attrs.get("end_time", ds["time"].values[-1])),
             sliders=tuple(sliders),
-            switches=int(kinds.size),
+            switches=int(ds.attrs.get("n_switches", kinds.size)),
+            phase_changes=int(kinds.size),
+            degenerate=str(ds.attrs.get("degenerate", "")),
             impacts=impacts,
             max_abs_w=float(np.nanmax(w, initial=0.0) if np.isfinite(w).any() else np.nan),
             wall_time=float(ds.attrs.get("wall_time", np.nan)),

@@ -8,13 +8,12 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from fivdisc import integration
 from fivdisc._kernels import integrate as kern
 from fivdisc._kernels import slots
 from fivdisc.case import Case
 from fivdisc.compilation import compile_notice
 from fivdisc.errors import SimulationError
-from fivdisc.integration import STATUS, Integration
+from fivdisc.integration import STATUS, Integration, check_steps
 from fivdisc.limits import check_simulation
 from fivdisc.model import Model, build_model
 from fivdisc.result import EVENT_KINDS, PHASE_NAMES, Result, build_dataset
@@ -25,6 +24,8 @@ from fivdisc.warmup import warm_up
 # Failures in which a state beyond the plate theory's range means the model diverged.
 _BLOW_UPS = ("nonfinite", "step_size_underflow")
 _CHUNKS = 200
+#: Largest initial rotation of a slider [rad].
+MAX_PHI = 1e6
 
 
 def initial_state(model: Model, initial=None) -> np.ndarray:
@@ -56,7 +57,7 @@ def initial_state(model: Model, initial=None) -> np.ndarray:
             y = sliding_equilibrium(model).state.copy()
             y[phi] += sim.perturbation.phi
             y[phi_dot] += sim.perturbation.phi_dot
-            return y
+            return _checked(y, phi)
         raise SimulationError(
             f"initial = {initial!r} is invalid: must be 'rest', 'equilibrium', a mapping "
             "or a state array"
@@ -89,8 +90,19 @@ def initial_state(model: Model, initial=None) -> np.ndarray:
                 f"initial state has shape {y.shape}: must be ({model.state_size},) = "
                 "2 (n + 2 S)"
             )
+    return _checked(y, phi)
+
+
+def _checked(y: np.ndarray, phi: slice) -> np.ndarray:
+    """``y``, refused unless finite with slider rotations within :data:`MAX_PHI`."""
     if not np.all(np.isfinite(y)):
         raise SimulationError("initial state is invalid: all values must be finite")
+    largest = float(np.max(np.abs(y[phi]), initial=0.0))
+    if largest > MAX_PHI:
+        raise SimulationError(
+            f"initial phi = {largest:g} rad is invalid: must be within +-{MAX_PHI:g} rad "
+            "(further out a double resolves the slider's angle to no better than 1e-10 rad)"
+        )
     return y
 
 
@@ -134,16 +146,35 @@ def simulate(
     CaseError
         `speed` is not a profile or a pair of callables, or cannot be represented.
     """
+    if not isinstance(case, Case):
+        raise SimulationError(
+            f"case = {type(case).__name__} is invalid: must be a fivdisc.Case (Case(...), "
+            "Case.model_validate(dict) or load_case(path))"
+        )
     sim = case.simulation
     check_simulation(case)
     speed = SpeedProfile.from_override(speed, sim.duration)
+    if speed is not None and not speed.end >= sim.duration:
+        raise SimulationError(
+            f"speed is invalid: the profile ends at t = {speed.end!r} s, before "
+            f"simulation.duration = {sim.duration!r} s (it would be extrapolated); give "
+            "it over the whole run"
+        )
     for kind in stop_on:
         if kind not in EVENT_KINDS:
             raise SimulationError(
                 f"stop_on = {kind!r} is invalid: must be one of {', '.join(EVENT_KINDS)}"
             )
     model = build_model(case, speed)
+    check_steps(model, sim.duration)
     y0 = initial_state(model, initial)
+    limit = Deflection(model)
+    if limit.beyond(y0):
+        raise SimulationError(
+            f"the initial state is invalid: it deflects the disc by {limit.largest:.3g} m, "
+            f"more than {limit.DIVERGED:g} times disc.thickness, where the run would end as "
+            "diverged"
+        )
     run = Integration(model, y0, duration=sim.duration, output_rate=sim.output_rate,
                       stop_on=stop_on, energy=sim.energy_balance)
 
@@ -162,37 +193,41 @@ def simulate(
                    bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s [{elapsed}<{remaining}]")
     start = _time.perf_counter()
     status = slots.ST_RUNNING
-    interrupted = False
-    limit = Deflection(model)
-    try:
-        # The kernel's step-size controller restarts at each return (the saved outputs
-        # of the paper's cases follow this grid), so the grid is fixed, not adaptive.
-        for chunk in range(1, _CHUNKS + 1):
-            status = run.run_to(sim.duration * chunk / _CHUNKS)
+    with Interrupt() as interrupt:
+        try:
+            # The kernel's step-size controller restarts at each chunk (the saved outputs
+            # of the paper's cases follow this grid), so the grid is fixed, not adaptive;
+            # within a chunk each call is bounded (Integration.advance), and an interrupt
+            # is taken between calls.
+            for chunk in range(1, _CHUNKS + 1):
+                target = sim.duration * chunk / _CHUNKS
+                while not interrupt.requested:
+                    status = run.advance(target)
+                    if bar is not None:
+                        bar.update(run.t - bar.n)
+                    if status != slots.ST_RUNNING or run.t >= target:
+                        break
+                if interrupt.requested or limit.exceeded(run) or status != slots.ST_RUNNING:
+                    break
+        except KeyboardInterrupt:
+            interrupt.requested = True
+        finally:
             if bar is not None:
-                bar.update(run.t - bar.n)
-            if limit.exceeded(run):
-                break
-            if status != slots.ST_RUNNING:
-                break
-    except KeyboardInterrupt:
-        interrupted = True
-    finally:
-        if bar is not None:
-            bar.close()
+                bar.close()
+    interrupted = interrupt.requested
     wall = _time.perf_counter() - start
 
     t_end = run.t
     ph = run.ph
     y = run.y
-    phases = ", ".join(PHASE_NAMES[p] for p in ph)
+    phases = _phases(ph)
     name = STATUS.get(status, "unknown")
     if interrupted:
         name, message = "interrupted", f"interrupted at t = {t_end:.9g} s in {phases}"
     elif limit.when is not None or (name in _BLOW_UPS and limit.beyond(y)):
         name, message = "diverged", limit.message(t_end)
     else:
-        message = _message(name, t_end, phases, sim)
+        message = _message(name, t_end, phases, case, run)
     n_done = run.n_samples
     times = np.minimum(np.arange(n_done) / sim.output_rate, sim.duration)
     ist = run.ist
@@ -204,6 +239,8 @@ def simulate(
         "end_time": float(t_end),
         "impact": int(sim.impact),
         "case": case.to_toml(),
+        "speed_source": "case" if speed is None else
+        f"{speed.source} given to simulate (the case's [speed] table is not used)",
         "fivdisc_version": package.__version__,
         "wall_time": wall,
         "n_steps": int(ist[slots.I_STEPS]),
@@ -217,7 +254,43 @@ def simulate(
     imported()
     ds = build_dataset(model, run.out_y[:n_done], run.out_aux[:n_done], times, run.events(),
                        attrs)
+    ds.attrs["degenerate"] = degenerate(case, ds, limit.largest)
     return Result(ds)
+
+
+# Below these a run's response has no physical meaning (a thousandth of a nanometre; a
+# nanonewton, a millionth of a gram's weight): a case that stays below them is degenerate.
+_NO_DEFLECTION = 1e-12
+_NO_FORCE = 1e-9
+
+
+def degenerate(case: Case, ds, largest_w: float) -> str:
+    """Why the run of `case` (its dataset `ds`) says nothing about friction-induced
+    vibration, in one line ("" if nothing does): no preload or no friction, no probes,
+    or a response that stays below any physical scale (`largest_w` [m]: the largest
+    deflection under the sliders and at the probes)."""
+    reasons = []
+    zero = [f"{case.slider_key(j)}.preload" for j, s in enumerate(case.sliders)
+            if s.preload == 0]
+    if zero:
+        reasons.append(f"{', '.join(zero)} = 0 N (no normal force, so no friction)")
+    law = case.friction
+    coefficients = [law.static, *(v for _, v in law.kinetic_at_rest()),
+                    getattr(law, "kinetic_min", 0.0), *getattr(law, "values", ())]
+    if not any(coefficients):
+        reasons.append("every friction coefficient is 0 (no friction force)")
+    if not case.simulation.probes:
+        reasons.append("simulation.probes = [] (no deflection is recorded)")
+    if ds.sizes["time"] > 1:
+        force = ds["normal_force"].values
+        peak = float(np.nanmax(force)) if np.isfinite(force).any() else math.nan
+        if len(zero) < len(case.sliders) and peak < _NO_FORCE:
+            reasons.append(f"the normal force stays below {_NO_FORCE:g} N (peak {peak:.3g} N)")
+        if largest_w < _NO_DEFLECTION:
+            reasons.append(f"the disc's deflection stays below {_NO_DEFLECTION:g} m (largest "
+                           f"{largest_w:.3g} m): check disc.density, disc.youngs_modulus, "
+                           "the preloads")
+    return "; ".join(reasons)
 
 
 class Deflection:
@@ -302,16 +375,71 @@ class Deflection:
                 "printed_gyroscopic_sign = true)")
 
 
-def _message(name: str, t: float, phase: str, sim) -> str:
+class Interrupt:
+    """While active (a ``with`` block in the main thread), the first SIGINT (Ctrl-C) sets
+    :attr:`requested` instead of raising, so that a run stops between two kernel calls
+    and keeps what it computed; a second one interrupts at once."""
+
+    def __init__(self) -> None:
+        self.requested = False
+        self._previous = None
+
+    def _handle(self, signum, frame) -> None:
+        if self.requested:
+            raise KeyboardInterrupt
+        self.requested = True
+
+    def __enter__(self) -> Interrupt:
+        import signal
+        import threading
+
+        # Only over Python's own handler: a process that ignores SIGINT (a sweep's
+        # worker, which its coordinator stops) keeps ignoring it.
+        if (threading.current_thread() is threading.main_thread()
+                and signal.getsignal(signal.SIGINT) is signal.default_int_handler):
+            self._previous = signal.signal(signal.SIGINT, self._handle)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._previous is not None:
+            import signal
+
+            signal.signal(signal.SIGINT, self._previous)
+
+
+def _phases(ph: np.ndarray) -> str:
+    """The sliders' phases in a message: each one's, or how many are in each."""
+    if ph.size <= 8:
+        return ", ".join(PHASE_NAMES[p] for p in ph)
+    return ", ".join(f"{np.sum(ph == i)} sliders in {name}"
+                     for i, name in enumerate(PHASE_NAMES) if np.any(ph == i))
+
+
+def _sliders(case: Case, sliders: tuple[int, ...]) -> str:
+    names = [case.slider_key(j) for j in sliders]
+    if len(names) > 8:
+        names = [*names[:8], f"... ({len(names)} sliders)"]
+    return ", ".join(names)
+
+
+def _message(name: str, t: float, phase: str, case: Case, run: Integration) -> str:
+    sim = case.simulation
     where = f"at t = {t:.9g} s in {phase}"
+    if name == "endless_switching":
+        return (f"endless switching (Zeno/chattering) {where}: switches accumulate among "
+                f"{_sliders(case, run.zeno_sliders)} ({run.zeno_count} switches "
+                f"within {run.zeno_span:.3g} s); check the parameters of these sliders "
+                "(an impact cascade between sliders close together, a stiff contact)")
     return {
         "success": f"reached t = {sim.duration} s",
         "stopped": f"stopped early on request at t = {t:.9g} s",
         "nonfinite": f"state became non-finite {where}; try smaller simulation.rtol/atol "
         "or check the parameters",
         "step_size_underflow": f"step size underflow {where}; try looser simulation.rtol/atol",
-        "endless_switching": f"endless switching (Zeno/chattering) {where}: "
-        f"{integration.ZENO_COUNT} switches less than {integration.ZENO_DT} s apart",
-        "max_switches": f"simulation.max_switches = {sim.max_switches} reached {where}",
+        "max_switches": f"simulation.max_switches = {sim.max_switches} reached {where} "
+        f"after {run.ist[slots.I_SWITCHES]} switches",
+        "too_many_steps": f"simulation.max_steps = {sim.max_steps} steps tried {where} "
+        f"(mean step {t / max(run.steps_tried, 1):.3g} s); raise simulation.max_steps, "
+        "loosen simulation.rtol/atol or check the parameters (a stiff spring or damper)",
     }.get(name, f"ended {where}")
 

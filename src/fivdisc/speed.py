@@ -62,11 +62,19 @@ class SpeedProfile:
         ``(len(knots), 4)`` polynomial coefficients [rad/s, rad/s^2, rad/s^3, rad/s^4].
     breakpoints : ndarray
         Times where Omegadot jumps [s]; the integrator stops and restarts there.
+    end : float
+        Last time the profile represents [s] (inf: all times); a simulation may not run
+        past it.
+    source : str
+        Where the profile comes from, kept with a run's result: ``"callables"``
+        (:meth:`from_callables`) or ``"profile"`` (any other).
     """
 
     knots: np.ndarray
     coefficients: np.ndarray
     breakpoints: np.ndarray
+    end: float = math.inf
+    source: str = "profile"
 
     @classmethod
     def constant(cls, value: float) -> SpeedProfile:
@@ -220,7 +228,7 @@ class SpeedProfile:
 
         def sample(t: float, left: bool = False) -> tuple[float, float]:
             tt = float(np.nextafter(t, -np.inf)) if left else t
-            w, wd = float(omega(tt)), float(omega_dot(tt))
+            w, wd = _real(omega, "Omega", tt), _real(omega_dot, "Omegadot", tt)
             if not (math.isfinite(w) and math.isfinite(wd)) or w < 0.0:
                 raise CaseError(
                     f"speed profile gives Omega({t}) = {w}, Omegadot = {wd}: "
@@ -282,7 +290,7 @@ class SpeedProfile:
                     f"rtol_dot={rtol_dot} (near t = {lo:.9g} s); declare its kinks as "
                     "breakpoints or loosen rtol / rtol_dot"
                 )
-        return cls(np.array(knots), np.array(coefs), np.array(bps))
+        return cls(np.array(knots), np.array(coefs), np.array(bps), float(t_end), "callables")
 
     def _locate(self, t: np.ndarray) -> np.ndarray:
         return np.clip(np.searchsorted(self.knots, t, side="right") - 1, 0, None)
@@ -308,6 +316,19 @@ class SpeedProfile:
         """Whether Omega never changes."""
         coef = self.coefficients
         return bool(np.all(coef[:, 1:] == 0.0) and np.ptp(coef[:, 0]) == 0.0)
+
+
+def _real(f: Callable[[float], float], name: str, t: float) -> float:
+    """``f(t)`` as a float, refused in one line unless it is a real number."""
+    value = f(t)
+    if isinstance(value, np.ndarray) and value.size == 1:
+        value = value.reshape(()).item()
+    if isinstance(value, (bool, complex, np.complexfloating, np.bool_)) or not isinstance(
+            value, (int, float, np.integer, np.floating)):
+        shown = repr(value)[:_SHOWN_CHARS]
+        raise CaseError(f"speed callable {name}({t!r}) returned {shown} "
+                        f"({type(value).__name__}): must return a real number")
+    return float(value)
 
 
 def _check_derivative(omega: Callable[[float], float], t: float, omega_dot: float,

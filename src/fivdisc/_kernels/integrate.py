@@ -1,7 +1,9 @@
 """The non-smooth time integration: adaptive DOPRI5 steps inside a phase machine.
 
 One call of :func:`run` advances the integrator from its saved state until a target
-time is passed, the run ends, it fails, or the event buffer is nearly full; the
+time is passed, the run ends, it fails, the event buffer is nearly full, or it has tried
+its budget of steps (so that the caller can report progress, count steps against a
+budget and stop on an interrupt however slowly the integration goes); the
 caller (``fivdisc.simulate``) loops over calls, which gives progress reporting
 without changing the step sequence (the integrator state is carried over exactly).
 
@@ -33,6 +35,7 @@ from fivdisc._kernels.layout import (
 )
 from fivdisc._kernels.slots import (
     C_ATOL,
+    C_CALL_STEPS,
     C_MAX_STEP,
     C_MAX_SWITCHES,
     C_OUT_DT,
@@ -42,6 +45,7 @@ from fivdisc._kernels.slots import (
     C_ZENO_COUNT,
     C_ZENO_DT,
     EVI_KIND,
+    F_ERR_OLD,
     F_H,
     F_H_CAP,
     F_LAST_SWITCH,
@@ -50,6 +54,7 @@ from fivdisc._kernels.slots import (
     I_EVAL_EVENTS,
     I_EVENTS,
     I_OUT_NEXT,
+    I_PAUSED,
     I_REJECTED,
     I_RHS,
     I_STARTED,
@@ -429,14 +434,22 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
         ist[I_RHS] += 2
 
     status = ST_RUNNING
-    after_reject = False
-    err_old = 1e-4
+    after_reject = ist[I_PAUSED] == 2
+    err_old = fst[F_ERR_OLD] if ist[I_PAUSED] else 1e-4
+    ist[I_PAUSED] = 0
+    call_steps = ctl[C_CALL_STEPS]
+    tried = 0
     while True:
         if t >= t_final:
             status = ST_DONE
             break
         if t >= t_target or ist[I_EVENTS] > cap - 4 * n_sl - 4:
             break
+        if tried >= call_steps > 0:
+            ist[I_PAUSED] = 2 if after_reject else 1
+            fst[F_ERR_OLD] = err_old
+            break
+        tried += 1
         kb = np.searchsorted(breaks, t, side="right")
         tb = breaks[kb] if kb < breaks.shape[0] else t_final
         tb = min(tb, t_final)

@@ -9,6 +9,8 @@ ST_UNDERFLOW = 3
 ST_ZENO = 4
 ST_MAX_SWITCHES = 5
 ST_STOPPED = 6
+# Set by the caller (fivdisc.integration), not the kernel: the step budget is spent.
+ST_TOO_MANY_STEPS = 7
 
 # Integer state slots.
 I_STATUS = 0
@@ -21,7 +23,10 @@ I_SWITCHES = 6
 I_ZENO = 7
 I_STARTED = 8
 I_EVAL_EVENTS = 9
-N_ISTATE = 10
+# 1 (2 after a rejected step) when the last call ended on its step budget: the next call
+# resumes the step-size controller where it was, so splitting a run changes no step.
+I_PAUSED = 10
+N_ISTATE = 11
 
 # Float state slots.
 F_T = 0
@@ -30,7 +35,9 @@ F_LAST_SWITCH = 2
 F_H_CAP = 3
 # Largest |w| under the sliders at the samples written since the caller reset it.
 F_W_PEAK = 4
-N_FSTATE = 5
+# The step-size controller's previous error, kept across a paused call.
+F_ERR_OLD = 5
+N_FSTATE = 6
 
 # Control slots.
 C_RTOL = 0
@@ -42,7 +49,9 @@ C_MAX_SWITCHES = 5
 C_ZENO_DT = 6
 C_ZENO_COUNT = 7
 C_STOP_MASK = 8
-N_CONTROL = 9
+# Steps (accepted and rejected) one call may try before it returns; <= 0: no bound.
+C_CALL_STEPS = 9
+N_CONTROL = 10
 
 # Columns of the event table's integer part.
 EVI_KIND = 0

@@ -120,14 +120,24 @@ def sliding_equilibrium(
     # deflected statically by the preloads.
     mu = np.array([dyn.kinetic_friction(kern.opts, kern.table, radius[j], 1, omega_c)
                    for j in range(ns)])
-    phi0 = radius * mu * n0 / kern.row("kphi")
-    stiff = model.modal_mass * (model.omega**2 - model.l**2 * omega_c**2)
-    q0 = np.zeros(n)
-    for j in range(ns):
-        psi = kern.row("theta")[j] + phi0[j]
-        g = np.where(model.sgn > 0, np.cos(model.l * psi), np.sin(model.l * psi)) * model.shape[j]
-        q0 -= kern.slider[lay.S_SN0, j] * g / stiff
+    with np.errstate(all="ignore"):
+        phi0 = radius * mu * n0 / kern.row("kphi")
+        stiff = model.modal_mass * (model.omega**2 - model.l**2 * omega_c**2)
+        q0 = np.zeros(n)
+        for j in range(ns):
+            psi = kern.row("theta")[j] + phi0[j]
+            g = np.where(model.sgn > 0, np.cos(model.l * psi),
+                         np.sin(model.l * psi)) * model.shape[j]
+            q0 -= kern.slider[lay.S_SN0, j] * g / stiff
     x0 = np.append(q0, phi0)
+    if not np.all(np.isfinite(x0)):
+        # Parameters out of range (a preload or friction torque against a vanishing
+        # spring): the static deflection is not representable.
+        raise SimulationError(
+            f"no sliding equilibrium at Omega = {omega_c} rad/s: the static deflection by "
+            "the preloads is out of floating-point range (check slider.preload, "
+            "slider.rotational_stiffness, the friction coefficients)"
+        )
     if guess is not None and guess.q.size == n and np.size(guess.phi) == ns:
         x0 = np.append(guess.q, guess.phi)
 

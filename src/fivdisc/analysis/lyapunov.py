@@ -21,7 +21,7 @@ import numpy as np
 
 from fivdisc.case import Case
 from fivdisc.errors import FivdiscError
-from fivdisc.integration import Integration, tangent_step
+from fivdisc.integration import Integration, check_steps, tangent_step
 from fivdisc.model import build_model
 
 __all__ = ["LyapunovSpectrum", "lyapunov"]
@@ -30,6 +30,8 @@ __all__ = ["LyapunovSpectrum", "lyapunov"]
 _BLOCKS = 10
 # [s]: the default re-orthonormalisation interval.
 DEFAULT_INTERVAL = 0.05
+#: Most re-orthonormalisations of one measurement (each keeps a row of n logarithms).
+MAX_INTERVALS = 1_000_000
 
 
 @dataclass(frozen=True)
@@ -67,6 +69,26 @@ class LyapunovSpectrum:
         """The largest exponent [1/s]."""
         return float(self.exponents[0])
 
+    @property
+    def conclusive(self) -> np.ndarray:
+        """``(n,)`` whether each exponent is known: its uncertainty is finite and smaller
+        than its magnitude (else even its sign is not; a collapsed direction's -inf is
+        known)."""
+        e, u = self.exponents, self.uncertainty
+        with np.errstate(invalid="ignore"):
+            return np.isneginf(e) | (np.isfinite(e) & np.isfinite(u) & (u < np.abs(e)))
+
+    def verdict(self, i: int) -> str:
+        """Why exponent ``i`` is inconclusive ("" if it is not)."""
+        if self.conclusive[i]:
+            return ""
+        e, u = self.exponents[i], self.uncertainty[i]
+        if not np.isfinite(u):
+            return (f"lambda_{i + 1} = {e:+.6g} 1/s has no uncertainty estimate (too few "
+                    "re-orthonormalisations: lengthen the measurement or shorten the interval)")
+        return (f"lambda_{i + 1} = {e:+.6g} 1/s has an uncertainty of {u:.2g} 1/s, more than "
+                "its magnitude (lengthen the measurement)")
+
     def to_dict(self) -> dict:
         """Exponents [1/s] (largest first) and their uncertainty as plain JSON types
         (-inf, for a collapsed direction, as ``null``)."""
@@ -74,6 +96,7 @@ class LyapunovSpectrum:
             return [float(v) if np.isfinite(v) else None for v in values]
 
         return {"exponents": plain(self.exponents), "uncertainty": plain(self.uncertainty),
+                "conclusive": [bool(c) for c in self.conclusive],
                 "transient": self.transient, "duration": self.duration,
                 "interval": self.interval}
 
@@ -107,7 +130,8 @@ class LyapunovSpectrum:
         lines = [f"Lyapunov exponents over {self.duration:g} s after a {self.transient:g} s "
                  f"transient (QR every {self.interval:g} s) [1/s]:"]
         for i, (e, u) in enumerate(zip(self.exponents, self.uncertainty, strict=True)):
-            lines.append(f"  lambda_{i + 1} = {e:+.6g} +- {u:.2g}")
+            mark = "" if self.conclusive[i] else "  (inconclusive)"
+            lines.append(f"  lambda_{i + 1} = {e:+.6g} +- {u:.2g}{mark}")
         return "\n".join(lines)
 
 
@@ -167,28 +191,35 @@ def lyapunov(
     duration = sim.duration if duration is None else duration
     if interval is None:
         interval = min(DEFAULT_INTERVAL, duration) if duration > 0 else DEFAULT_INTERVAL
-    checks = (("transient", transient, transient >= 0), ("duration", duration, duration > 0),
-              ("interval", interval, interval > 0 and interval <= duration))
-    for name, value, ok in checks:
-        if not ok:
-            allowed = "<= duration" if name == "interval" and interval > 0 else (
-                ">= 0" if name == "transient" else "> 0")
-            raise FivdiscError(f"{name} = {value!r} is invalid: must be {allowed} [s]")
-    if not isinstance(n, (int, np.integer)) or n < 1:
+    from fivdisc.analysis.checks import check_time
+
+    check_time("transient", transient, zero=True)
+    check_time("duration", duration)
+    check_time("interval", interval)
+    if not interval <= duration:
+        raise FivdiscError(f"interval = {interval!r} is invalid: must be <= duration [s]")
+    if duration / interval > MAX_INTERVALS:
+        raise FivdiscError(
+            f"interval = {interval!r} is invalid: duration / interval = "
+            f"{duration / interval:.3g} re-orthonormalisations, more than {MAX_INTERVALS:g}; "
+            "must be >= duration / 1e6 [s]")
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise FivdiscError(f"n = {n!r} is invalid: must be an integer >= 1")
     from fivdisc.analysis.orbits import energy_scales
-    from fivdisc.simulate import initial_state
+    from fivdisc.simulate import Deflection, initial_state
 
     model = build_model(case)
+    check_steps(model, transient + duration)
     cap = tangent_step(model)
     if sim.max_step > 0:
         cap = min(cap, sim.max_step)
     run = Integration(model, initial_state(model, initial), duration=transient + duration,
                       rtol=rtol, atol=atol, max_step=cap)
     run.advance(0.0)
+    limit = Deflection(model)
     if transient > 0:
         run.run_to(transient)
-        _check(run, "the transient")
+        _check(run, limit, "the transient")
     free = run.free()
     if n > free.sum():
         raise FivdiscError(f"n = {n} is invalid: must be at most {int(free.sum())}, the "
@@ -212,10 +243,10 @@ def lyapunov(
         # The first interval compiles the kernel with tangents in a fresh installation.
         with tangent_notice(show=progress):
             run.set_tangents((q * sc[:, None]).T)
-            _interval(run, 0, logs, times, t0, interval, transient + duration, sc)
+            _interval(run, limit, 0, logs, times, t0, interval, transient + duration, sc)
         for k in range(steps):
             if k:
-                _interval(run, k, logs, times, t0, interval, transient + duration, sc)
+                _interval(run, limit, k, logs, times, t0, interval, transient + duration, sc)
             if bar is not None:
                 bar.update()
     finally:
@@ -237,12 +268,12 @@ def lyapunov(
                             float(duration), float(interval))
 
 
-def _interval(run: Integration, k: int, logs: np.ndarray, times: np.ndarray, t0: float,
-              interval: float, end: float, sc: np.ndarray) -> None:
+def _interval(run: Integration, limit, k: int, logs: np.ndarray, times: np.ndarray,
+              t0: float, interval: float, end: float, sc: np.ndarray) -> None:
     """Integrate the k-th interval, then re-orthonormalise (energy norm) and keep the
     logarithms of the stretching factors."""
     run.run_to(min(t0 + (k + 1) * interval, end))
-    _check(run, "the measurement")
+    _check(run, limit, "the measurement")
     q, r = np.linalg.qr(run.tangents(slaved=False).T / sc[:, None])
     with np.errstate(divide="ignore"):
         logs[k] = np.log(np.abs(np.diag(r)))
@@ -251,7 +282,13 @@ def _interval(run: Integration, k: int, logs: np.ndarray, times: np.ndarray, t0:
     times[k] = run.t - t0
 
 
-def _check(run: Integration, what: str) -> None:
+def _check(run: Integration, limit, what: str) -> None:
+    """Refuse to go on from a run that failed or left the model's range (as
+    :func:`fivdisc.simulate` would call it diverged): its exponents would describe a
+    blow-up, not the case."""
+    if limit.beyond(run.y):
+        raise FivdiscError(f"lyapunov: the run diverged during {what}: "
+                           f"{limit.message(run.t)}")
     if run.status_name not in ("running", "success"):
         raise FivdiscError(f"lyapunov: the run ended with {run.status_name} at "
                            f"t = {run.t:.9g} s during {what}")

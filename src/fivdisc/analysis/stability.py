@@ -411,4 +411,8 @@ def parse_range(text: str, option: str) -> tuple[str, np.ndarray]:
         raise CaseError(usage) from None
     if values.size < 1 or not np.all(np.isfinite(values)):
         raise CaseError(usage)
+    # -0.0 == 0.0: np.unique counts them as one value.
+    if np.unique(values).size != values.size:
+        raise CaseError(f"{option} = {text!r} is invalid: its values must be distinct "
+                        "(a repeated value gives a map of repeated columns or curves)")
     return resolve_key(key.strip(), option), values

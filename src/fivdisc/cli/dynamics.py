@@ -55,9 +55,11 @@ def orbit(case_file: Path | None, period: float | None, transient: float | None,
     Runs the case for its duration (or --transient), finds the first return of the
     trajectory and refines the orbit by Newton shooting with the exact monodromy matrix
     (saltation matrices at every switch); the orbit is reported at its minimal period.
-    CASE_FILE is a TOML file or a packaged example. An orbit that does not converge is
-    not a result: exit status 1, with the residual reached.
+    CASE_FILE is a TOML file or a packaged example. An orbit that does not converge, or
+    whose period is shorter than any motion of the model, is not a result: exit status
+    1, with the residual reached.
     """
+    from fivdisc.analysis.checks import check_orbit_request, check_period
     from fivdisc.analysis.orbits import periodic_orbit, saved_start
     from fivdisc.case import load_case
     from fivdisc.errors import ConvergenceError, FivdiscError
@@ -74,6 +76,7 @@ def orbit(case_file: Path | None, period: float | None, transient: float | None,
         period = period if period is not None else saved_period
     if case is None:
         raise FivdiscError("orbit needs CASE_FILE, or --from a file that stores its case")
+    check_orbit_request(case, period=period, transient=transient, window=window, rtol=rtol)
     try:
         res = periodic_orbit(case, guess, period=period, phases=phases, transient=transient,
                              window=window, rtol=rtol, start=start, progress=progress)
@@ -81,6 +84,11 @@ def orbit(case_file: Path | None, period: float | None, transient: float | None,
         if as_json and exc.result is not None:
             click.echo(exc.result.to_json())
         click.echo(f"error: {exc}", err=True)
+        sys.exit(1)
+    try:
+        check_period(case, res.period, "the period found")
+    except FivdiscError as err:
+        click.echo(f"error: no periodic orbit: {err}", err=True)
         sys.exit(1)
     _report(res, case, as_json, out)
 
@@ -108,7 +116,8 @@ def lyapunov(case_file: Path, count: int, transient: float | None, duration: flo
     """Lyapunov exponents of CASE_FILE by the QR method on the tangent dynamics.
 
     The tangent vectors are carried across every switch by its saltation matrix.
-    CASE_FILE is a TOML file or a packaged example.
+    CASE_FILE is a TOML file or a packaged example. Exits with status 1 when the largest
+    exponent is inconclusive (its uncertainty unknown or larger than itself).
     """
     from fivdisc.analysis.lyapunov import lyapunov as compute
     from fivdisc.case import load_case
@@ -119,3 +128,6 @@ def lyapunov(case_file: Path, count: int, transient: float | None, duration: flo
     res = compute(case, n=count, transient=transient, duration=duration, interval=interval,
                   progress=progress)
     _report(res, case, as_json, out)
+    if not res.conclusive[0]:
+        click.echo(f"error: the largest exponent is inconclusive: {res.verdict(0)}", err=True)
+        sys.exit(1)

@@ -328,6 +328,12 @@ def run_sweep(
         isinstance(workers, bool) or not isinstance(workers, int) or workers < 1
     ):
         raise SweepError(f"workers = {workers!r} is invalid: must be an integer >= 1")
+    cpus = os.cpu_count() or 1
+    if workers is not None and workers > cpus:
+        raise SweepError(
+            f"workers = {workers} is invalid: must be <= {cpus}, the number of CPUs (more "
+            "processes than cores only add memory, some 300 MB each)"
+        )
     if workers is not None and scheduler is not None:
         raise SweepError(
             f"workers = {workers} is invalid with a scheduler: the cluster's size is set "

@@ -112,6 +112,17 @@ def parse_range(text: str, where: str = "range") -> list[float] | list[int]:
     return values.tolist()
 
 
+def _unsigned_zero(value: Any) -> Any:
+    """`value` with every -0.0 in it made 0.0: the same point of a case."""
+    if isinstance(value, float) and value == 0.0:
+        return 0.0
+    if isinstance(value, list | tuple):
+        return [_unsigned_zero(v) for v in value]
+    if isinstance(value, Mapping):
+        return {k: _unsigned_zero(v) for k, v in value.items()}
+    return value
+
+
 def _axis_values(key: str, raw: Any) -> tuple[Any, ...]:
     """An axis's values from a range string or a list."""
     where = f"axes.'{key}'"
@@ -237,6 +248,13 @@ class Sweep:
                     f"link.'{target}' = {origin!r} is invalid: must be a case key"
                     f"{nearest(str(origin), valid)}"
                 )
+            if origin in link:
+                # Links are applied one after the other: a chain or a circle of them would
+                # depend on their order (a circle swaps values).
+                raise SweepError(
+                    f"link.'{target}' = '{origin}' is invalid: '{origin}' is itself linked "
+                    f"(to '{link[origin]}'); link '{target}' to an axis or an unlinked key"
+                )
         set_(self, "link", link)
 
         if isinstance(self.sections, str | Mapping) or not isinstance(self.sections, Sequence):
@@ -282,7 +300,7 @@ class Sweep:
         set_(self, "axes", validated)
         if self.mode == "grid":
             for key, values in validated.items():
-                text = [json.dumps(v, sort_keys=True) for v in values]
+                text = [json.dumps(_unsigned_zero(v), sort_keys=True) for v in values]
                 repeated = next((v for v in text if text.count(v) > 1), None)
                 if repeated is not None:
                     raise SweepError(
@@ -342,7 +360,7 @@ class Sweep:
         seen = {r.name: f"reduction '{r.spec}'" for r in self.reductions}
         seen |= {name: "the sweep's own variable" for name in _RESERVED}
         for section in self.sections:
-            for name in (section.name, section.count_name):
+            for name in (section.name, section.count_name, section.dim):
                 if name in seen:
                     raise SweepError(
                         f"{section.where} would be stored as '{name}', as {seen[name]} is: "
@@ -352,6 +370,8 @@ class Sweep:
 
     def _check_cases(self) -> None:
         """Sections and Lyapunov settings that every point's case allows."""
+        from fivdisc.analysis.lyapunov import DEFAULT_INTERVAL, MAX_INTERVALS
+
         for i, case in enumerate(self.cases):
             for section in self.sections:
                 problem = section.problem(case)
@@ -366,6 +386,14 @@ class Sweep:
                     f"point {i} ({self._describe(i)}): {where}.transient = {transient:g} is "
                     f"invalid: must be < simulation.duration = {case.simulation.duration:g} s "
                     f"(or set {where}.duration)"
+                )
+            interval = self.lyapunov.interval or min(DEFAULT_INTERVAL, duration)
+            if duration / interval > MAX_INTERVALS:
+                raise SweepError(
+                    f"point {i} ({self._describe(i)}): {where}.interval = {interval:g} s over "
+                    f"a measurement of {duration:g} s is {duration / interval:.3g} "
+                    f"re-orthonormalisations, more than {MAX_INTERVALS:g}: lengthen the "
+                    "interval or shorten the duration"
                 )
             if self.lyapunov.interval is not None and self.lyapunov.interval > duration:
                 raise SweepError(

@@ -1,0 +1,108 @@
+"""Checks of an analysis request before any work starts, and of its answer after.
+
+:func:`check_orbit_request` refuses what would make a periodic-orbit search run without
+bound or answer nonsense (an infinite transient or window, an absurd period guess or
+tolerance, a disc without modes); :func:`check_period` refuses a period that no orbit of
+the model can have. Both name the option, its value and what is allowed, in one line.
+"""
+
+from __future__ import annotations
+
+import math
+
+from fivdisc.case import Case
+from fivdisc.errors import FivdiscError
+
+__all__ = ["MAX_RTOL", "MIN_RTOL", "check_orbit_request", "check_period", "check_time",
+           "shortest_period"]
+
+#: Tolerances the shooting runs accept: below MIN_RTOL the error control asks for less
+#: than double precision's round-off (unbounded work); above MAX_RTOL, as for
+#: ``simulation.rtol``, the integrator no longer resolves the dynamics.
+MIN_RTOL = 1e-14
+MAX_RTOL = 0.1
+
+
+def check_time(name: str, value: float | None, *, zero: bool = False) -> None:
+    """Refuse a time option [s] that is not finite and positive (or zero with `zero`)."""
+    if value is None:
+        return
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise FivdiscError(f"{name} = {value!r} is invalid: must be a number [s]")
+    ok = math.isfinite(value) and (value >= 0 if zero else value > 0)
+    if not ok:
+        raise FivdiscError(f"{name} = {value!r} is invalid: must be finite and "
+                           f"{'>= 0' if zero else '> 0'} [s]")
+
+
+def shortest_period(case: Case) -> float:
+    """The shortest period [s] an orbit of `case` may have: half the period of the
+    model's fastest time scale (:func:`fivdisc.integration.fastest_time_scale`). No
+    motion of the model is faster; the half leaves room for the coupling of the disc and
+    the sliders, which raises the fastest frequency above each part's own."""
+    from fivdisc.integration import fastest_time_scale
+    from fivdisc.model import build_model
+
+    return math.pi / fastest_time_scale(build_model(case))[1]
+
+
+def check_period(case: Case, period: float, what: str = "--period") -> None:
+    """Refuse a period [s] shorter than :func:`shortest_period`."""
+    shortest = shortest_period(case)
+    if not period >= shortest:
+        raise FivdiscError(
+            f"{what} = {period!r} s is invalid: must be >= {shortest:.3g} s, half the period "
+            "of the model's fastest motion (no orbit is shorter)"
+        )
+
+
+def check_orbit_request(case: Case, *, period: float | None = None,
+                        transient: float | None = None, window: float = 1.0,
+                        rtol: float = 1e-12, names: tuple[str, ...] = (
+                            "--period", "--transient", "--window", "--rtol")) -> None:
+    """Refuse a periodic-orbit request that cannot give an answer in bounded time.
+
+    Parameters
+    ----------
+    case
+        The case.
+    period, transient, window
+        The guess of the period, the transient run and the window searched for a return [s].
+    rtol
+        Tolerance of the shooting runs.
+    names
+        How the four are named in messages (the command line's options by default).
+
+    Raises
+    ------
+    FivdiscError
+        One line naming the option, its value and what is allowed; also for a disc
+        without modes (nothing to shoot on), a window (without a period) shorter than
+        any period, and runs (transient, window, one period) whose work estimate exceeds
+        ``simulation.max_steps`` (:func:`fivdisc.integration.check_steps`).
+    """
+    p_name, t_name, w_name, r_name = names
+    check_time(p_name, period)
+    check_time(t_name, transient)
+    check_time(w_name, window)
+    if isinstance(rtol, bool) or not (isinstance(rtol, (int, float))
+                                      and MIN_RTOL <= rtol <= MAX_RTOL):
+        raise FivdiscError(f"{r_name} = {rtol!r} is invalid: must lie in "
+                           f"[{MIN_RTOL:g}, {MAX_RTOL:g}]")
+    if not case.disc.modes:
+        raise FivdiscError("disc.modes = [] is invalid for a periodic orbit: a rigid disc "
+                           "has no disc coordinates to shoot on; give at least one mode")
+    if not any(s.preload for s in case.sliders):
+        raise FivdiscError("slider.preload = 0 is invalid for a periodic orbit: without a "
+                           "normal force nothing drives the disc, which stays at rest")
+    if period is not None:
+        check_period(case, period, p_name)
+    else:
+        check_period(case, window, w_name)  # no return comes sooner
+    from fivdisc.integration import check_steps
+    from fivdisc.model import build_model
+
+    model = build_model(case)
+    run = case.simulation.duration if transient is None else transient
+    # The transient, the window searched, and at least one shot over the period.
+    check_steps(model, run + window + (period or 0.0))
