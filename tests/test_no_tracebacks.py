@@ -100,8 +100,9 @@ def test_a_directory_as_case_file(tmp_path: Path) -> None:
         (["--x", "decay=0:1:3", "--y", "normal_damping=0:2:3", "--curves", "decay=1,2"],
          ["--curves friction.decay is invalid: --x varies the same key"]),
         (["--curves", "decay=0,1"], ["--curves is used only by a stability map"]),
-        (["-o", "map.nc"], ["-o is used only by a stability map"]),
-        (["--x", "decay=0:1:3"], ["needs both --x and --y"]),
+        (["-o", "map.nc"], ["-o is used only by a scan"]),
+        (["--x", "decay=0:1:3", "--curves", "decay=1,2"], ["--curves is used only by a map"]),
+        (["--y", "decay=0:1:3"], ["--y needs --x too"]),
     ],
 )
 def test_meaningless_stability_options(tmp_path: Path, monkeypatch, args, words) -> None:

@@ -336,7 +336,7 @@ def _map(curves):
                          curves=curves)
 
 
-def test_stability_map_marks_the_stable_side_and_drops_absent_curves():
+def test_stability_map_shows_every_curve_and_says_which_have_no_boundary():
     ds = _map(("friction.decay", [1.0, 10.0, 50.0]))
     present = [bool(np.isfinite(ds["boundary"].sel({"friction.decay": a})).any())
                for a in (1.0, 10.0, 50.0)]
@@ -344,16 +344,31 @@ def test_stability_map_marks_the_stable_side_and_drops_absent_curves():
     fig = plots.plot_stability_map(ds)
     ax = fig.axes[0]
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
-    shown = [f"$\\alpha$ = {a:g} s/m, stable above" for a, p in zip((1, 10, 50), present,
-                                                                     strict=True) if p]
-    assert labels == shown
+    # Every value is in the legend: its boundary, or the state without one.
+    for a, p, label in zip((1, 10, 50), present, labels, strict=True):
+        assert label.startswith(f"$\\alpha$ = {a:g} s/m: ")
+        assert ("boundary" in label) == p
     missing = [a for a, p in zip((1, 10, 50), present, strict=True) if not p]
     assert all(f"$\\alpha$ = {a:g} s/m" in ax.get_title() for a in missing)
-    # the stable regions are shaded, one filled contour per curve drawn
-    assert len(ax.collections) >= len(shown)
+    # the stable regions are shaded and each boundary drawn as a contour
+    assert len(ax.collections) >= sum(present)
     assert ax.get_xlabel() == "slider normal damping $c_z$ [N s/m]"
     assert ax.get_ylabel() == "slider rotational damping $r_0^2 c_\\phi$ [N m s/rad]"
     assert _text_outside_canvas(fig) == []
+
+
+def test_map_without_boundary_says_so_on_the_figure():
+    from fivdisc import examples, load_case, stability_map
+
+    # Fig. 3a at alpha = 10 s/m: unstable throughout its box.
+    ds = stability_map(load_case(examples.path("fig03a")).replace({"friction.decay": 10.0}),
+                       ("slider.normal_damping", np.linspace(0.0, 12.0, 4)),
+                       ("slider.rotational_damping", np.linspace(0.0, 3.0, 4)))
+    assert not np.isfinite(ds["boundary"].values).any()
+    ax = plots.plot_stability_map(ds).axes[0]
+    assert "no stability boundary in the grid" in [t.get_text() for t in ax.texts]
+    # the field is still drawn: the unstable shading
+    assert ax.collections
 
 
 @pytest.mark.parametrize("suffix", [".pdf", ".svg", ".png"])

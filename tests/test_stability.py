@@ -6,12 +6,13 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from fivdisc import examples
 from fivdisc.analysis.stability import (
     linear_stability,
     perturbation_test,
     stability_map,
 )
-from fivdisc.case import Case
+from fivdisc.case import Case, load_case
 from fivdisc.cli import cli
 from fivdisc.errors import CaseError, SimulationError
 from reference_model import (
@@ -166,3 +167,72 @@ def test_stability_command(tmp_path):
     np.testing.assert_allclose(ds["friction.decay"].values, [0.0, 1.0])
     bad = runner.invoke(cli, ["stability", "--x", "normal_dampin=1:2:3", "--y", "decay=0:1:2"])
     assert bad.exit_code == 2 and "did you mean 'slider.normal_damping'" in bad.output
+
+
+def test_map_boundary_found_whichever_side_is_stable():
+    """The issue's case: stable at high speed and low friction. With the stable side
+    below (speed on y) or above (friction on y) the grid's boundary is found in the
+    columns it crosses, at the same place."""
+    case = load_case(examples.path("two-pads")).replace({"disc.damping_ratio": 0.002})
+    speed = ("speed.value", np.linspace(1.0, 30.0, 8))
+    friction = ("friction.kinetic_max", np.linspace(0.35, 0.8, 10))
+    one = stability_map(case, speed, friction)
+    other = stability_map(case, friction, speed)
+    assert np.isfinite(one["boundary"].values).sum() >= 6
+    assert np.isfinite(other["boundary"].values).sum() >= 6
+    np.testing.assert_array_equal(one["stable"].values, other["stable"].values.T)
+
+
+def test_stability_command_branches_and_boundary(tmp_path):
+    import xarray as xr
+
+    runner = CliRunner()
+    out = runner.invoke(cli, ["stability", "fig03a", "--x", "rotational_damping=0:3:16",
+                              "-o", str(tmp_path / "br.nc"), "--no-progress"])
+    assert out.exit_code == 0, out.output
+    assert "Hopf point at slider.rotational_damping = 0.98" in out.output
+    ds = xr.open_dataset(tmp_path / "br.nc")
+    assert ds["growth_rate"].dims == ("slider.rotational_damping", "branch")
+    out = runner.invoke(cli, ["stability", "fig03b", "--boundary", "normal_damping=0:12",
+                              "rotational_damping=0:3", "-o", str(tmp_path / "b.nc")])
+    assert out.exit_code == 0, out.output
+    assert "boundary curve 0 (open" in out.output and "C00" in out.output
+    ds = xr.open_dataset(tmp_path / "b.nc")
+    assert ds.sizes["point"] > 10 and ds.attrs["x_key"] == "slider.normal_damping"
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--x", "law=0:1:5"], "friction.law is invalid: its value 'exponential' is not a number"),
+    (["--x", "decay=1:1:5"], "empty"),
+    (["--x", "decay=-1:1:5"], "friction.decay = -1.0 is invalid: must be >= 0"),
+    (["--boundary", "decay=0:1", "decay=1:2"], "varies the same key"),
+    (["--boundary", "decay=0:1", "normal_damping=1"], "write KEY=START:STOP"),
+    (["--x", "decay=0:1:5", "--y", "decay=0:2:3"], "varies the same key"),
+    (["--y", "decay=0:1:5"], "--y needs --x"),
+])
+def test_stability_command_refuses_bad_scans(args, message):
+    out = CliRunner().invoke(cli, ["stability", "fig03a", *args, "--no-progress"])
+    assert out.exit_code == 2, out.output
+    assert message in out.output and len(out.output.strip().splitlines()) == 1
+
+
+def test_stability_command_refuses_a_case_without_sliding_equilibrium():
+    out = CliRunner().invoke(cli, ["stability", "fig10", "--x", "decay=0:1:5",
+                                   "--no-progress"])
+    assert out.exit_code == 2 and "no sliding equilibrium" in out.output
+    assert len(out.output.strip().splitlines()) == 1
+
+
+def test_plot_command_draws_saved_branches_and_boundaries(tmp_path):
+    runner = CliRunner()
+    for args, name in ((["--x", "rotational_damping=0:3:8"], "br.nc"),
+                       (["--boundary", "normal_damping=0:12", "rotational_damping=0:3"],
+                        "b.nc")):
+        saved = tmp_path / name
+        out = runner.invoke(cli, ["stability", "fig03a", *args, "-o", str(saved),
+                                  "--no-progress"])
+        assert out.exit_code == 0, out.output
+        figure = tmp_path / f"{name}.png"
+        out = runner.invoke(cli, ["plot", str(saved), "-o", str(figure)])
+        assert out.exit_code == 0, out.output
+        assert figure.read_bytes()[:4] == b"\x89PNG"

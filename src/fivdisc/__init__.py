@@ -26,10 +26,13 @@ from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from fivdisc.analysis.boundary import stability_boundary
     from fivdisc.analysis.branch import Branch, open_branch
     from fivdisc.analysis.continuation import continue_orbit
+    from fivdisc.analysis.eigenbranches import eigen_branches
     from fivdisc.analysis.energy import energy_balance
     from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium
+    from fivdisc.analysis.hopf import HopfPoint, hopf_points
     from fivdisc.analysis.lyapunov import LyapunovSpectrum, lyapunov
     from fivdisc.analysis.orbits import PeriodicOrbit, periodic_orbit
     from fivdisc.analysis.spectra import classify, dominant_frequency, find_peaks, spectrum, stft
@@ -64,6 +67,7 @@ __all__ = [
     "ConvergenceError",
     "Equilibrium",
     "FivdiscError",
+    "HopfPoint",
     "LinearStability",
     "LyapunovSpectrum",
     "ModeError",
@@ -79,8 +83,10 @@ __all__ = [
     "classify",
     "continue_orbit",
     "dominant_frequency",
+    "eigen_branches",
     "energy_balance",
     "find_peaks",
+    "hopf_points",
     "linear_stability",
     "load_case",
     "lyapunov",
@@ -92,6 +98,7 @@ __all__ = [
     "simulate",
     "sliding_equilibrium",
     "spectrum",
+    "stability_boundary",
     "stability_map",
     "stft",
 ]
@@ -102,8 +109,11 @@ _HOMES = {
     for module, names in {
         "fivdisc.analysis.branch": ("Branch", "open_branch"),
         "fivdisc.analysis.continuation": ("continue_orbit",),
+        "fivdisc.analysis.boundary": ("stability_boundary",),
+        "fivdisc.analysis.eigenbranches": ("eigen_branches",),
         "fivdisc.analysis.energy": ("energy_balance",),
         "fivdisc.analysis.equilibrium": ("Equilibrium", "sliding_equilibrium"),
+        "fivdisc.analysis.hopf": ("HopfPoint", "hopf_points"),
         "fivdisc.analysis.lyapunov": ("LyapunovSpectrum", "lyapunov"),
         "fivdisc.analysis.orbits": ("PeriodicOrbit", "periodic_orbit"),
         "fivdisc.analysis.spectra": (

@@ -198,6 +198,7 @@ def model_at(base: Model, case: Case, updates: dict[str, float]) -> Model:
     patched arrays (tolerances, output) is the same.
     """
     model = base
+    rows: dict[str, np.ndarray] = {}
     for key, value in updates.items():
         parts = key.split(".")
         if key == "speed.value" and case.speed.profile == "constant":
@@ -205,14 +206,13 @@ def model_at(base: Model, case: Case, updates: dict[str, float]) -> Model:
         elif parts[0] in ("slider", "sliders") and parts[-1] in _SLIDER_ARRAYS:
             j = 0 if parts[0] == "slider" else int(parts[1])
             name = _SLIDER_ARRAYS[parts[-1]]
-            values = model.kernel.row(name).copy()
-            values[j] = value
-            model = model.with_sliders(**{name: values})
+            # One slider patch for all the keys (the face-signed rows follow once).
+            rows.setdefault(name, model.kernel.row(name).copy())[j] = value
         elif parts[0] == "friction" and parts[-1] in lay.FRICTION_SLOTS:
             model = model.with_friction(**{parts[-1]: value})
         else:
             return build_model(case.replace(updates))
-    return model
+    return model.with_sliders(**rows) if rows else model
 
 
 def build_model(case: Case, speed: SpeedProfile | None = None) -> Model:

@@ -1,8 +1,11 @@
-"""Analyses of the slider-on-disc system: equilibrium, stability, spectra, trajectories,
-periodic orbits, Lyapunov exponents."""
+"""Analyses of the slider-on-disc system: equilibrium, stability, eigenvalue branches,
+Hopf points and boundaries, spectra, trajectories, periodic orbits, Lyapunov exponents."""
 
+from fivdisc.analysis.boundary import stability_boundary
+from fivdisc.analysis.eigenbranches import eigen_branches
 from fivdisc.analysis.energy import energy_balance
 from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium
+from fivdisc.analysis.hopf import HopfPoint, hopf_points
 from fivdisc.analysis.lyapunov import LyapunovSpectrum, lyapunov
 from fivdisc.analysis.orbits import PeriodicOrbit, periodic_orbit
 from fivdisc.analysis.regimes import Regime, cross_check
@@ -31,6 +34,7 @@ from fivdisc.analysis.trajectories import (
 
 __all__ = [
     "Equilibrium",
+    "HopfPoint",
     "LinearStability",
     "LyapunovSpectrum",
     "PeriodicOrbit",
@@ -41,9 +45,11 @@ __all__ = [
     "classify",
     "cross_check",
     "dominant_frequency",
+    "eigen_branches",
     "energy_balance",
     "find_peaks",
     "friction_trajectory",
+    "hopf_points",
     "linear_stability",
     "lyapunov",
     "periodic_orbit",
@@ -53,6 +59,7 @@ __all__ = [
     "separation_stats",
     "sliding_equilibrium",
     "spectrum",
+    "stability_boundary",
     "stability_map",
     "stft",
 ]

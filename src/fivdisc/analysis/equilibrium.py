@@ -64,7 +64,8 @@ def _unknowns(model: Model) -> np.ndarray:
 
 
 def sliding_equilibrium(
-    case: Case | Model, xtol: float = 1e-13, guess: Equilibrium | None = None
+    case: Case | Model, xtol: float = 1e-13, guess: Equilibrium | None = None,
+    contact: bool = True,
 ) -> Equilibrium:
     """Solve the slip equations (s = +1 for every slider) with all velocities and
     accelerations zero.
@@ -84,11 +85,17 @@ def sliding_equilibrium(
         Start of the iteration (for example the solution at a neighbouring parameter);
         default: each slider on a rigid disc, the disc deflected statically by the
         preloads.
+    contact : bool
+        Require every normal force to be positive (an equilibrium with a slider pulling
+        on the disc does not exist). ``False`` returns the solution of the slip
+        equations anyway, so that the limit of existence (a normal force reaching zero)
+        can be located by a root finder.
 
     Raises
     ------
     SimulationError
-        If the speed is not constant or no equilibrium is found.
+        If the speed is not constant or no equilibrium is found (with `contact`: or a
+        normal force is not positive).
     """
     from scipy.optimize import root
 
@@ -149,7 +156,7 @@ def sliding_equilibrium(
     y = state(sol.x)
     _, aux = _evaluate(model, y)
     nf = aux[lay.A_N].copy()
-    if np.any(nf <= 0.0):
+    if contact and np.any(nf <= 0.0):
         j = int(np.argmin(nf))
         raise SimulationError(
             f"no sliding equilibrium at Omega = {omega_c} rad/s: the normal force of slider {j} "

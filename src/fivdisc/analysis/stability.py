@@ -10,13 +10,18 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import xarray as xr
 
-from fivdisc._kernels import dynamics as dyn
-from fivdisc._kernels import layout as lay
-from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium, slip_phases
+from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium
+from fivdisc.analysis.points import (
+    ParameterPoints,
+    check_box,
+    check_keys,
+    check_values,
+    slip_jacobian,
+)
 from fivdisc.case import Case, is_case_key, keys_like, unit_of
-from fivdisc.errors import CaseError, SimulationError, nearest
+from fivdisc.errors import CaseError, nearest
 from fivdisc.limits import check_memory
-from fivdisc.model import Model, build_model, model_at
+from fivdisc.model import Model, build_model
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -24,6 +29,8 @@ if TYPE_CHECKING:
 # Bytes per grid point of a stability map: growth rate and stability flag, and the
 # dataset's and the netCDF writer's copies of them.
 _GRID_BYTES = 3 * (8 + 1)
+
+
 @dataclass(frozen=True, repr=False)
 class LinearStability:
     """Eigen-analysis of the slip equations linearised about the sliding equilibrium.
@@ -138,22 +145,6 @@ class LinearStability:
         }
 
 
-def _reduced_indices(model: Model) -> np.ndarray:
-    # Drop the sliders' own z, zdot: in contact they are slaved to the disc.
-    n, ns = model.n, model.n_sliders
-    half = n + 2 * ns
-    return np.r_[0 : n + ns, half : half + n + ns]
-
-
-def slip_jacobian(model: Model, state: np.ndarray) -> np.ndarray:
-    """Exact (complex-step) Jacobian of the slip equations (s = +1 for every slider) at
-    ``state``, in the variables ``(q, phi, qdot, phidot)``."""
-    ph, sg = slip_phases(model)
-    jac = dyn.complex_step_jacobian(0.0, state, ph, sg, model.kernel_args)
-    idx = _reduced_indices(model)
-    return jac[np.ix_(idx, idx)]
-
-
 def _angle_names(model: Model) -> tuple[str, ...]:
     return ("phi",) if model.n_sliders == 1 else tuple(f"phi{j}" for j in range(model.n_sliders))
 
@@ -177,13 +168,18 @@ def linear_stability(case: Case | Model) -> LinearStability:
     order = np.lexsort((-lam.imag, -lam.real))
     lam = lam[order]
     vec = vec[:, order]
+    return LinearStability(eq, jac, lam, vec, dominant_coordinates(model, vec))
+
+
+def dominant_coordinates(model: Model, vectors: np.ndarray) -> tuple[str, ...]:
+    """Per eigenvector (columns, variables ``(q, phi, qdot, phidot)``), the coordinate
+    with the largest share of its kinetic energy (``"C01"``, ..., ``"phi"``)."""
     size = model.n + model.n_sliders
     inertia = np.append(model.modal_mass, model.kernel.row("inertia"))
     # Velocity part of an eigenvector is lambda times its displacement part.
-    energy = inertia[:, None] * np.abs(vec[size:, :]) ** 2
+    energy = inertia[:, None] * np.abs(vectors[size:, :]) ** 2
     names = (*model.labels, *_angle_names(model))
-    dominant = tuple(names[i] for i in np.argmax(energy, axis=0))
-    return LinearStability(eq, jac, lam, vec, dominant)
+    return tuple(names[i] for i in np.argmax(energy, axis=0))
 
 
 @dataclass(frozen=True)
@@ -248,33 +244,6 @@ def perturbation_test(case: Case, duration: float | None = None) -> Perturbation
     return PerturbationTest(first, last, rate, last < first)
 
 
-def _axis(spec, name: str) -> tuple[str, np.ndarray]:
-    key, values = spec
-    values = np.asarray(values, dtype=float)
-    if values.ndim != 1 or values.size < 2:
-        raise CaseError(f"{name} = {key}: needs at least 2 values, got {values.size}")
-    return key, values
-
-
-def _equilibrium_key(model: Model) -> tuple:
-    # The sliders' dampers do not enter the equilibrium: maps over c_z, c_phi reuse one
-    # solve.
-    slider = model.kernel_args.slider.copy()
-    slider[[lay.S_CZ, lay.S_SCZ, lay.S_CPHI]] = 0.0
-    kern = model.kernel_args._replace(slider=slider)
-    return tuple(a.tobytes() for a in kern)
-
-
-def _validate_grid(case: Case, axes: list[tuple[str, np.ndarray]]) -> None:
-    """Every axis value, alone and at the grid's corners, must give a valid case."""
-    for key, values in axes:
-        for v in values:
-            case.replace({key: float(v)})
-    corners = np.array(np.meshgrid(*[[v[0], v[-1]] for _, v in axes])).reshape(len(axes), -1)
-    for combo in corners.T:
-        case.replace({key: float(v) for (key, _), v in zip(axes, combo, strict=True)})
-
-
 def stability_map(
     case: Case,
     x: tuple[str, Sequence[float]],
@@ -304,17 +273,17 @@ def stability_map(
         (curves key, y key, x key), or (y key, x key) without `curves`. Variables
         ``max_growth_rate`` [1/s] (NaN where no sliding equilibrium exists) and
         ``stable`` (1 stable, 0 unstable) on all of them, and ``boundary`` (curves key,
-        x key): the value of y above which the equilibrium is stable at that x,
-        interpolated where the growth rate changes sign for the last time (NaN if the
-        column is never stable at the top or stable throughout). Attributes ``x_key``,
+        x key): the lowest value of y where the growth rate changes sign at that x,
+        interpolated linearly, whichever side is stable (NaN if it keeps its sign in the
+        column). :func:`fivdisc.analysis.boundary.stability_boundary` traces the
+        boundary exactly, as curves. Attributes ``x_key``,
         ``y_key`` and (with `curves`) ``curve_key`` name the axes; the CF global
         attributes and the base case's TOML (``case``) are there too.
     """
-    xkey, xs = _axis(x, "x")
-    ykey, ys = _axis(y, "y")
-    axes = [(xkey, xs), (ykey, ys)]
+    axes = [(x[0], check_values("x", x[0], x[1])), (y[0], check_values("y", y[0], y[1]))]
     if curves:
         axes.append((curves[0], np.asarray(curves[1], dtype=float)))
+    (xkey, xs), (ykey, ys) = axes[:2]
     size = math.prod(len(values) for _, values in axes)
     n = 2 * sum(1 if l == 0 else 2 for _, l in case.disc.modes) + 2
     check_memory(
@@ -322,34 +291,28 @@ def stability_map(
         f"a stability map of {' x '.join(str(len(v)) for _, v in axes)} points",
         "use fewer points per axis",
     )
-    _validate_grid(case, axes)
+    check_keys(case, [key for key, _ in axes], ["x", "y", "curves"][: len(axes)])
+    check_box(case, axes)
     cs = axes[2][1] if curves else [None]
-    base = build_model(case)
+    points = ParameterPoints(case, [key for key, _ in axes])
     growth = np.full((len(cs), ys.size, xs.size), np.nan)
-    cache: dict[tuple, Equilibrium] = {}
     bar = None
     if progress:
         from tqdm import tqdm
 
         bar = tqdm(total=growth.size, desc="stability map", unit="pt")
     for ic, cval in enumerate(cs):
-        fixed = {} if cval is None else {curves[0]: float(cval)}
+        fixed = () if cval is None else (cval,)
         for iy, yval in enumerate(ys):
             jacs = []
             guess = None
             for xval in xs:
-                model = model_at(base, case, {**fixed, ykey: float(yval), xkey: float(xval)})
-                key = _equilibrium_key(model)
-                if key not in cache:
-                    try:
-                        cache[key] = sliding_equilibrium(model, guess=guess)
-                    except SimulationError:
-                        cache[key] = None
-                if cache[key] is None:
-                    jacs.append(np.full((2 * (base.n + base.n_sliders),) * 2, np.nan))
+                point = points.linearise((xval, yval, *fixed), guess)
+                if point is None:
+                    jacs.append(np.full((points.size,) * 2, np.nan))
                     continue
-                guess = cache[key]
-                jacs.append(slip_jacobian(model, guess.state))
+                _, guess, jac = point
+                jacs.append(jac)
             stack = np.stack(jacs)
             ok = np.isfinite(stack).all(axis=(1, 2))
             growth[ic, iy, ok] = np.max(np.linalg.eigvals(stack[ok]).real, axis=1)
@@ -361,13 +324,15 @@ def stability_map(
     boundary = np.full((len(cs), xs.size), np.nan)
     for ic in range(len(cs)):
         for ix in range(xs.size):
-            col = stable[ic, :, ix]
-            if col.all() or not col[-1]:
+            # The lowest change of sign in the column, whichever side is stable.
+            col = growth[ic, :, ix]
+            change = np.flatnonzero(((col[:-1] < 0.0) != (col[1:] < 0.0))
+                                    & np.isfinite(col[:-1]) & np.isfinite(col[1:]))
+            if change.size == 0:
                 continue
-            last_unstable = np.nonzero(~col)[0][-1]
-            g0, g1 = growth[ic, last_unstable, ix], growth[ic, last_unstable + 1, ix]
-            y0, y1 = ys[last_unstable], ys[last_unstable + 1]
-            boundary[ic, ix] = y0 + (y1 - y0) * g0 / (g0 - g1)
+            i = change[0]
+            g0, g1 = col[i], col[i + 1]
+            boundary[ic, ix] = ys[i] + (ys[i + 1] - ys[i]) * g0 / (g0 - g1)
     from fivdisc.conventions import global_attrs, key_attrs, units
 
     ckey = curves[0] if curves else ""
@@ -398,8 +363,9 @@ def stability_map(
                 "flag_meanings": "unstable stable"}),
             "boundary": ((*dims[:-2], xkey), boundary, {
                 "units": units(unit_of(ykey)),
-                "long_name": f"stability boundary: the {yinfo['long_name']} above which the "
-                             "equilibrium is stable (nan: none in the grid)"}),
+                "long_name": f"stability boundary: the lowest {yinfo['long_name']} where the "
+                             "growth rate changes sign, either way (nan: none in the "
+                             "column)"}),
         },
         coords=coords,
         attrs=attrs,

@@ -149,7 +149,7 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
     run = run if run is not None else (groups[0] if groups else None)
     with xr.open_dataset(result, group=run) as stored:
         what = stored.attrs.get("fivdisc_kind", "simulation")
-    if what in ("stability_map", "sweep"):
+    if what in ("stability_map", "sweep", "eigen_branches", "stability_boundary"):
         given = [name for name, value in (("--var", var), ("--probe", probe),
                                           ("--window", window_text), ("--fmax", fmax),
                                           ("--segment", segment)) if value is not None]
@@ -218,11 +218,15 @@ def _groups(path: Path, run_groups) -> list[str]:
 
 
 def _map(ds, path: Path):
-    """The figure of a stability map or a separation map."""
-    if ds.attrs.get("fivdisc_kind") == "stability_map":
-        from fivdisc.plots import plot_stability_map
+    """The figure of a stability map, branches, a boundary or a separation map."""
+    kind = ds.attrs.get("fivdisc_kind")
+    if kind in ("stability_map", "eigen_branches", "stability_boundary"):
+        from fivdisc import plots
 
-        return plot_stability_map(ds)
+        draw = {"stability_map": plots.plot_stability_map,
+                "eigen_branches": plots.plot_eigen_branches,
+                "stability_boundary": plots.plot_stability_boundary}[kind]
+        return draw(ds)
     if "separated" not in ds:
         raise FivdiscError(f"{path} is a sweep without 'separated': read it with "
                            "xarray.open_dataset")

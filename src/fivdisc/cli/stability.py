@@ -13,10 +13,13 @@ from fivdisc.errors import FivdiscError
 @click.command()
 @click.argument("case_file", required=False, type=CASE)
 @click.option("--x", "x_spec", metavar="KEY=START:STOP:N",
-              help="Horizontal axis, e.g. normal_damping=0:12:200 (with --y: a map).")
+              help="Horizontal axis, e.g. normal_damping=0:12:200. Alone: the eigenvalue "
+              "branches, mode couplings and Hopf points along it; with --y: a map.")
 @click.option("--y", "y_spec", metavar="KEY=START:STOP:N", help="Vertical axis.")
 @click.option("--curves", "curve_spec", metavar="KEY=v1,v2,...",
               help="One map and boundary curve per value, e.g. decay=0,1,10.")
+@click.option("--boundary", "boundary_spec", nargs=2, metavar="KEY1=START:STOP KEY2=START:STOP",
+              help="Trace the exact stability boundary (Hopf curves) in this box.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               help="map.nc (netCDF dataset) or a figure in any format matplotlib writes "
               "(map.png, map.pdf, map.svg, ...).")
@@ -24,28 +27,29 @@ from fivdisc.errors import FivdiscError
               help="Print the equilibrium and the eigenvalues as JSON (without a map).")
 @click.option("--progress/--no-progress", default=True, show_default=True)
 def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
-              curve_spec: str | None, output: Path | None, as_json: bool,
-              progress: bool) -> None:
+              curve_spec: str | None, boundary_spec: tuple[str, str] | None,
+              output: Path | None, as_json: bool, progress: bool) -> None:
     """Stability of the sliding equilibrium of CASE_FILE (default: Table 1 at 2 pi rad/s).
 
     CASE_FILE is a TOML case file or the name of a packaged example (``fivdisc examples``).
-    Without --x/--y: prints the equilibrium and the eigenvalues of the linearised slip
-    equations. With both: computes the largest growth rate over the grid and the
-    stability boundary, and writes it with -o.
+    Without options: prints the equilibrium and the eigenvalues of the linearised slip
+    equations. With --x alone: follows every eigenvalue along one key, with the mode
+    couplings, Hopf points and limits of the equilibrium's existence. With --x and --y:
+    the largest growth rate over the grid and where it changes sign. With --boundary:
+    the exact boundary curves in a box of two keys (a figure draws them on a grid map).
     """
-    import numpy as np
-
-    from fivdisc.analysis.stability import linear_stability, parse_range, stability_map
+    from fivdisc.analysis.stability import linear_stability
     from fivdisc.case import Case, load_case
-    from fivdisc.extras import require
-    from fivdisc.files import check_output, figure_suffixes, write_atomic
 
     case = load_case(case_file) if case_file else Case()
-    if x_spec is None and y_spec is None:
-        for option, given in (("--curves", curve_spec), ("-o", output)):
-            if given is not None:
-                raise FivdiscError(f"{option} is used only by a stability map: give --x and --y "
-                                   "too (KEY=START:STOP:N)")
+    if boundary_spec and (x_spec or y_spec or curve_spec):
+        raise FivdiscError("--boundary takes its own two keys: leave out --x, --y and --curves")
+    if x_spec is None and y_spec is None and not boundary_spec:
+        if curve_spec is not None:
+            raise FivdiscError("--curves is used only by a stability map: give --x and --y "
+                               "too (KEY=START:STOP:N)")
+        if output is not None:
+            raise FivdiscError("-o is used only by a scan: give --x (and --y) or --boundary")
         res = linear_stability(case)
         if as_json:
             import json
@@ -54,16 +58,138 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
             return
         click.echo(str(res))
         return
-    if x_spec is None or y_spec is None:
-        raise FivdiscError("a stability map needs both --x and --y (KEY=START:STOP:N)")
     if as_json:
-        raise FivdiscError("--json prints the equilibrium and eigenvalues: leave out --x/--y")
-    target = output or Path("stability.nc")
+        raise FivdiscError("--json prints the equilibrium and eigenvalues: leave out --x, --y "
+                           "and --boundary")
+    if y_spec is not None and x_spec is None:
+        raise FivdiscError("--y needs --x too (KEY=START:STOP:N)")
+    if x_spec is not None and y_spec is None:
+        if curve_spec is not None:
+            raise FivdiscError("--curves is used only by a map: give --y too")
+        _branches(case, case_file, x_spec, output, progress)
+    elif boundary_spec:
+        _boundary(case, case_file, boundary_spec, output)
+    else:
+        _map(case, case_file, x_spec, y_spec, curve_spec, output, progress)
+
+
+def _target(case_file: Path | None, output: Path | None, default: str) -> tuple[Path, bool]:
+    """Checked output path, and whether it is a figure."""
+    from fivdisc.extras import require
+    from fivdisc.files import check_output, figure_suffixes
+
+    target = output or Path(default)
     figure = target.suffix.lower() != ".nc"
     if figure:
         require("plot", f"fivdisc stability -o {target.name} (a figure)")
     out = check_output(target, "-o", (".nc", *figure_suffixes()) if figure else (".nc",),
                        inputs=[case_file])
+    return out, figure
+
+
+def _write(out: Path, figure, ds) -> None:
+    from fivdisc.files import write_atomic
+
+    if figure is None:
+        write_atomic(out, ds.to_netcdf)
+    else:
+        write_atomic(out, lambda path: figure.savefig(path, dpi=150))
+    click.echo(f"wrote {out}")
+
+
+def _branches(case, case_file, x_spec: str, output: Path | None, progress: bool) -> None:
+    import numpy as np
+
+    from fivdisc.analysis.eigenbranches import eigen_branches
+    from fivdisc.analysis.hopf import hopf_points
+    from fivdisc.analysis.stability import parse_range
+
+    key, values = parse_range(x_spec, "--x")
+    out, figure = _target(case_file, output, "branches.nc")
+    ds = eigen_branches(case, key, values, option="--x", progress=progress)
+    hopf = hopf_points(case, key, values, option="--x", branches=ds)
+    ds = ds.assign(
+        hopf=(("hopf",), [hp.value for hp in hopf],
+              {**ds[key].attrs, "long_name": "Hopf points: where a complex pair crosses the "
+                                             "imaginary axis"}),
+        hopf_frequency=(("hopf",), [hp.frequency for hp in hopf],
+                        {"units": "Hz", "long_name": "critical frequency"}),
+        hopf_direction=(("hopf",), np.array([hp.direction for hp in hopf], dtype=np.int8),
+                        {"long_name": "+1: the mode loses stability as the key increases"}),
+    )
+    if case_file is not None:
+        ds.attrs["case_name"] = case_file.stem
+    if figure:
+        from fivdisc.plots import plot_eigen_branches
+
+        _write(out, plot_eigen_branches(ds, hopf), ds)
+    else:
+        _write(out, None, ds)
+    unstable = ds["max_growth_rate"].values > 0.0
+    click.echo(f"{ds.sizes['branch']} eigenvalue branches at {values.size} values of {key}; "
+               f"unstable at {unstable.mean():.1%} of them")
+    for value, a, b in zip(ds["coupling"].values, ds["coupling_first"].values,
+                           ds["coupling_second"].values, strict=True):
+        click.echo(f"mode coupling near {key} = {value:.6g}: branches {a} "
+                   f"({ds['mode'].values[a]}) and {b} ({ds['mode'].values[b]})")
+    for value in ds["existence_limit"].values:
+        click.echo(f"the sliding equilibrium ceases to exist at {key} = {value:.10g} "
+                   "(a normal force reaches zero)")
+    for hp in hopf:
+        click.echo(str(hp))
+    if not hopf:
+        click.echo(f"no Hopf point between {key} = {values[0]:g} and {values[-1]:g}")
+
+
+def _boundary(case, case_file, specs: tuple[str, str], output: Path | None) -> None:
+    import numpy as np
+
+    from fivdisc.analysis.boundary import stability_boundary
+    from fivdisc.analysis.stability import resolve_key, stability_map
+
+    box = []
+    for spec in specs:
+        usage = f"--boundary {spec!r} is invalid: write KEY=START:STOP"
+        if "=" not in spec or spec.split("=", 1)[1].count(":") != 1:
+            raise FivdiscError(usage)
+        key, ends = spec.split("=", 1)
+        try:
+            start, stop = (float(v) for v in ends.split(":"))
+        except ValueError:
+            raise FivdiscError(usage) from None
+        box.append((resolve_key(key.strip(), "--boundary"), (start, stop)))
+    out, figure = _target(case_file, output, "boundary.nc")
+    ds = stability_boundary(case, box[0], box[1])
+    if case_file is not None:
+        ds.attrs["case_name"] = case_file.stem
+    if figure:
+        from fivdisc.plots import plot_stability_map
+
+        grid = stability_map(case, *[(key, np.linspace(*ends, 40)) for key, ends in box])
+        if case_file is not None:
+            grid.attrs["case_name"] = case_file.stem
+        _write(out, plot_stability_map(grid, boundary=ds), ds)
+    else:
+        _write(out, None, ds)
+    curves = np.unique(ds["branch"].values)
+    if curves.size == 0:
+        click.echo("no stability boundary in the box: the sliding equilibrium is "
+                   "stable or unstable throughout")
+    for b in curves:
+        sel = ds["branch"].values == b
+        freq = ds["frequency"].values[sel]
+        modes = ", ".join(dict.fromkeys(ds["mode"].values[sel]))
+        shape = "closed" if ds["closed"].values[b] else "open"
+        click.echo(f"boundary curve {b} ({shape}, {int(sel.sum())} points): {modes} at "
+                   f"{freq.min():.6g}-{freq.max():.6g} Hz")
+
+
+def _map(case, case_file, x_spec, y_spec, curve_spec, output, progress) -> None:
+    import numpy as np
+
+    from fivdisc.analysis.stability import parse_range, stability_map
+
+    out, figure = _target(case_file, output, "stability.nc")
     axes = {"--x": parse_range(x_spec, "--x"), "--y": parse_range(y_spec, "--y")}
     if curve_spec is not None:
         axes["--curves"] = parse_range(curve_spec, "--curves")
@@ -76,18 +202,21 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
     ds = stability_map(case, axes["--x"], axes["--y"], axes.get("--curves"), progress=progress)
     if case_file is not None:
         ds.attrs["case_name"] = case_file.stem
-    if not figure:
-        write_atomic(out, ds.to_netcdf)
-    else:
+    if figure:
         from fivdisc.plots import plot_stability_map
 
-        drawn = plot_stability_map(ds)
-        write_atomic(out, lambda path: drawn.savefig(path, dpi=150))
-    click.echo(f"wrote {out}")
+        _write(out, plot_stability_map(ds), ds)
+    else:
+        _write(out, None, ds)
     ckey = ds.attrs.get("curve_key", "")
     for value in ds[ckey].values if ckey else [None]:
         one = ds if value is None else ds.sel({ckey: value})
-        boundary, stable = one["boundary"].values, one["stable"].values
+        growth = one["max_growth_rate"].values
+        stable = one["stable"].values.astype(bool)
         label = "" if value is None else f"{ckey} = {value:g}: "
-        click.echo(f"{label}stable at {stable.mean():.1%} of the grid; boundary found at "
-                   f"{int(np.sum(~np.isnan(boundary)))} of {boundary.size} x values")
+        signs = np.sign(growth)
+        crossed = (np.any(signs[:, 1:] * signs[:, :-1] < 0, axis=1).sum()
+                   + np.any(signs[1:, :] * signs[:-1, :] < 0, axis=0).sum())
+        where = (f"the boundary crosses {crossed} of {sum(growth.shape)} grid lines"
+                 if crossed else "no stability boundary in the grid")
+        click.echo(f"{label}stable at {stable.mean():.1%} of the grid; {where}")

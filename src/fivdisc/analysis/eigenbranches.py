@@ -1,0 +1,264 @@
+"""The sliding equilibrium and its eigenvalues followed along one key, by continuity.
+
+Re-sorting the eigenvalues at every value of a parameter (by frequency, by growth rate)
+swaps modes wherever two of them cross in that order, which hides what happens there.
+Here each eigenvalue is followed from one value to the next: the eigenvalues at the next
+value are assigned to the branches so that the total distance from each branch's linear
+extrapolation is least (an assignment problem, :func:`scipy.optimize.linear_sum_assignment`).
+Veering modes then keep their branch, and coupling modes (two frequencies that merge
+while one growth rate leaves zero, the flutter of brake squeal) show as such.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import xarray as xr
+
+from fivdisc.analysis.equilibrium import Equilibrium
+from fivdisc.analysis.points import ParameterPoints, check_box, check_keys, check_values
+from fivdisc.analysis.stability import dominant_coordinates
+from fivdisc.case import Case
+
+# Two branches' frequencies count as merged (a coupling) within this fraction of the
+# frequency: inside a flutter region of an undamped system they are equal, damping
+# leaves them apart by about the difference of the modes' damping rates.
+COUPLING_TOLERANCE = 0.01
+
+
+def follow(lam: np.ndarray) -> np.ndarray:
+    """Eigenvalues at successive parameter values reordered into branches.
+
+    Parameters
+    ----------
+    lam : ndarray
+        ``(values, k)`` complex eigenvalues, each row in any order; rows of NaN (no
+        equilibrium) break the branches, which resume from the last finite row.
+
+    Returns
+    -------
+    ndarray
+        The same rows, reordered: column b is branch b. The first finite row is ordered
+        by the imaginary part's sign (positive first) and magnitude.
+
+    Notes
+    -----
+    Row i + 1 is assigned to the branches so that the sum of the distances
+    ``|lambda_b(i + 1) - (2 lambda_b(i) - lambda_b(i - 1))|`` to the branches' linear
+    extrapolations is least (:func:`scipy.optimize.linear_sum_assignment`).
+    """
+    from scipy.optimize import linear_sum_assignment
+
+    out = np.array(lam, dtype=complex)
+    history: list[np.ndarray] = []
+    last = None
+    for i, row in enumerate(out):
+        if not np.isfinite(row).all():
+            history = []
+            continue
+        if last is None:
+            out[i] = row[np.lexsort((np.abs(row.imag), row.imag < 0))]
+        else:
+            prior = history or [last]
+            guess = prior[-1] if len(prior) < 2 else 2.0 * prior[-1] - prior[-2]
+            _, order = linear_sum_assignment(np.abs(guess[:, None] - row[None, :]))
+            out[i] = row[order]
+        last = out[i]
+        history = [*history[-1:], out[i]]
+    return out
+
+
+def _existence_limit(points: ParameterPoints, inside: float, outside: float,
+                     guess: Equilibrium) -> float:
+    """Value of the key between `inside` (the equilibrium exists) and `outside` (it does
+    not) where it ceases to exist: where the smallest normal force of the solution of the
+    slip equations reaches zero, or where that solution itself is lost (a fold); `inside`
+    if the solution jumps between the two."""
+    from scipy.optimize import brentq
+
+    last = [guess]
+
+    def least_force(value: float) -> float:
+        eq = points.equilibrium(points.model((value,)), last[0], contact=False)
+        if eq is None:
+            # No solution at all counts as outside: Brent's method then converges on
+            # the edge of the solutions, the fold.
+            return -1.0
+        last[0] = eq
+        return float(np.min(eq.normal_force))
+
+    if least_force(outside) > 0.0:
+        # The solution jumped between the two values (a pole of the disc's static
+        # compliance at a critical speed lies between them): no bracket to refine.
+        return inside
+    span = abs(outside - inside)
+    return float(brentq(least_force, inside, outside, xtol=1e-13 * max(span, abs(inside)),
+                        rtol=1e-15))
+
+
+def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = "key",
+                   progress: bool = False) -> xr.Dataset:
+    """Eigenvalues of the linearised slip equations followed along one numeric key.
+
+    Parameters
+    ----------
+    case : Case
+        Base case at constant speed.
+    key : str
+        Dotted case key to vary, e.g. ``"friction.kinetic_max"``.
+    values : sequence of float
+        Its values, in the order to follow (at least 2; close enough that an eigenvalue
+        moves less than its distance to the others between neighbours).
+    option : str
+        What names `key` in error messages (``"--x"`` from the command line).
+    progress : bool
+        Show a progress bar.
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimension named after the key (with its units), ``branch`` (one per eigenvalue,
+        ``2 (n + S)``) and ``slider``. Variables: ``growth_rate`` and ``frequency`` (key,
+        branch) [1/s], [Hz]: the real part and the imaginary part / 2 pi (signed: each
+        complex pair has a positive and a negative branch); ``mode`` (branch): the
+        coordinate with most of the kinetic energy where the branch starts;
+        ``max_growth_rate`` (key); ``normal_force``, ``phi`` (key, slider): the
+        equilibrium (NaN where there is none); ``existence_limit`` (limit): the values
+        of the key where a slider's normal force reaches zero and the equilibrium ceases
+        to exist; ``coupling`` (coupling) with ``coupling_first``, ``coupling_second``:
+        the values (at the grid's resolution) where two branches' frequencies merge
+        within ``COUPLING_TOLERANCE`` while their growth rates part, and the branches.
+        Attributes ``x_key`` and the base case's TOML (``case``).
+
+    Raises
+    ------
+    CaseError
+        A key that is not a number of this case, fewer than two values, an empty range,
+        values outside the key's allowed range, or no sliding equilibrium at the first
+        value.
+    """
+    values = check_values(option, key, values)
+    check_keys(case, [key], [option])
+    check_box(case, [(key, values)])
+    points = ParameterPoints(case, [key])
+    points.require_equilibrium((values[0],), option)
+    size, ns = points.size, points.base.n_sliders
+    lam = np.full((values.size, size), np.nan + 1j * np.nan)
+    force = np.full((values.size, ns), np.nan)
+    angle = np.full((values.size, ns), np.nan)
+    first_model = first_vectors = None
+    limits: list[float] = []
+    guess = None
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=values.size, desc="eigenvalue branches", unit="pt")
+    for i, value in enumerate(values):
+        point = points.linearise((value,), guess)
+        if bar is not None:
+            bar.update()
+        if point is None:
+            if guess is not None:
+                limits.append(_existence_limit(points, values[i - 1], value, guess))
+            guess = None
+            continue
+        model, eq, jac = point
+        if guess is None and i > 0:
+            # The equilibrium reappears: the limit lies between the last two values.
+            limits.append(_existence_limit(points, value, values[i - 1], eq))
+        guess = eq
+        if first_model is None:
+            lam[i], first_vectors = np.linalg.eig(jac)
+            first_model = model
+        else:
+            lam[i] = np.linalg.eigvals(jac)
+        force[i], angle[i] = eq.normal_force, eq.phi
+    if bar is not None:
+        bar.close()
+    raw = lam[np.isfinite(lam).all(axis=1)][0]
+    lam = follow(lam)
+    start = lam[np.isfinite(lam).all(axis=1)][0]
+    which = [int(np.argmin(np.abs(raw - v))) for v in start]
+    modes = dominant_coordinates(first_model, first_vectors[:, which])
+    return _dataset(case, key, values, lam, modes, force, angle, limits)
+
+
+def _last_valid(lam: np.ndarray, i: int) -> int:
+    rows = np.flatnonzero(np.isfinite(lam[:i, 0]))
+    return int(rows[-1])
+
+
+def mode_couplings(lam: np.ndarray, tolerance: float = COUPLING_TOLERANCE
+                   ) -> list[tuple[int, int, int]]:
+    """Where pairs of branches couple: ``(index, first, second)`` at each edge of an
+    interval of values where the two positive frequencies agree within `tolerance`
+    (relative) and the growth rates are further apart than just outside it; `index` is
+    the edge's value inside the interval (where the modes merge, and where they part
+    again).
+
+    Parameters
+    ----------
+    lam : ndarray
+        ``(values, branches)`` complex eigenvalues, followed by continuity.
+    """
+    found = []
+    upper = [b for b in range(lam.shape[1]) if np.nanmedian(lam[:, b].imag) > 0.0]
+    for ia, a in enumerate(upper):
+        for b in upper[ia + 1:]:
+            wa, wb = lam[:, a].imag, lam[:, b].imag
+            merged = np.abs(wa - wb) <= tolerance * np.maximum(np.abs(wa), np.abs(wb))
+            split = np.abs(lam[:, a].real - lam[:, b].real)
+            for i in range(1, lam.shape[0]):
+                if merged[i] == merged[i - 1] or not np.isfinite(wa[i - 1] + wb[i]):
+                    continue
+                inside, outside = (i, i - 1) if merged[i] else (i - 1, i)
+                # The growth rates part on the merged side (a coupling, not a veering).
+                if split[inside] > split[outside]:
+                    found.append((inside, a, b))
+    return sorted(found)
+
+
+def _dataset(case: Case, key: str, values: np.ndarray, lam: np.ndarray,
+             modes: tuple[str, ...], force: np.ndarray, angle: np.ndarray,
+             limits: list[float]) -> xr.Dataset:
+    from fivdisc.conventions import global_attrs, key_attrs
+
+    couplings = mode_couplings(lam)
+    growth = lam.real
+    return xr.Dataset(
+        {
+            "growth_rate": ((key, "branch"), growth, {
+                "units": "1/s", "long_name": "real part of the eigenvalue"}),
+            "frequency": ((key, "branch"), lam.imag / (2.0 * np.pi), {
+                "units": "Hz", "long_name": "imaginary part of the eigenvalue / 2 pi"}),
+            "mode": (("branch",), np.array(modes, dtype=str), {
+                "long_name": "coordinate with most of the kinetic energy where the branch "
+                             "starts"}),
+            "max_growth_rate": ((key,), np.max(growth, axis=1), {
+                "units": "1/s", "long_name": "largest real part of the eigenvalues (nan: no "
+                                             "sliding equilibrium)"}),
+            "normal_force": ((key, "slider"), force, {
+                "units": "N", "long_name": "normal force at the sliding equilibrium"}),
+            "phi": ((key, "slider"), angle, {
+                "units": "rad", "long_name": "slider angle at the sliding equilibrium"}),
+            "existence_limit": (("limit",), np.array(limits, dtype=float), {
+                "units": key_attrs(key)["units"],
+                "long_name": "where a slider's normal force at the equilibrium reaches "
+                             "zero"}),
+            "coupling": (("coupling",), np.array([values[i] for i, _, _ in couplings]), {
+                "units": key_attrs(key)["units"],
+                "long_name": "where two frequencies merge and their growth rates part "
+                             "(at the resolution of the values)"}),
+            "coupling_first": (("coupling",), np.array([a for _, a, _ in couplings],
+                                                      dtype=np.int64)),
+            "coupling_second": (("coupling",), np.array([b for _, _, b in couplings],
+                                                       dtype=np.int64)),
+        },
+        coords={key: (key, values, key_attrs(key)), "branch": np.arange(lam.shape[1]),
+                "slider": np.arange(force.shape[1])},
+        attrs={**global_attrs(f"fivdisc eigenvalue branches along {key}",
+                              "fivdisc.eigen_branches"),
+               "fivdisc_kind": "eigen_branches", "x_key": key, "case": case.to_toml()},
+    )
