@@ -120,5 +120,30 @@ def test_simulations_agree_with_the_subcritical_verdict(hopf, cycles):
 
 
 def test_bad_amplitude_is_refused(hopf):
-    with pytest.raises(FivdiscError, match="amplitude = 0.0 is invalid"):
+    with pytest.raises(FivdiscError, match=r"amplitude = 0\.0 is invalid"):
         hopf_cycles(hopf, 30.0, amplitude=0.0)
+
+
+def test_continue_from_hopf_on_the_command_line(tmp_path):
+    """fivdisc continue --from-hopf: the Hopf point, the verdict, a branch file that
+    keeps them; a bad range is refused in one line (exit status 2)."""
+    from click.testing import CliRunner
+
+    from fivdisc.analysis.branch import open_branch
+    from fivdisc.cli import cli
+
+    case = tmp_path / "rigid.toml"
+    case.write_text(CASE.to_toml())
+    out = tmp_path / "cycles.nc"
+    res = CliRunner().invoke(cli, ["continue", str(case), "--key", "speed.value", "--to",
+                                   "30", "--from-hopf", "0.5:30:25", "--points", "3",
+                                   "--no-progress", "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    assert "Hopf point at speed.value = 9.16290" in res.output
+    assert "subcritical" in res.output
+    saved = open_branch(out).hopf()
+    assert saved["criticality"] == "subcritical" and saved["direction"] == -1
+    bad = CliRunner().invoke(cli, ["continue", str(case), "--key", "speed.value", "--to",
+                                   "30", "--from-hopf", "0.5:30"])
+    assert bad.exit_code == 2
+    assert "--from-hopf = '0.5:30' is invalid" in bad.output
