@@ -67,6 +67,35 @@ def test_small_orbits_follow_the_averaged_closed_form(hopf):
     assert shifts[1] / shifts[0] == pytest.approx(4.0, rel=0.1)
 
 
+STRIBECK = Case(disc={"modes": []}, slider={"rotational_damping": 0.2},
+                friction={"law": "stribeck", "stribeck_velocity": 1.0,
+                          "stribeck_exponent": 2.0}, speed={"value": 1.0})
+
+
+@pytest.fixture(scope="module")
+def stribeck_hopf():
+    return hopf_points(STRIBECK, "speed.value", np.linspace(0.2, 30.0, 40))
+
+
+@pytest.mark.parametrize("which", [0, 1])
+def test_stribeck_hopf_points_supercritical_below_subcritical_above(stribeck_hopf, which):
+    """mu = mu_k + dmu exp(-(u / v_s)^2) has two Hopf points (test_hopf). The averaging of
+    the module docstring, for any law, gives Omega - Omega_H = -r mu''' V^2 / (8 mu''):
+    at the lower point (u / v_s = 0.08) mu''' > 0 > mu'', the orbits lie above it where
+    sliding is unstable, and are stable: supercritical; at the upper one (u / v_s = 1.76)
+    mu''' < 0 < mu'', the orbits lie above it where sliding is stable: subcritical. The
+    first orbit (r V / v_s ~ 1e-3 and 2e-2) matches the offset to 1e-3."""
+    hopf = stribeck_hopf[which]
+    first = hopf_cycles(hopf, 30.0, max_points=1)
+    x = R * hopf.value  # v_s = 1 m/s
+    d2, d3 = (4 * x**2 - 2) * np.exp(-x**2), (12 * x - 8 * x**3) * np.exp(-x**2)
+    v = _rate_amplitude(first)
+    offset = first.parameter[0] - hopf.value
+    assert offset == pytest.approx(-R * d3 * v**2 / (8 * d2), rel=1e-3)
+    expected = ("supercritical", True) if which == 0 else ("subcritical", False)
+    assert (first.hopf()["criticality"], bool(first.stable[0])) == expected
+
+
 def test_branch_grazes_and_gives_the_bistable_range(hopf, cycles):
     """The unstable slipping orbits grow with the speed until the slip speed touches
     zero; the branch ends there, and the bistable range runs from the Hopf speed to it."""
