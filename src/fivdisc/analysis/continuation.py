@@ -27,6 +27,12 @@ event signature, by bisection, each to a relative accuracy of 1e-6 in the parame
 * torus (Neimark-Sacker): a complex pair crosses the unit circle;
 * discontinuity-induced: the event signature (:mod:`fivdisc.analysis.cycle`) changes;
   the multipliers on either side are reported, since they may jump there.
+* grazing: a branch of slipping orbits lost where its slip speed touches zero ends
+  there (the stick-slip orbits turn back from it).
+
+A branch may also start at a Hopf point of the equilibrium
+(:func:`fivdisc.analysis.hopf_cycle.hopf_cycles`): the first point is corrected with its
+amplitude along the critical eigenvector held and the parameter free.
 """
 
 from __future__ import annotations
@@ -388,7 +394,7 @@ def _hopf_start(branch: _Branch, state: np.ndarray, direction: np.ndarray, eps: 
     x0 = state + eps * direction
     shot = branch.shooting.shoot(x0, branch.period0)
     branch.set_free(shot, x0)
-    # The set size is linear in the amplitude for small orbits.
+    # The orbit's size is linear in its amplitude while it is small.
     branch.xs *= size / eps
     z0 = branch.pack(x0, branch.period0, branch.p0)
     row = z0 - branch.pack(state, branch.period0, branch.p0)
