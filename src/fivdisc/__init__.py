@@ -33,6 +33,7 @@ if TYPE_CHECKING:
     from fivdisc.analysis.energy import energy_balance
     from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium
     from fivdisc.analysis.hopf import HopfPoint, hopf_points
+    from fivdisc.analysis.hopf_cycle import hopf_cycles
     from fivdisc.analysis.lyapunov import LyapunovSpectrum, lyapunov
     from fivdisc.analysis.orbits import PeriodicOrbit, periodic_orbit
     from fivdisc.analysis.spectra import classify, dominant_frequency, find_peaks, spectrum, stft
@@ -86,6 +87,7 @@ __all__ = [
     "eigen_branches",
     "energy_balance",
     "find_peaks",
+    "hopf_cycles",
     "hopf_points",
     "linear_stability",
     "load_case",
@@ -114,6 +116,7 @@ _HOMES = {
         "fivdisc.analysis.energy": ("energy_balance",),
         "fivdisc.analysis.equilibrium": ("Equilibrium", "sliding_equilibrium"),
         "fivdisc.analysis.hopf": ("HopfPoint", "hopf_points"),
+        "fivdisc.analysis.hopf_cycle": ("hopf_cycles",),
         "fivdisc.analysis.lyapunov": ("LyapunovSpectrum", "lyapunov"),
         "fivdisc.analysis.orbits": ("PeriodicOrbit", "periodic_orbit"),
         "fivdisc.analysis.spectra": (

@@ -115,6 +115,19 @@ class Branch:
             })
         return out
 
+    def hopf(self) -> dict[str, Any] | None:
+        """For a branch from :func:`~fivdisc.analysis.hopf_cycle.hopf_cycles`: the Hopf
+        point's ``value``, ``omega`` [rad/s], ``direction``, ``criticality``
+        (``"subcritical"`` or ``"supercritical"``) and the ``bistable`` range (low, high;
+        nan if none); else None."""
+        attrs = self.dataset.attrs
+        if "criticality" not in attrs:
+            return None
+        return {"value": float(attrs["hopf_value"]), "omega": float(attrs["hopf_omega"]),
+                "direction": int(attrs["hopf_direction"]),
+                "criticality": str(attrs["criticality"]),
+                "bistable": (float(attrs["bistable_low"]), float(attrs["bistable_high"]))}
+
     # --- writing ------------------------------------------------------------------------
 
     @classmethod
@@ -248,7 +261,10 @@ class Branch:
             bifs.append(entry)
         return {"key": self.key, "points": points, "bifurcations": bifs,
                 "stop_reason": self.stop_reason, "lost": self.lost,
-                "start": str(self.dataset.attrs.get("start", ""))}
+                "start": str(self.dataset.attrs.get("start", "")),
+                **({"hopf": {**hopf, "bistable": [None if math.isnan(b) else b
+                                                  for b in hopf["bistable"]]}}
+                   if (hopf := self.hopf()) else {})}
 
     def to_json(self) -> str:
         """:meth:`to_dict` as indented JSON (what ``fivdisc continue --json`` prints)."""
@@ -265,6 +281,13 @@ class Branch:
                  f"{p[0]:.9g} to {p[-1]:.9g}{unit}, period {t[0]:.9g} to {t[-1]:.9g} s; "
                  f"{int(self.stable.sum())} stable",
                  f"stopped: {self.stop_reason}"]
+        hopf = self.hopf()
+        if hopf:
+            lines.append(f"from the Hopf point at {self.key} = {hopf['value']:.9g}{unit}: "
+                         f"{hopf['criticality']}")
+            low, high = hopf["bistable"]
+            lines.append("bistable range (stable sliding and a stable vibration): " + (
+                "none found" if math.isnan(low) else f"{low:.9g} to {high:.9g}{unit}"))
         bifs = self.bifurcations()
         lines.append(f"bifurcations: {len(bifs) or 'none'}")
         for b in bifs:

@@ -28,6 +28,12 @@ event signature, by bisection, each to a relative accuracy of 1e-6 in the parame
 * torus (Neimark-Sacker): a complex pair crosses the unit circle;
 * discontinuity-induced: the event signature (:mod:`fivdisc.analysis.cycle`) changes;
   the multipliers on either side are reported, since they may jump there.
+* grazing: a branch of slipping orbits lost where its slip speed touches zero ends
+  there (the stick-slip orbits turn back from it).
+
+A branch may also start at a Hopf point of the equilibrium
+(:func:`fivdisc.analysis.hopf_cycle.hopf_cycles`): the first point is corrected with its
+amplitude along the critical eigenvector held and the parameter free.
 """
 
 from __future__ import annotations
@@ -68,6 +74,9 @@ _LOCATE = 1e-6
 _POLISH = 1e-2
 # A multiplier whose imaginary part is below this (relative) is taken as real.
 _REAL = 1e-6
+# A lost branch of slipping orbits whose smallest slip speed is below this fraction of
+# the disc speed ends grazing the stick boundary.
+_GRAZING = 1e-3
 
 
 @dataclass
@@ -98,8 +107,9 @@ class Bifurcation:
     ----------
     kind : str
         ``"fold"``, ``"period doubling"``, ``"torus"``, ``"branch point"`` (a real
-        multiplier through +1 without a fold) or ``"signature change"``
-        (discontinuity-induced).
+        multiplier through +1 without a fold), ``"signature change"``
+        (discontinuity-induced) or ``"grazing"`` (the branch ends where its slip speed
+        touches zero, at its last point).
     parameter : float
         The key's value there [its unit].
     period : float
@@ -160,16 +170,16 @@ def check_key(case: Case, key: str, option: str = "key") -> float:
 class _Branch:
     """The continuation problem: the case, the key, scales and the point machinery."""
 
-    def __init__(self, case: Case, key: str, orbit: PeriodicOrbit, rtol: float, atol: float,
-                 tol: float) -> None:
+    def __init__(self, case: Case, key: str, phases: np.ndarray, period: float, rtol: float,
+                 atol: float, tol: float) -> None:
         self.case, self.key = case, key
         self.base = build_model(case)
         self.p0 = check_key(case, key)
         self.rtol, self.atol, self.tol = rtol, atol, tol
         self.scale = energy_scales(self.base)
-        self.shooting = Shooting(self.base, orbit.phases, rtol, atol, self.scale)
+        self.shooting = Shooting(self.base, phases, rtol, atol, self.scale)
         self._models: dict[float, Model] = {}
-        self.period0 = orbit.period
+        self.period0 = period
         self.ps = abs(self.p0) if self.p0 != 0 else 1.0
 
     # --- coordinates ----------------------------------------------------------------------
@@ -370,6 +380,29 @@ def _start_point(branch: _Branch, orbit: PeriodicOrbit, direction: float,
         t[: branch.m] = along[branch.free] / branch.scale[branch.free]
         pt.tangent = t / np.linalg.norm(t)
     return pt
+
+
+def _hopf_start(branch: _Branch, state: np.ndarray, direction: np.ndarray, eps: float,
+                size: float, deadline: float) -> _Point:
+    """The first point of the orbits born at a Hopf point: from ``state + eps direction``
+    (the equilibrium and the critical eigenvector's real part, the period the branch's
+    first), Newton with the amplitude along ``direction`` held at ``eps`` and the
+    parameter free; the tangent points to larger amplitudes. The unknowns are measured
+    in the orbit of amplitude ``size`` (not the first, small orbit's): so a step is a
+    fraction of the way to ``size``."""
+    x0 = state + eps * direction
+    shot = branch.shooting.shoot(x0, branch.period0)
+    branch.set_free(shot, x0)
+    # The orbit's size is linear in its amplitude while it is small.
+    branch.xs *= size / eps
+    z0 = branch.pack(x0, branch.period0, branch.p0)
+    row = z0 - branch.pack(state, branch.period0, branch.p0)
+    row /= np.linalg.norm(row)
+    dp = branch.dgap_dp(x0, branch.period0, branch.p0)
+    jac = branch.jacobian(shot, branch.shooting, dp, branch.phase_row(shot))
+    ref = _Point(z0, x0, shot, jac, np.zeros_like(z0), np.zeros(0), 0, np.inf, 0)
+    pt = branch.correct(z0, row, float(row @ z0), ref, 1.0, deadline)
+    return branch.finish(pt, row, 1.0)
 
 
 def doubled_start(case: Case, state: np.ndarray, period: float, phases: np.ndarray,
@@ -593,9 +626,24 @@ def continue_orbit(
     grows by 1.5, after 7 or more it halves; a refused or failed step is halved, and a
     step below ``min_step`` ends the branch as lost.
     """
-    from fivdisc.analysis.branch import Branch
-    from fivdisc.progress import progress_bar
+    p0 = _check_options(case, key, to, max_points, step, max_step, min_step, tol,
+                        time_budget)
+    atol_run = atol if atol is not None else rtol * 1e-7
+    if orbit is None:
+        orbit = periodic_orbit(case, rtol=rtol, atol=atol_run, tol=tol, progress=progress,
+                               **search)
+    elif not orbit.converged:
+        raise ConvergenceError("the start is not a converged periodic orbit", result=orbit,
+                               reason="not converged")
+    direction = 1.0 if to > p0 else -1.0
+    branch = _Branch(case, key, orbit.phases, orbit.period, rtol, atol_run, tol)
+    return _run(branch, lambda deadline: _start_point(branch, orbit, direction, along), to,
+                max_points, step, max_step, min_step, time_budget, progress, orbit.start)
 
+
+def _check_options(case: Case, key: str, to: float, max_points: int, step: float,
+                   max_step: float, min_step: float, tol: float, time_budget: float) -> float:
+    """The one-line refusals of :func:`continue_orbit`'s arguments; the key's value."""
     if case.speed.profile != "constant":
         raise FivdiscError(f"continuation needs a constant disc speed (speed.profile = "
                            f"'constant'), not {case.speed.profile!r}: with a varying speed "
@@ -616,23 +664,23 @@ def continue_orbit(
                            f"{min_step!r} and max_step = {max_step!r}")
     if not (isinstance(max_points, int) and max_points >= 1):
         raise FivdiscError(f"max_points = {max_points!r} is invalid: must be an integer >= 1")
-    atol_run = atol if atol is not None else rtol * 1e-7
-    if orbit is None:
-        orbit = periodic_orbit(case, rtol=rtol, atol=atol_run, tol=tol, progress=progress,
-                               **search)
-    elif not orbit.converged:
-        raise ConvergenceError("the start is not a converged periodic orbit", result=orbit,
-                               reason="not converged")
+    return p0
+
+
+def _run(branch: _Branch, first, to: float, max_points: int, step: float, max_step: float,
+         min_step: float, time_budget: float, progress: bool, start: str):
+    """The first point (``first(deadline)``), then the walk to ``to``: the branch."""
+    from fivdisc.analysis.branch import Branch
+    from fivdisc.progress import progress_bar
+
     deadline = time.monotonic() + time_budget
-    direction = 1.0 if to > p0 else -1.0
-    branch = _Branch(case, key, orbit, rtol, atol_run, tol)
     walk = _Walk()
-    with progress_bar(progress, total=max_points, desc=f"continuing in {key}",
+    with progress_bar(progress, total=max_points, desc=f"continuing in {branch.key}",
                       unit="point") as bar:
-        walk.points.append(_start_point(branch, orbit, direction, along))
+        walk.points.append(first(deadline))
         bar.update()
         _walk(branch, walk, to, max_points, step, max_step, min_step, deadline, bar)
-    return Branch.from_walk(branch, walk, orbit.start)
+    return Branch.from_walk(branch, walk, start)
 
 
 def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
@@ -655,7 +703,11 @@ def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
             if ds < min_step:
                 _, _, p = branch.unpack(a.z)
                 end = _vanishing(branch, a, len(walk.points) - 1)
-                if end is None:
+                if end is None and _slip_margin(branch, a) < _GRAZING:
+                    walk.bifurcations.append(_grazing(branch, a, len(walk.points) - 1))
+                    walk.stop = _Stop(f"the orbit grazes the stick boundary at {branch.key} "
+                                      f"= {p:.9g} and does not persist past it")
+                elif end is None:
                     walk.stop = _Stop(f"the orbit is lost at {branch.key} = {p:.9g}: "
                                       f"{exc.reason}", lost=True)
                 else:
@@ -689,6 +741,35 @@ def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
         elif b.iterations >= 7:
             ds = max(ds * 0.5, min_step)
     walk.stop = _Stop(f"the largest number of points ({max_points}) is reached")
+
+
+def _slip_margin(branch: _Branch, a: _Point) -> float:
+    """The smallest slip speed ``|Omega - phidot|`` over ``a``'s orbit, relative to the
+    disc speed (over the sliders that slip throughout; 0 if one sticks)."""
+    _, _, p = branch.unpack(a.z)
+    speed = p if branch.key == "speed.value" else branch.case.speed.value
+    speed = abs(speed)
+    margins = []
+    for j, sig in enumerate(a.cycle.signature):
+        if "stick" in sig:
+            return 0.0
+        if sig.startswith("slip"):
+            hi = a.cycle.measures["phi_dot_max"][j]
+            lo = a.cycle.measures["phi_dot_min"][j]
+            margins.append(min(abs(speed - hi), abs(speed - lo)))
+    return min(margins) / speed if margins and speed > 0 else np.inf
+
+
+def _grazing(branch: _Branch, a: _Point, index: int) -> Bifurcation:
+    """The end of a branch of slipping orbits lost where its slip speed touches zero."""
+    _, period, p = branch.unpack(a.z)
+    return Bifurcation(kind="grazing", parameter=p, period=period, state=a.x.copy(),
+                       before=a.multipliers, after=a.multipliers,
+                       signature_before=a.cycle.signature, signature_after=a.cycle.signature,
+                       point=index,
+                       note=f"the slip speed touches zero (smallest {_slip_margin(branch, a):.1e}"
+                       " of the disc speed): a stick phase appears and the slipping orbits "
+                       "end (the stick-slip orbits leave from here)")
 
 
 def _vanishing(branch: _Branch, a: _Point, index: int) -> Bifurcation | None:

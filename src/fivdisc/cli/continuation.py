@@ -28,6 +28,11 @@ from fivdisc.cli._case import CASE
 @click.option("--bifurcation", "which", type=int,
               help="With --from BRANCH: start at its bifurcation K (from 0); at a period "
               "doubling, continue the branch of doubled orbits born there.")
+@click.option("--from-hopf", "hopf_spec", metavar="START:STOP:N",
+              help="Start from the orbits born at a Hopf point of the sliding equilibrium "
+              "in --key, searched on N values from START to STOP (the first where the "
+              "equilibrium changes stability): says whether it is sub- or supercritical "
+              "and the bistable range.")
 @click.option("--points", type=int, default=200, show_default=True,
               help="Most points on the branch.")
 @click.option("--step", type=float, default=0.02, show_default=True,
@@ -47,7 +52,8 @@ from fivdisc.cli._case import CASE
 @click.option("--progress/--no-progress", default=True, show_default=True,
               help="Show the Newton iterations and the points on a terminal.")
 def continuation(case_file: Path | None, key: str, target: float, from_file: Path | None,
-                 which: int | None, points: int, step: float, max_step: float,
+                 which: int | None, hopf_spec: str | None, points: int, step: float,
+                 max_step: float,
                  transient: float | None, period: float | None, rtol: float, as_json: bool,
                  output: Path | None, progress: bool) -> None:
     """Follow a periodic orbit of CASE_FILE (constant speed) as --key goes --to a value.
@@ -69,6 +75,16 @@ def continuation(case_file: Path | None, key: str, target: float, from_file: Pat
     for name, value in (("--points", points),):
         if value < 1:
             raise FivdiscError(f"{name} = {value} is invalid: must be >= 1")
+    if hopf_spec is not None:
+        if from_file is not None or transient is not None or period is not None:
+            raise FivdiscError("--from-hopf starts at a Hopf point: leave out --from, "
+                               "--transient and --period")
+        branch = _from_hopf(case_file, key, target, hopf_spec, points, step, max_step, rtol,
+                            progress)
+        if out is not None:
+            branch.to_netcdf(out)
+        click.echo(branch.to_json() if as_json else str(branch))
+        sys.exit(1 if branch.lost else 0)
     try:
         case, orbit, along, search = _start(case_file, from_file, which, key, target, rtol,
                                             transient, period)
@@ -83,6 +99,37 @@ def continuation(case_file: Path | None, key: str, target: float, from_file: Pat
     click.echo(branch.to_json() if as_json else str(branch))
     if branch.lost:
         sys.exit(1)
+
+
+def _from_hopf(case_file, key: str, target: float, spec: str, points: int, step: float,
+               max_step: float, rtol: float, progress: bool):
+    """The branch of orbits from the first Hopf point on ``spec``'s values of ``key``."""
+    import numpy as np
+
+    from fivdisc.analysis.hopf import hopf_points
+    from fivdisc.analysis.hopf_cycle import hopf_cycles
+    from fivdisc.case import Case, load_case
+    from fivdisc.errors import FivdiscError
+
+    usage = f"--from-hopf = {spec!r} is invalid: write START:STOP:N (N >= 2 values of {key})"
+    try:
+        start, stop, num = spec.split(":")
+        values = np.linspace(float(start), float(stop), int(num))
+    except ValueError:
+        raise FivdiscError(usage) from None
+    if values.size < 2 or not np.all(np.isfinite(values)) or values[0] == values[-1]:
+        raise FivdiscError(usage)
+    case = _checked(load_case(case_file) if case_file else Case(), key, target)
+    for value in values[[0, -1]]:
+        _checked(case, key, float(value))
+    found = hopf_points(case, key, values, option="--key")
+    if not found:
+        raise FivdiscError(f"--from-hopf {spec}: no Hopf point of the sliding equilibrium in "
+                           f"{key} between {values[0]:g} and {values[-1]:g}")
+    hopf = next((h for h in found if h.on_boundary), found[0])
+    click.echo(str(hopf))
+    return hopf_cycles(hopf, target, max_points=points, step=step, max_step=max_step,
+                       rtol=rtol, progress=progress)
 
 
 def _checked(case, key: str, target: float):

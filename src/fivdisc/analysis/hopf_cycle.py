@@ -1,0 +1,149 @@
+"""The periodic orbits born at a Hopf point of the sliding equilibrium, continued.
+
+At a Hopf point (:mod:`fivdisc.analysis.hopf`) a family of small periodic orbits is born
+along the critical eigenvector ``v`` with the period ``2 pi / omega``. The family is
+started from the small orbit ``x0 = y_eq + eps Re(v)``, ``T = 2 pi / omega``, corrected
+with its amplitude along ``Re(v)`` held and the parameter free (the first orbit then
+lies at ``p(eps)``), and continued by :func:`~fivdisc.analysis.continuation.continue_orbit`'s
+machinery towards larger amplitudes, through folds, until the slip-speed oscillation
+reaches the sliding speed and a stick phase appears (grazing: the branch either goes on
+as stick-slip orbits or ends there, saying so).
+
+Which side of the Hopf value the small orbits lie on decides the Hopf point's kind:
+on the side where the equilibrium is unstable it is supercritical (small stable orbits,
+the vibration grows gently from zero), on the stable side subcritical (small unstable
+orbits: a threshold around a stable equilibrium, and a jump to a large vibration where
+the equilibrium loses stability).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fivdisc.analysis.branch import Branch
+from fivdisc.analysis.continuation import _Branch, _check_options, _hopf_start, _run
+from fivdisc.analysis.hopf import HopfPoint
+from fivdisc.errors import FivdiscError
+from fivdisc.model import build_model
+
+__all__ = ["hopf_cycles"]
+
+
+def grazing_amplitude(hopf: HopfPoint) -> float:
+    """The amplitude ``eps`` along ``Re(v)`` at which the linear orbit's slip-speed
+    oscillation ``eps |v_phidot|`` reaches the sliding speed ``Omega`` for the first
+    slider: where, to first order, a stick phase appears."""
+    model = build_model(hopf.case)
+    rates = [abs(hopf.eigenvector[model.index("phi_dot", j)])
+             for j in range(model.n_sliders)]
+    return float(abs(hopf.case.speed.value) / max(max(rates), 1e-300))
+
+
+def hopf_cycles(
+    hopf: HopfPoint,
+    to: float,
+    *,
+    amplitude: float = 0.01,
+    max_points: int = 200,
+    step: float = 0.02,
+    max_step: float = 0.1,
+    min_step: float = 1e-6,
+    rtol: float = 1e-12,
+    atol: float | None = None,
+    tol: float = 1e-8,
+    time_budget: float = 3600.0,
+    progress: bool = False,
+) -> Branch:
+    """Start the periodic orbits born at a Hopf point and continue them.
+
+    Parameters
+    ----------
+    hopf : HopfPoint
+        From :func:`~fivdisc.analysis.hopf.hopf_points`.
+    to : float
+        A value of ``hopf.key`` where the continuation stops if the branch gets there
+        [the key's unit] (the branch's direction is set by the orbits, not by `to`).
+    amplitude : float
+        Size of the first orbit, as a fraction of the linear orbit that would graze the
+        stick boundary (slip-speed oscillation equal to the sliding speed) [-]:
+        ``eps = amplitude * Omega / |v_phidot|``. In (0, 0.5].
+    max_points, step, max_step, min_step, rtol, atol, tol, time_budget, progress
+        As :func:`~fivdisc.analysis.continuation.continue_orbit`; the unknowns' scale is
+        the grazing orbit, so a step of 0.02 takes about 2 % of the way to grazing.
+
+    Returns
+    -------
+    Branch
+        The branch of orbits from the Hopf point, with attributes ``hopf_value``,
+        ``hopf_omega``, ``hopf_direction``, ``criticality`` (``"subcritical"`` or
+        ``"supercritical"``) and ``bistable_low``, ``bistable_high`` (nan if there is no
+        bistable range) in its dataset, printed by ``str`` (see :meth:`Branch.hopf`).
+
+    Raises
+    ------
+    FivdiscError
+        A bad argument (one line, before any work).
+    ConvergenceError
+        The first orbit does not converge (take a smaller `amplitude`).
+
+    Notes
+    -----
+    The first orbit solves, for ``(x, T, p)``, the shooting equations
+    ``phi_T(x; p) = x``, the phase condition and ``w . (z - z_eq) = eps |w|``, with
+    ``w`` the scaled ``Re(v)``. Near the Hopf point ``p(eps) - p_H = c eps^2``: the sign
+    of ``c`` against the side where the equilibrium is unstable gives the kind (that of
+    the first Lyapunov coefficient ``l1``: ``c`` has the sign of ``-l1 / (d Re lambda /
+    dp)``). The bistable range is where the equilibrium is stable and a stable orbit of
+    the branch exists: from the Hopf value to the farthest stable orbit on the
+    equilibrium's stable side (a fold of cycles), or to where unstable slipping orbits
+    on that side graze the stick boundary (there the stick-slip orbits begin, and the
+    unstable orbits separate the equilibrium's basin from them: the stick-slip orbits
+    themselves are not continued here; a simulation in the range shows both
+    attractors). The equilibrium's stability beyond other Hopf points of the key is not
+    checked.
+    """
+    if not (np.isfinite(amplitude) and 0 < amplitude <= 0.5):
+        raise FivdiscError(f"amplitude = {amplitude!r} is invalid: must be in (0, 0.5], a "
+                           "fraction of the grazing orbit's size")
+    case, key = hopf.case, hopf.key
+    _check_options(case, key, to, max_points, step, max_step, min_step, tol, time_budget)
+    atol_run = atol if atol is not None else rtol * 1e-7
+    size = grazing_amplitude(hopf)
+    model = build_model(case)
+    branch = _Branch(case, key, np.zeros(model.n_sliders, dtype=np.int64), hopf.period, rtol,
+                     atol_run, tol)
+    direction = hopf.eigenvector.real
+
+    def first(deadline: float):
+        return _hopf_start(branch, hopf.state, direction, amplitude * size, size, deadline)
+
+    result = _run(branch, first, to, max_points, step, max_step, min_step, time_budget,
+                  progress, f"at the Hopf point {key} = {hopf.value:.10g}, amplitude "
+                  f"{amplitude:g} of grazing")
+    _judge(result, hopf)
+    return result
+
+
+def _judge(result: Branch, hopf: HopfPoint) -> None:
+    """The Hopf point's kind and the bistable range, in the branch's attributes."""
+    p = result.parameter
+    unstable_side = float(hopf.direction)
+    side = np.sign(p[0] - hopf.value)
+    kind = "supercritical" if side == unstable_side else "subcritical"
+    # Orbits on the side where the equilibrium is stable, and stable themselves.
+    stable_side = (p - hopf.value) * unstable_side < 0
+    coexist = list(p[result.stable & stable_side])
+    # Unstable slipping orbits that graze on the stable side: the stick-slip orbits leave
+    # the grazing orbit towards the Hopf value (a non-smooth fold), so they coexist
+    # with the equilibrium from there to the Hopf value.
+    coexist += [b["parameter"] for b in result.bifurcations()
+                if b["kind"] == "grazing" and (b["parameter"] - hopf.value) * unstable_side < 0]
+    coexist = np.array(coexist)
+    if hopf.on_boundary and coexist.size:
+        far = coexist[np.argmax(np.abs(coexist - hopf.value))]
+        low, high = sorted((float(far), hopf.value))
+    else:
+        low = high = np.nan
+    result.dataset.attrs.update({"hopf_value": hopf.value, "hopf_omega": hopf.omega,
+                                 "hopf_direction": hopf.direction, "criticality": kind,
+                                 "bistable_low": low, "bistable_high": high})
