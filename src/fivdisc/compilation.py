@@ -17,7 +17,7 @@ from contextlib import contextmanager
 from typing import Any, TextIO
 
 __all__ = ["COMPILE_SECONDS", "TANGENT_COMPILE_SECONDS", "compile_notice", "needs_compiling",
-           "warm_kernel"]
+           "tangent_notice"]
 
 #: Typical time to compile the kernel [s]: 44-67 s measured on a loaded 2-core machine,
 #: 118 s on one under heavier load; benchmarks/bench_simulate.py measures it on yours.
@@ -118,19 +118,3 @@ def tangent_notice(show: bool = True) -> Iterator[None]:
     with compile_notice(tangent.prepare, show=show, what="kernel with tangent vectors",
                         seconds=TANGENT_COMPILE_SECONDS):
         yield
-
-
-def warm_kernel(show: bool = False) -> None:
-    """Compile or load the simulation kernel now, with a run of 1 ms of simulated time.
-
-    Parameters
-    ----------
-    show
-        Print the notice of :func:`compile_notice` if the kernel compiles.
-    """
-    from fivdisc._kernels import integrate
-    from fivdisc.case import Case
-    from fivdisc.simulate import simulate
-
-    with compile_notice(integrate.run, show=show):
-        simulate(Case(simulation={"duration": 1e-3, "output_rate": 1000.0}))

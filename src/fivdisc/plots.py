@@ -37,7 +37,7 @@ from fivdisc.analysis.trajectories import (
     separation_intervals,
 )
 from fivdisc.conventions import axis_label
-from fivdisc.result import select_slider
+from fivdisc.selection import select_slider
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from fivdisc.errors import FivdiscError
+from fivdisc.selection import select_slider  # noqa: F401 - its documented path
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -177,36 +178,6 @@ def describe_run(case: Case, speed: SpeedProfile | None = None) -> str:
         how = "disc speed from a table"
     count = len(case.sliders)
     return f"{count} slider{'s' if count > 1 else ''}, {how}, {case.simulation.duration:g} s"
-
-
-def select_slider(ds: xr.Dataset, slider: int = 0) -> xr.Dataset:
-    """The dataset as seen by one slider: per-slider variables at ``slider`` (the
-    ``slider`` dimension dropped) and only that slider's events.
-
-    Parameters
-    ----------
-    ds : xarray.Dataset
-        A simulation dataset (a dataset without a ``slider`` dimension is returned as is).
-    slider : int
-        Slider index, from 0.
-
-    Raises
-    ------
-    ValueError
-        If ``slider`` is not an index of the dataset's sliders.
-    """
-    if "slider" not in ds.dims:
-        return ds
-    count = ds.sizes["slider"]
-    if isinstance(slider, bool) or not isinstance(slider, int | np.integer) or not (
-        0 <= slider < count
-    ):
-        raise ValueError(f"slider = {slider!r} is invalid: must be an index in [0, {count - 1}]"
-                         f" (the run has {count} slider{'s' if count > 1 else ''})")
-    out = ds.isel(slider=int(slider))
-    if "event_slider" in ds and "event" in ds.dims:
-        out = out.isel(event=np.flatnonzero(ds["event_slider"].values == slider))
-    return out
 
 
 def _disc_thickness(ds: xr.Dataset) -> float:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import time as _time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 
 import numpy as np
 
@@ -13,6 +13,7 @@ from fivdisc._kernels import integrate as kern
 from fivdisc._kernels import slots
 from fivdisc.case import Case
 from fivdisc.compilation import compile_notice
+from fivdisc.conventions import fivdisc_version
 from fivdisc.errors import SimulationError
 from fivdisc.integration import STATUS, Integration
 from fivdisc.limits import check_simulation
@@ -20,78 +21,12 @@ from fivdisc.model import Model, build_model
 from fivdisc.result import EVENT_KINDS, PHASE_NAMES, Result, build_dataset
 from fivdisc.speed import SpeedProfile
 from fivdisc.split_compile import compile_split
+from fivdisc.start import initial_state
 from fivdisc.warmup import warm_up
 
 # Failures in which a state beyond the plate theory's range means the model diverged.
 _BLOW_UPS = ("nonfinite", "step_size_underflow")
 _CHUNKS = 200
-
-
-def initial_state(model: Model, initial=None) -> np.ndarray:
-    """Kernel state at t = 0 (without energy accumulators).
-
-    Parameters
-    ----------
-    model : Model
-        The model.
-    initial : None, "rest", "equilibrium", mapping or array
-        ``None`` takes the case's ``simulation.initial_state``. A mapping may give
-        ``q`` [m] and ``q_dot`` [m/s] (one per modal coordinate), ``phi`` [rad] and
-        ``phi_dot`` [rad/s] (one per slider, or one number for all); missing ones are
-        zero. An array is a full state of length ``2 (n + 2 S)``.
-    """
-    sim = model.case.simulation
-    if initial is None:
-        initial = sim.initial_state
-    n, ns = model.n, model.n_sliders
-    y = np.zeros(model.state_size)
-    phi = slice(model.index("phi"), model.index("phi") + ns)
-    phi_dot = slice(model.index("phi_dot"), model.index("phi_dot") + ns)
-    if isinstance(initial, str):
-        if initial == "rest":
-            return y
-        if initial == "equilibrium":
-            from fivdisc.analysis.equilibrium import sliding_equilibrium
-
-            y = sliding_equilibrium(model).state.copy()
-            y[phi] += sim.perturbation.phi
-            y[phi_dot] += sim.perturbation.phi_dot
-            return y
-        raise SimulationError(
-            f"initial = {initial!r} is invalid: must be 'rest', 'equilibrium', a mapping "
-            "or a state array"
-        )
-    if isinstance(initial, Mapping):
-        allowed = {"q", "q_dot", "phi", "phi_dot"}
-        unknown = set(initial) - allowed
-        if unknown:
-            raise SimulationError(
-                f"initial has unknown keys {sorted(unknown)}: allowed are {sorted(allowed)}"
-            )
-        blocks = (("q", slice(0, n), n, "modal coordinate"),
-                  ("q_dot", slice(n + 2 * ns, 2 * n + 2 * ns), n, "modal coordinate"),
-                  ("phi", phi, ns, "slider"), ("phi_dot", phi_dot, ns, "slider"))
-        for key, sl, size, what in blocks:
-            if key not in initial:
-                continue
-            val = np.asarray(initial[key], dtype=float)
-            if what == "slider" and val.ndim == 0:
-                val = np.full(ns, float(val))
-            if val.shape != (size,):
-                raise SimulationError(
-                    f"initial[{key!r}] has shape {val.shape}: must be ({size},), one per {what}"
-                )
-            y[sl] = val
-    else:
-        y = np.array(initial, dtype=float)
-        if y.shape != (model.state_size,):
-            raise SimulationError(
-                f"initial state has shape {y.shape}: must be ({model.state_size},) = "
-                "2 (n + 2 S)"
-            )
-    if not np.all(np.isfinite(y)):
-        raise SimulationError("initial state is invalid: all values must be finite")
-    return y
 
 
 def simulate(
@@ -196,15 +131,13 @@ def simulate(
     n_done = run.n_samples
     times = np.minimum(np.arange(n_done) / sim.output_rate, sim.duration)
     ist = run.ist
-    import fivdisc as package  # its version is looked up once per process
-
     attrs = {
         "status": name,
         "message": message,
         "end_time": float(t_end),
         "impact": int(sim.impact),
         "case": case.to_toml(),
-        "fivdisc_version": package.__version__,
+        "fivdisc_version": fivdisc_version(),
         "wall_time": wall,
         "n_steps": int(ist[slots.I_STEPS]),
         "n_rejected": int(ist[slots.I_REJECTED]),
@@ -315,3 +248,14 @@ def _message(name: str, t: float, phase: str, sim) -> str:
         "max_switches": f"simulation.max_switches = {sim.max_switches} reached {where}",
     }.get(name, f"ended {where}")
 
+
+def warm_kernel(show: bool = False) -> None:
+    """Compile or load the simulation kernel now, with a run of 1 ms of simulated time.
+
+    Parameters
+    ----------
+    show
+        Print the notice of :func:`compile_notice` if the kernel compiles.
+    """
+    with compile_notice(kern.run, show=show):
+        simulate(Case(simulation={"duration": 1e-3, "output_rate": 1000.0}))

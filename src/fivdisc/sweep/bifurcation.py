@@ -15,9 +15,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import xarray as xr
 
-from fivdisc.errors import nearest
+from fivdisc.errors import SweepError, nearest
 from fivdisc.files import write_atomic
-from fivdisc.sweep.reductions import SweepError
 from fivdisc.sweep.sections import VARIABLES, Section
 
 if TYPE_CHECKING:

@@ -20,7 +20,7 @@ from functools import cache, partial
 from typing import TYPE_CHECKING, Any
 
 from fivdisc.case import Case
-from fivdisc.errors import FivdiscError, nearest
+from fivdisc.errors import FivdiscError, SweepError, nearest
 from fivdisc.result import Result
 
 if TYPE_CHECKING:
@@ -36,10 +36,6 @@ __all__ = [
     "resolve",
     "stop_events",
 ]
-
-
-class SweepError(FivdiscError, ValueError):
-    """A sweep file or sweep value is invalid; the message names the key, value and allowed."""
 
 
 class RunFailed(FivdiscError):

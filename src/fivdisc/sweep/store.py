@@ -65,8 +65,8 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from fivdisc.errors import SweepError
 from fivdisc.files import write_atomic
-from fivdisc.sweep.reductions import SweepError
 from fivdisc.sweep.spec import Sweep
 
 __all__ = [
