@@ -55,6 +55,6 @@ def lazy_names(namespace: dict[str, Any], names: Mapping[str, str]
         return value
 
     def __dir__() -> list[str]:
-        return sorted({*namespace, *names})
+        return sorted({*namespace, *names, *namespace.get("__all__", ())})
 
     return __getattr__, __dir__

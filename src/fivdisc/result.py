@@ -424,6 +424,20 @@ class Result:
 
         return plot_kind(self.dataset, kind, **options)
 
+    def to_dataframe(self) -> pd.DataFrame:
+        """The per-slider time series as a table: one row per (time, slider), one column
+        per variable with a ``slider`` dimension (``phi`` [rad], ``phi_dot`` [rad/s],
+        ``normal_force`` [N], ``friction_force`` [N], ``phase`` (0 slip, 1 stick, 2
+        separation), ``z`` [m], ``z_dot`` [m/s], ``gap`` [m]) and ``disc_speed``
+        [rad/s]. The disc's probes, modal coordinates and events stay in
+        :attr:`dataset` (``result.dataset["w"].to_pandas()``, ...).
+        """
+        ds = self.dataset
+        names = [name for name, var in ds.data_vars.items()
+                 if var.dims == ("time", "slider") or name == "disc_speed"]
+        return ds[names].drop_vars([c for c in ds.coords if c not in ("time", "slider")],
+                                   errors="ignore").to_dataframe()
+
     def to_netcdf(self, path: str | PathLike[str]) -> None:
         """Write the dataset to a netCDF file atomically (a temporary file is renamed);
         :func:`open_result` reads it back."""

@@ -15,6 +15,7 @@ import numpy as np
 from fivdisc._kernels import dynamics as dyn
 from fivdisc._kernels import layout as lay
 from fivdisc.case import Case
+from fivdisc.compilation import compile_notice
 from fivdisc.errors import SimulationError
 from fivdisc.model import Model, build_model
 
@@ -109,42 +110,47 @@ def sliding_equilibrium(
         raise SimulationError(
             f"speed.value = {omega_c} has no sliding equilibrium: the disc must spin (> 0 rad/s)"
         )
-    n, ns = model.n, model.n_sliders
-    kern = model.kernel_args
-    unknowns = _unknowns(model)
-    acc_index = unknowns + n + 2 * ns
-    radius, n0 = kern.row("radius"), kern.row("n0")
-    inertias = np.append(model.modal_mass, kern.row("inertia"))
-    # Rigid-disc guess: N = N0, friction balanced by the in-plane spring; the disc
-    # deflected statically by the preloads.
-    mu = np.array([dyn.kinetic_friction(kern.opts, kern.table, radius[j], 1, omega_c)
-                   for j in range(ns)])
-    phi0 = radius * mu * n0 / kern.row("kphi")
-    stiff = model.modal_mass * (model.omega**2 - model.l**2 * omega_c**2)
-    q0 = np.zeros(n)
-    for j in range(ns):
-        psi = kern.row("theta")[j] + phi0[j]
-        g = np.where(model.sgn > 0, np.cos(model.l * psi), np.sin(model.l * psi)) * model.shape[j]
-        q0 -= kern.slider[lay.S_SN0, j] * g / stiff
-    x0 = np.append(q0, phi0)
-    if guess is not None and guess.q.size == n and np.size(guess.phi) == ns:
-        x0 = np.append(guess.q, guess.phi)
+    # The first equilibrium of a fresh installation compiles the right-hand side (with
+    # the friction law and its complex-step Jacobian) that everything here calls.
+    with compile_notice((dyn.evaluate, dyn.complex_step_jacobian), show=None,
+                        what="right-hand side and its Jacobian"):
+        n, ns = model.n, model.n_sliders
+        kern = model.kernel_args
+        unknowns = _unknowns(model)
+        acc_index = unknowns + n + 2 * ns
+        radius, n0 = kern.row("radius"), kern.row("n0")
+        inertias = np.append(model.modal_mass, kern.row("inertia"))
+        # Rigid-disc guess: N = N0, friction balanced by the in-plane spring; the disc
+        # deflected statically by the preloads.
+        mu = np.array([dyn.kinetic_friction(kern.opts, kern.table, radius[j], 1, omega_c)
+                       for j in range(ns)])
+        phi0 = radius * mu * n0 / kern.row("kphi")
+        stiff = model.modal_mass * (model.omega**2 - model.l**2 * omega_c**2)
+        q0 = np.zeros(n)
+        for j in range(ns):
+            psi = kern.row("theta")[j] + phi0[j]
+            g = (np.where(model.sgn > 0, np.cos(model.l * psi), np.sin(model.l * psi))
+                 * model.shape[j])
+            q0 -= kern.slider[lay.S_SN0, j] * g / stiff
+        x0 = np.append(q0, phi0)
+        if guess is not None and guess.q.size == n and np.size(guess.phi) == ns:
+            x0 = np.append(guess.q, guess.phi)
 
-    def state(x: np.ndarray) -> np.ndarray:
-        y = np.zeros(model.state_size)
-        y[unknowns] = x
-        return y
+        def state(x: np.ndarray) -> np.ndarray:
+            y = np.zeros(model.state_size)
+            y[unknowns] = x
+            return y
 
-    def residual(x: np.ndarray) -> np.ndarray:
-        dy, _ = _evaluate(model, state(x))
-        return dy[acc_index] * inertias
+        def residual(x: np.ndarray) -> np.ndarray:
+            dy, _ = _evaluate(model, state(x))
+            return dy[acc_index] * inertias
 
-    def jacobian(x: np.ndarray) -> np.ndarray:
-        ph, sg = slip_phases(model)
-        jac = dyn.complex_step_jacobian(0.0, state(x), ph, sg, kern)
-        return jac[np.ix_(acc_index, unknowns)] * inertias[:, None]
+        def jacobian(x: np.ndarray) -> np.ndarray:
+            ph, sg = slip_phases(model)
+            jac = dyn.complex_step_jacobian(0.0, state(x), ph, sg, kern)
+            return jac[np.ix_(acc_index, unknowns)] * inertias[:, None]
 
-    sol = root(residual, x0, jac=jacobian, method="hybr", options={"xtol": xtol})
+        sol = root(residual, x0, jac=jacobian, method="hybr", options={"xtol": xtol})
     # hybr may report "no progress" once it sits at round-off: judge by the residual, in
     # generalised forces [N], against the preload.
     scale = float(np.max(n0)) + 1.0
