@@ -18,6 +18,7 @@ from fivdisc.errors import SimulationError
 from fivdisc.integration import STATUS, Integration
 from fivdisc.limits import check_simulation
 from fivdisc.model import Model, build_model
+from fivdisc.progress import SIMULATED_TIME, progress_bar
 from fivdisc.result import EVENT_KINDS, PHASE_NAMES, Result, build_dataset
 from fivdisc.speed import SpeedProfile
 from fivdisc.split_compile import compile_split
@@ -89,12 +90,8 @@ def simulate(
         compile_split(run)
         run.advance(0.0)
     imported = warm_up("xarray")
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=sim.duration, unit="s", unit_scale=False, desc="simulating",
-                   bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s [{elapsed}<{remaining}]")
+    bar = progress_bar(sim.duration, "simulating", "s", show=progress,
+                       bar_format=SIMULATED_TIME)
     start = _time.perf_counter()
     status = slots.ST_RUNNING
     interrupted = False
@@ -104,8 +101,7 @@ def simulate(
         # of the paper's cases follow this grid), so the grid is fixed, not adaptive.
         for chunk in range(1, _CHUNKS + 1):
             status = run.run_to(sim.duration * chunk / _CHUNKS)
-            if bar is not None:
-                bar.update(run.t - bar.n)
+            bar.update(run.t - bar.n)
             if limit.exceeded(run):
                 break
             if status != slots.ST_RUNNING:
@@ -113,8 +109,7 @@ def simulate(
     except KeyboardInterrupt:
         interrupted = True
     finally:
-        if bar is not None:
-            bar.close()
+        bar.close()
     wall = _time.perf_counter() - start
 
     t_end = run.t

@@ -16,18 +16,22 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from fivdisc.case import Case
 from fivdisc.errors import FivdiscError
 from fivdisc.integration import Integration, tangent_step
-from fivdisc.model import build_model
+from fivdisc.model import Model, build_model
+from fivdisc.progress import SIMULATED_TIME, progress_bar
 
 __all__ = ["LyapunovSpectrum", "lyapunov"]
 
 # Blocks of the run whose exponents give the uncertainty (their spread).
 _BLOCKS = 10
+# Pieces of the transient, for its progress.
+_TRANSIENT_CHUNKS = 50
 # [s]: the default re-orthonormalisation interval.
 DEFAULT_INTERVAL = 0.05
 
@@ -176,7 +180,6 @@ def lyapunov(
             raise FivdiscError(f"{name} = {value!r} is invalid: must be {allowed} [s]")
     if not isinstance(n, (int, np.integer)) or n < 1:
         raise FivdiscError(f"n = {n!r} is invalid: must be an integer >= 1")
-    from fivdisc.analysis.orbits import energy_scales
     from fivdisc.simulate import initial_state
 
     model = build_model(case)
@@ -186,9 +189,26 @@ def lyapunov(
     run = Integration(model, initial_state(model, initial), duration=transient + duration,
                       rtol=rtol, atol=atol, max_step=cap)
     run.advance(0.0)
-    if transient > 0:
-        run.run_to(transient)
-        _check(run, "the transient")
+    # One bar in simulated time over the transient and the measurement: a long transient
+    # is the first minutes of a run.
+    bar = progress_bar(transient + duration, "Lyapunov exponents", "s", show=progress,
+                       bar_format=SIMULATED_TIME)
+    try:
+        for chunk in range(1, _TRANSIENT_CHUNKS + 1 if transient > 0 else 1):
+            run.run_to(transient * chunk / _TRANSIENT_CHUNKS)
+            _check(run, "the transient")
+            bar.update(run.t - bar.n)
+        spectrum = _measure(run, model, n, seed, transient, duration, interval, progress, bar)
+    finally:
+        bar.close()
+    return spectrum
+
+
+def _measure(run: Integration, model: Model, n: int, seed: int | None, transient: float,
+             duration: float, interval: float, progress: bool, bar: Any) -> LyapunovSpectrum:
+    """The exponents over `duration` after the transient, with `bar` counting it."""
+    from fivdisc.analysis.orbits import energy_scales
+
     free = run.free()
     if n > free.sum():
         raise FivdiscError(f"n = {n} is invalid: must be at most {int(free.sum())}, the "
@@ -203,24 +223,14 @@ def lyapunov(
     times = np.zeros(steps)
     from fivdisc.compilation import tangent_notice
 
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=steps, desc="Lyapunov exponents", unit="QR")
-    try:
-        # The first interval compiles the kernel with tangents in a fresh installation.
-        with tangent_notice(show=progress):
-            run.set_tangents((q * sc[:, None]).T)
-            _interval(run, 0, logs, times, t0, interval, transient + duration, sc)
-        for k in range(steps):
-            if k:
-                _interval(run, k, logs, times, t0, interval, transient + duration, sc)
-            if bar is not None:
-                bar.update()
-    finally:
-        if bar is not None:
-            bar.close()
+    # The first interval compiles the kernel with tangents in a fresh installation.
+    with tangent_notice(show=progress):
+        run.set_tangents((q * sc[:, None]).T)
+        _interval(run, 0, logs, times, t0, interval, transient + duration, sc)
+    for k in range(steps):
+        if k:
+            _interval(run, k, logs, times, t0, interval, transient + duration, sc)
+        bar.update(run.t - bar.n)
     # Over a finite run the QR order need not be the order of the values: sort.
     order = np.argsort(-logs.sum(axis=0), kind="stable")
     logs = logs[:, order]
