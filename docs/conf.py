@@ -65,9 +65,42 @@ def _escape_bars(lines: list[str]) -> None:
         lines[i] = "``".join(parts)
 
 
+_PARAM = re.compile(r":param (\w+):(.*)")
+
+
+def share_descriptions(lines: list[str]) -> None:
+    """Parameters documented together (``rtol, atol : float``) are split by napoleon into
+    one field each, with the whole description repeated: keep it on the first and refer
+    the others to it."""
+    fields: list[tuple[int, int, str]] = []  # (start, end, name) of each :param: field
+    for i, line in enumerate(lines):
+        match = _PARAM.match(line)
+        if match:
+            end = i + 1
+            while end < len(lines) and lines[end].startswith((" ", "\t")) and lines[end].strip():
+                end += 1
+            fields.append((i, end, match.group(1)))
+    for start, end, name in reversed(fields):
+        text = (_PARAM.match(lines[start]).group(2), *lines[start + 1:end])
+        first = next((n for s, e, n in fields if s < start and
+                      (_PARAM.match(lines[s]).group(2), *lines[s + 1:e]) == text), None)
+        if first is not None and text != ("",):
+            lines[start:end] = [f":param {name}: As ``{first}``."]
+
+
+def short_model_signature(app, what, name, obj, options, signature, return_annotation):
+    """A pydantic model's signature names its fields without their defaults: the
+    defaults of a case's tables are documented with the tables, not dumped in one line."""
+    fields = getattr(obj, "model_fields", None)
+    if what == "class" and isinstance(fields, dict) and signature:
+        return "(*, " + ", ".join(f"{field}=..." for field in fields) + ")", return_annotation
+    return None
+
+
 def setup(app):
     app.connect("autodoc-process-docstring", lambda app, what, name, obj, opts, lines:
-                _escape_bars(lines))
+                (_escape_bars(lines), share_descriptions(lines)))
+    app.connect("autodoc-process-signature", short_model_signature)
     for event in ("description", "options", "arguments", "epilog"):
         app.connect(f"sphinx-click-process-{event}", lambda app, ctx, lines:
                     _escape_bars(lines))

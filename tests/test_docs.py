@@ -38,3 +38,45 @@ def test_relative_links_stay_in_the_repository(page):
         assert path.is_relative_to(ROOT), f"{target} points outside the repository"
         assert path.exists(), f"{target} does not exist"
     assert "shared/design" not in text and "../shared" not in text
+
+
+def _conf():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("docs_conf", DOCS / "conf.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_parameters_documented_together_are_described_once():
+    """Issue 27, item 9: ``rtol, atol : float`` rendered the whole description twice
+    (napoleon gives each name the text); the second now refers to the first."""
+    import inspect
+
+    from sphinx.ext.napoleon import Config
+    from sphinx.ext.napoleon.docstring import NumpyDocstring
+
+    lines = NumpyDocstring(inspect.getdoc(fivdisc.periodic_orbit),
+                           Config(napoleon_use_rtype=False)).lines()
+    _conf().share_descriptions(lines)
+    text = "\n".join(lines)
+    assert text.count("Integration tolerances of the shooting runs") == 1
+    assert ":param atol: As ``rtol``." in text
+    assert ":type atol: float" in text
+
+
+def test_case_signature_names_the_tables_without_their_defaults():
+    """Issue 27, item 9: the Case signature was one line of every default of every table."""
+    signature, _ = _conf().short_model_signature(
+        None, "class", "fivdisc.Case", fivdisc.Case, {}, "(*, disc: Disc = Disc(...))", None)
+    assert signature == "(*, disc=..., sliders=..., friction=..., speed=..., simulation=...)"
+
+
+def test_plot_help_names_its_argument():
+    from click.testing import CliRunner
+
+    from fivdisc.cli import cli
+
+    text = CliRunner().invoke(cli, ["plot", "--help"]).output
+    assert "RESULT" in text and "FILE" not in text.split("Options:")[0]
