@@ -1,7 +1,11 @@
 """Sphinx configuration of the fivdisc documentation (see docs/contributing.md)."""
 
+import json
+import os
 import re
+import sys
 from importlib.metadata import version as _version
+from pathlib import Path
 
 project = "fivdisc"
 author = "fivdisc developers"
@@ -28,10 +32,23 @@ myst_heading_anchors = 3
 # tested; a failing cell fails the build. The timeout covers the one-off compilation of
 # the kernel in a fresh installation.
 nb_execution_mode = "force"
+nb_kernel_rgx_aliases = {".*": "fivdisc-docs"}
 nb_execution_raise_on_error = True
 nb_execution_timeout = 600
 nb_execution_in_temp = True
 nb_merge_streams = True
+
+# The tutorials' kernel: this Python, logging errors only. ipykernel warns at every start
+# that it talks to the build over local TCP, unencrypted: a warning per tutorial that
+# says nothing about the documentation (issue 27, item 10).
+_KERNELS = Path(__file__).resolve().parent / "_build" / "kernels"
+(_KERNELS / "kernels" / "fivdisc-docs").mkdir(parents=True, exist_ok=True)
+(_KERNELS / "kernels" / "fivdisc-docs" / "kernel.json").write_text(json.dumps({
+    "argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}",
+             "--IPKernelApp.log_level=ERROR"],
+    "display_name": "Python 3 (fivdisc docs)", "language": "python"}))
+os.environ["JUPYTER_PATH"] = os.pathsep.join(
+    filter(None, [str(_KERNELS), os.environ.get("JUPYTER_PATH")]))
 
 # API reference from the numpy-style docstrings.
 autodoc_member_order = "bysource"
