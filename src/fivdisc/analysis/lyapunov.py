@@ -159,8 +159,9 @@ def lyapunov(
     seed : int
         Seed of the random initial tangent vectors.
     progress : bool
-        Show a progress bar over the measurement, and a notice when the kernel with
-        tangent vectors compiles (first use).
+        Show a progress bar in simulated time over the transient and the measurement (on
+        a terminal), and a notice when the kernel with tangent vectors compiles (first
+        use).
 
     Returns
     -------
