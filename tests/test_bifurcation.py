@@ -61,7 +61,7 @@ output_rate = 4000.0
 [axes]
 "speed.value" = [0.8, 1.0, 1.2]
 [reduce]
-keep = ["max_normal_force", "largest_lyapunov"]
+keep = ["max_normal_force", "largest_lyapunov", "largest_lyapunov_uncertainty"]
 [[reduce.section]]
 variable = "phi"
 at = "maxima"
@@ -451,16 +451,39 @@ def test_command_runs_the_sweep_and_draws_the_diagram(diagram, sweep_file) -> No
     assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     fig = plot_bifurcation(store, name="speeds")
     top, bottom = fig.axes
-    assert top.get_title() == "speeds: phi of slider 0 at its local maxima, t >= 0.1 s"
+    # The other section is named, with how to draw it (issue 27, item 5).
+    assert top.get_title().split("\n") == [
+        "speeds: phi of slider 0 at its local maxima, t >= 0.1 s",
+        "(other sections: phi_dot_stick; pick one with --section NAME)"]
     assert top.get_ylabel() == "slider circumferential angle of slider 0 [rad]"
     assert bottom.get_xlabel() == r"disc speed $\Omega_c$ [rad/s]"
     assert "[1/s]" in bottom.get_ylabel()
     # the dots are the stored values: 4 maxima at each of the 3 speeds
     xs, ys = top.lines[0].get_data()
     assert len(xs) == 12 and set(np.round(xs, 9)) == {0.8, 1.0, 1.2}
+    from fivdisc.sweep.bifurcation import _DOT
+
+    assert top.lines[0].get_markersize() > 2 * _DOT  # few values: visible markers
     np.testing.assert_array_equal(ys, open_sweep(store)["phi_maxima"].values.ravel())
     # the zero line and the exponents
     assert any(np.all(np.asarray(line.get_ydata()) == 0.0) for line in bottom.lines)
+    # Error bars of the exponent: its standard error, that of fivdisc.lyapunov run on the
+    # point's case with the sweep's window (issue 27, item 2).
+    from matplotlib.collections import LineCollection
+
+    from fivdisc import lyapunov
+    from fivdisc.sweep import load_sweep
+
+    spec = load_sweep(sweep_file)
+    transient, duration = spec.lyapunov.window(spec.cases[1])
+    direct = lyapunov(spec.cases[1], n=1, transient=transient, duration=duration,
+                      interval=spec.lyapunov.interval)
+    stored = open_sweep(store)
+    assert stored["largest_lyapunov"].values[1] == direct.largest
+    assert stored["largest_lyapunov_uncertainty"].values[1] == direct.uncertainty[0]
+    (bars,) = [c for c in bottom.collections if isinstance(c, LineCollection)]
+    lengths = [float(np.ptp(segment[:, 1])) for segment in bars.get_segments()]
+    np.testing.assert_allclose(lengths, 2 * stored["largest_lyapunov_uncertainty"].values)
     # a second run draws the complete store without computing anything
     again = CliRunner().invoke(cli, ["bifurcation", str(sweep_file), "-o", str(figure),
                                      "--store", str(store), "--section", "phi_dot_stick",

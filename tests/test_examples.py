@@ -6,6 +6,7 @@ wheel installed into a fresh virtual environment, away from the source tree.
 
 from __future__ import annotations
 
+import re
 import tomllib
 from pathlib import Path
 
@@ -114,3 +115,81 @@ def test_unknown_example_is_one_line(argv, tmp_path, monkeypatch):
     assert result.exit_code == 2
     assert result.output.startswith("error: 'fig1' is neither a file nor a packaged example")
     assert result.output.count("\n") == 1 and "Traceback" not in result.output
+
+
+def _is_sweep(text: str) -> bool:
+    return "axes" in tomllib.loads(text)
+
+
+def _effective(text: str):
+    """What an example makes run: the case, or the sweep's base, axes, reductions and the
+    measurement window and interval of its Lyapunov exponent."""
+    if not _is_sweep(text):
+        return load_case_text(text)
+    from fivdisc.analysis.lyapunov import DEFAULT_INTERVAL
+
+    spec = load_sweep_text(text)
+    lyap = None
+    if spec.lyapunov is not None:
+        transient, duration = spec.lyapunov.window(spec.base)
+        interval = spec.lyapunov.interval
+        lyap = (transient, duration,
+                min(DEFAULT_INTERVAL, duration) if interval is None else interval)
+    return spec.base, spec.axes, spec.keep, spec.sections, lyap
+
+
+def load_case_text(text: str):
+    from fivdisc import Case
+
+    return Case.from_toml(text)
+
+
+def load_sweep_text(text: str):
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as directory:
+        path = Path(directory) / "sweep.toml"
+        path.write_text(text)
+        base = tomllib.loads(text).get("base")
+        if isinstance(base, str):  # a case file next to the example
+            (Path(directory) / base).write_text(examples.path(Path(base).stem).read_text())
+        return load_sweep(path)
+
+
+@pytest.mark.parametrize("name", sorted(examples.available()))
+def test_examples_are_formatted_for_a_reader(name):
+    """Issue 27, item 7: no array written one number per line, no note a reader cannot
+    act on."""
+    text = examples.path(name).read_text(encoding="utf-8")
+    for line in text.splitlines():
+        assert not line.strip().rstrip(",").replace(".", "").replace("-", "").isdigit(), (
+            name, line)
+    assert "edit the code" not in text
+
+
+@pytest.mark.parametrize("name", sorted(examples.available()))
+def test_comments_calling_a_value_the_default_are_true(name):
+    """Issue 27, item 7: a key whose comment says it is the default can be left out
+    without changing what runs (a case's value, a sweep's resolved Lyapunov window and
+    interval); one under a comment saying "these are the defaults" as well."""
+    text = examples.path(name).read_text(encoding="utf-8")
+    lines = text.splitlines()
+    whole = _effective(text)
+    under_defaults = False
+    checked = 0
+    for i, line in enumerate(lines):
+        code, _, comment = line.partition("#")
+        if not line.strip():
+            under_defaults = False  # a blank line ends what a comment introduced
+        if not code.strip():
+            under_defaults = under_defaults or "these are the defaults" in comment
+            continue
+        if code.strip().startswith("["):
+            continue
+        # "default" opening a clause of the comment claims that the value is the default.
+        if re.search(r"(^|[:;,(])\s*default\b", comment.strip()) or under_defaults:
+            without = "\n".join(lines[:i] + lines[i + 1:])
+            assert _effective(without) == whole, (name, line)
+            checked += 1
+    if name == "bifurcation-speed":
+        assert checked  # the test reads the comments it is meant to

@@ -43,7 +43,7 @@ from fivdisc.paper import (
 )
 from fivdisc.paper import measure as ms
 from fivdisc.paper.cases import FIG10
-from fivdisc.paper.figures import separation_grid
+from fivdisc.paper.fig_separation import separation_grid
 
 from cf_check import check_cf
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 
@@ -88,11 +89,12 @@ def test_timeseries_of_a_probe_in_a_window():
     fig = plots.plot_timeseries(_result(), "w", probe=1, window=(0.1, 0.2))
     ax = fig.axes[0]
     assert ax.get_xlabel() == "time [s]"
-    assert ax.get_ylabel() == "disc transverse displacement at the probes [m]"
+    # Engineering units (issue 27, item 5): 2e-5 m drawn as 20 µm.
+    assert ax.get_ylabel() == "disc transverse displacement at the probes [µm]"
     assert "probe 1" in ax.get_title() and "θ = 1 rad" in ax.get_title()
     x, y = ax.lines[0].get_data()
     np.testing.assert_allclose(x[[0, -1]], [0.1, 0.2])
-    assert np.max(np.abs(y)) == pytest.approx(2e-5, rel=1e-3)
+    assert np.max(np.abs(y)) == pytest.approx(20.0, rel=1e-3)
 
 
 def test_timeseries_of_phase_names_the_phases():
@@ -108,7 +110,8 @@ def test_drawing_into_given_axes():
     fig, (left, right) = plt.subplots(1, 2)
     assert plots.plot_phase_portrait(_result(), (0.0, 0.01), ax=right) is fig
     assert plots.plot_friction(_result(), None, ax=left) is fig
-    assert len(fig.axes) == 2 and right.get_xlabel() == "slider circumferential angle [rad]"
+    # 1e-3 rad drawn in mrad (engineering units)
+    assert len(fig.axes) == 2 and right.get_xlabel() == "slider circumferential angle [mrad]"
     assert right.get_ylabel() == "slider angular velocity [rad/s]"
     assert left.get_xlabel() == "relative angular velocity (disc minus slider) [rad/s]"
     assert left.get_ylabel() == "friction force on the slider [N]"
@@ -381,3 +384,51 @@ def test_stability_map_command_writes_any_matplotlib_format(tmp_path, suffix):
                                    "--no-progress"])
     assert run.exit_code == 0, run.output
     assert out.read_bytes()[:4] in (b"%PDF", b"<?xm", b"\x89PNG")
+
+
+# --- defaults a researcher accepts without flags (issue 27, item 5) ---------------------------
+
+
+def test_a_long_timeseries_shows_its_last_oscillations_and_says_so():
+    """0.4 s of a 206 Hz motion is 82 cycles, a solid block: the default window is the last
+    30 or so, and the title says which stretch is shown and how to choose another."""
+    ax = plots.plot_kind(_result(), "timeseries", var="phi").axes[0]
+    x, y = ax.lines[0].get_data()
+    assert x[-1] == pytest.approx(0.4)
+    crossings = np.count_nonzero(np.diff(np.sign(y - y.mean())) != 0)
+    assert 40 <= crossings <= 90  # about 30 cycles of the 206 Hz line (0.1 s: 41 cycles)
+    assert f"the last {0.4 - x[0]:.1g} s of 0.4 s" in ax.get_title()
+    assert "--window" in ax.get_title()
+    # A short record stays whole, with no note.
+    short = plots.plot_kind(_result(0.05), "timeseries", var="phi").axes[0]
+    assert short.lines[0].get_data()[0][0] == 0.0 and "the last" not in short.get_title()
+
+
+def test_the_spectrogram_band_covers_the_content():
+    """The synthetic angle has lines at 206 and 412 Hz, nothing above: the default band
+    ends above 412 Hz and far below the 5 kHz Nyquist frequency."""
+    ax = plots.plot_spectrogram(_result(), "phi").axes[0]
+    top = ax.get_ylim()[1]
+    assert 412.0 < top <= 1100.0
+    assert plots.content_band(_result()["phi"], 5000.0) in (500.0, 1000.0)
+    assert "0-" in ax.get_title() and " Hz," in ax.get_title()
+
+
+def test_titles_break_between_phrases_only():
+    """A long title wraps after its commas and semicolons, not inside "slider
+    circumferential angle" (it used to read "... circumferential / angle")."""
+    ds = _result().assign_attrs(case_name="brake-two-pads-stribeck-damped",
+                                title="fivdisc simulation of x: 2 sliders, disc at 6.283 "
+                                      "rad/s, 0.4 s")
+    for kind in ("timeseries", "spectrogram", "spectrum"):
+        lines = plots.plot_kind(ds, kind, var="phi").axes[0].get_title().split("\n")
+        assert any("slider circumferential angle" in line for line in lines), lines
+        assert not any(line.endswith(("circumferential", "slider")) for line in lines)
+
+
+def test_a_disc_variable_names_no_slider(simulated):
+    title = simulated.plot("timeseries", var="w").axes[0].get_title()
+    assert "probe 0" in title and not re.search(r"slider \d", title)
+    assert "slider 0" in simulated.plot("timeseries", var="phi").axes[0].get_title()
+
+

@@ -52,6 +52,22 @@ def test_summary_prints_and_gives_values(pads):
     assert summary.to_dict()["sliders"][1]["separations"] == summary.sliders[1].separations
 
 
+def test_result_to_dataframe_is_the_per_slider_series(pads):
+    """Issue 27, item 8: the README's ``.to_dataframe()`` exists on a result; its rows are
+    the dataset's samples of each slider, its columns the per-slider variables."""
+    ds = pads.dataset
+    table = pads.to_dataframe()
+    assert table.index.names == ["time", "slider"]
+    assert len(table) == ds.sizes["time"] * ds.sizes["slider"]
+    assert {"phi", "phi_dot", "normal_force", "friction_force", "phase", "disc_speed"} <= set(
+        table.columns)
+    assert "w" not in table.columns  # the disc's probes have their own dimension
+    second = table.xs(1, level="slider")
+    np.testing.assert_array_equal(second["normal_force"].to_numpy(),
+                                  ds["normal_force"].values[:, 1])
+    np.testing.assert_array_equal(second.index.to_numpy(), ds["time"].values)
+
+
 def test_linear_stability_prints_a_table():
     stability = linear_stability(Case())
     assert "\n" not in repr(stability)

@@ -191,6 +191,39 @@ def test_base_file_is_relative_to_the_sweep_file(tmp_path) -> None:
         load_sweep(path)
 
 
+@pytest.mark.parametrize("override", [
+    '[override.simulation]\nduration = 0.5\n[override.slider]\npreload = 400.0\n',
+    '[override]\n"simulation.duration" = 0.5\n"slider.preload" = 400.0\n',
+])
+def test_override_changes_the_base_file_in_place(tmp_path, override) -> None:
+    """Issue 27, item 6: a sweep changes keys of its base file without a copy of it."""
+    (tmp_path / "brake2.toml").write_text("[slider]\nmass = 0.2\n[simulation]\nduration = 3.0\n")
+    path = tmp_path / "sweep.toml"
+    path.write_text('base = "brake2.toml"\n' + override
+                    + '[axes]\n"speed.value" = [1.0]\n[reduce]\nkeep = ["separated"]\n')
+    spec = load_sweep(path)
+    assert spec.base == Case(slider={"mass": 0.2, "preload": 400.0},
+                             simulation={"duration": 0.5})
+
+
+def test_override_errors_and_the_toml_conflict_explained(tmp_path) -> None:
+    (tmp_path / "brake2.toml").write_text("")
+    path = tmp_path / "sweep.toml"
+    rest = '[axes]\n"speed.value" = [1.0]\n[reduce]\nkeep = ["separated"]\n'
+    # The form a user tries first is not TOML: say why, and what to write instead.
+    path.write_text('base = "brake2.toml"\n[base.simulation]\nduration = 2.0\n' + rest)
+    with pytest.raises(SweepError, match=r"base = \"FILE\" and a \[base\.TABLE\] table cannot "
+                       r"both be in a TOML file .* \[override\] table"):
+        load_sweep(path)
+    path.write_text('base = "brake2.toml"\n[override.simulation]\nduratoin = 2.0\n' + rest)
+    with pytest.raises(SweepError, match=r"unknown key 'override\.simulation\.duratoin': not a "
+                       r"case key; did you mean 'simulation\.duration'\?"):
+        load_sweep(path)
+    path.write_text('base = "brake2.toml"\n[override.simulation]\nduration = -1.0\n' + rest)
+    with pytest.raises(CaseError, match=r"override: .*simulation\.duration"):
+        load_sweep(path)
+
+
 def test_fig27_example_is_the_separation_map_default() -> None:
     from fivdisc.sweep import separation_sweep
 

@@ -20,10 +20,9 @@ The names of ``__all__`` are imported on first use, so that ``import fivdisc`` a
 command line start without numba, xarray and scipy.
 """
 
-import sys
-from importlib import import_module
-from types import ModuleType
 from typing import TYPE_CHECKING, Any
+
+from fivdisc._lazy import homes, lazy_names
 
 if TYPE_CHECKING:
     from fivdisc.analysis.boundary import stability_boundary
@@ -46,11 +45,14 @@ if TYPE_CHECKING:
     from fivdisc.analysis.trajectories import separation_stats
     from fivdisc.case import Case, load_case
     from fivdisc.errors import (
+        AnalysisError,
         CaseError,
         ConvergenceError,
         FivdiscError,
+        MissingExtraError,
         ModeError,
         SimulationError,
+        SweepError,
     )
     from fivdisc.model import Model, build_model
     from fivdisc.plate import AnnularPlate, PlateMode
@@ -61,6 +63,7 @@ if TYPE_CHECKING:
     __version__: str
 
 __all__ = [
+    "AnalysisError",
     "AnnularPlate",
     "Branch",
     "Case",
@@ -71,6 +74,7 @@ __all__ = [
     "HopfPoint",
     "LinearStability",
     "LyapunovSpectrum",
+    "MissingExtraError",
     "ModeError",
     "Model",
     "PeriodicOrbit",
@@ -79,6 +83,7 @@ __all__ = [
     "SimulationError",
     "SpeedProfile",
     "Summary",
+    "SweepError",
     "__version__",
     "build_model",
     "classify",
@@ -106,38 +111,35 @@ __all__ = [
 ]
 
 # Name of __all__ -> the module that defines it (the imports above, for type checkers).
-_HOMES = {
-    name: module
-    for module, names in {
-        "fivdisc.analysis.branch": ("Branch", "open_branch"),
-        "fivdisc.analysis.continuation": ("continue_orbit",),
-        "fivdisc.analysis.boundary": ("stability_boundary",),
-        "fivdisc.analysis.eigenbranches": ("eigen_branches",),
-        "fivdisc.analysis.energy": ("energy_balance",),
-        "fivdisc.analysis.equilibrium": ("Equilibrium", "sliding_equilibrium"),
-        "fivdisc.analysis.hopf": ("HopfPoint", "hopf_points"),
-        "fivdisc.analysis.hopf_cycle": ("hopf_cycles",),
-        "fivdisc.analysis.lyapunov": ("LyapunovSpectrum", "lyapunov"),
-        "fivdisc.analysis.orbits": ("PeriodicOrbit", "periodic_orbit"),
-        "fivdisc.analysis.spectra": (
-            "classify", "dominant_frequency", "find_peaks", "spectrum", "stft"
-        ),
-        "fivdisc.analysis.stability": (
-            "LinearStability", "linear_stability", "perturbation_test", "stability_map"
-        ),
-        "fivdisc.analysis.trajectories": ("separation_stats",),
-        "fivdisc.case": ("Case", "load_case"),
-        "fivdisc.errors": (
-            "CaseError", "ConvergenceError", "FivdiscError", "ModeError", "SimulationError"
-        ),
-        "fivdisc.model": ("Model", "build_model"),
-        "fivdisc.plate": ("AnnularPlate", "PlateMode"),
-        "fivdisc.result": ("Result", "Summary", "open_result"),
-        "fivdisc.simulate": ("simulate",),
-        "fivdisc.speed": ("SpeedProfile",),
-    }.items()
-    for name in names
-}
+_HOMES = homes({
+    "fivdisc.analysis.boundary": ("stability_boundary",),
+    "fivdisc.analysis.branch": ("Branch", "open_branch"),
+    "fivdisc.analysis.continuation": ("continue_orbit",),
+    "fivdisc.analysis.eigenbranches": ("eigen_branches",),
+    "fivdisc.analysis.energy": ("energy_balance",),
+    "fivdisc.analysis.equilibrium": ("Equilibrium", "sliding_equilibrium"),
+    "fivdisc.analysis.hopf": ("HopfPoint", "hopf_points"),
+    "fivdisc.analysis.hopf_cycle": ("hopf_cycles",),
+    "fivdisc.analysis.lyapunov": ("LyapunovSpectrum", "lyapunov"),
+    "fivdisc.analysis.orbits": ("PeriodicOrbit", "periodic_orbit"),
+    "fivdisc.analysis.spectra": (
+        "classify", "dominant_frequency", "find_peaks", "spectrum", "stft"
+    ),
+    "fivdisc.analysis.stability": (
+        "LinearStability", "linear_stability", "perturbation_test", "stability_map"
+    ),
+    "fivdisc.analysis.trajectories": ("separation_stats",),
+    "fivdisc.case": ("Case", "load_case"),
+    "fivdisc.errors": ("AnalysisError", "CaseError", "ConvergenceError", "FivdiscError",
+                       "MissingExtraError", "ModeError", "SimulationError", "SweepError"),
+    "fivdisc.model": ("Model", "build_model"),
+    "fivdisc.plate": ("AnnularPlate", "PlateMode"),
+    "fivdisc.result": ("Result", "Summary", "open_result"),
+    "fivdisc.simulate": ("simulate",),
+    "fivdisc.speed": ("SpeedProfile",),
+})
+
+_getattr, __dir__ = lazy_names(globals(), _HOMES)
 
 
 def __getattr__(name: str) -> Any:
@@ -145,32 +147,6 @@ def __getattr__(name: str) -> Any:
     if name == "__version__":
         from importlib.metadata import version
 
-        value = version("fivdisc")
-    elif name in _HOMES:
-        value = getattr(import_module(_HOMES[name]), name)
-    else:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    """The module's names, with the public ones not yet imported (tab completion)."""
-    return sorted({*globals(), *__all__})
-
-
-class _Package(ModuleType):
-    """fivdisc's module type: the function :func:`simulate` keeps its name on the package.
-
-    The import system binds a submodule, once imported, to the package's attribute of the
-    same name; the module ``fivdisc.simulate``, imported by whatever needs it first, would
-    then hide the function ``fivdisc.simulate`` that it defines.
-    """
-
-    def __setattr__(self, name: str, value: Any) -> None:
-        if isinstance(value, ModuleType) and _HOMES.get(name) == value.__name__:
-            value = getattr(value, name)
-        super().__setattr__(name, value)
-
-
-sys.modules[__name__].__class__ = _Package
+        globals()[name] = version("fivdisc")
+        return globals()[name]
+    return _getattr(name)

@@ -860,7 +860,7 @@ class Case(_Table):
         if len(self.sliders) == 1:
             data = {("slider" if k == "sliders" else k): (v[0] if k == "sliders" else v)
                     for k, v in data.items()}
-        return tomli_w.dumps(data)
+        return _inline_arrays(tomli_w.dumps(data))
 
     def save(self, path: str | PathLike[str]) -> None:
         """Write the case as a TOML file (see :meth:`to_toml`)."""
@@ -974,6 +974,28 @@ class Case(_Table):
                     table.clear()
             table[name] = _plain(updates[key])
         return _validate(data, source=None)
+
+
+def _inline_arrays(text: str, width: int = 88) -> str:
+    """TOML `text` with each array on one line (``modes = [[0, 0], [0, 1]]``), or one line
+    per element when that is wider than `width`: tomli_w writes one number per line."""
+    out: list[str] = []
+    lines = iter(text.splitlines())
+    for line in lines:
+        key, sep, value = line.partition(" = ")
+        if not (sep and value == "["):
+            out.append(line)
+            continue
+        block = [line]
+        for inner in lines:
+            block.append(inner)
+            if inner == "]":
+                break
+        items = tomllib.loads("\n".join(block))[key.strip().strip('"')]
+        inline = [json.dumps(item, separators=(", ", ": ")) for item in items]
+        one = f"{key} = [{', '.join(inline)}]"
+        out += [one] if len(one) <= width else [f"{key} = [", *(f"    {i}," for i in inline), "]"]
+    return "\n".join(out) + "\n"
 
 
 def is_case_key(key: str) -> bool:

@@ -1,32 +1,45 @@
-"""Saying so while the simulation kernel compiles.
+"""Saying so while a kernel compiles.
 
-numba compiles the kernel on its first call in a fresh installation (about a minute) and
-caches it on disk, so later processes load it in a second or two. :func:`compile_notice`
-wraps that first call: when the kernel is neither in memory nor in numba's cache it
-prints what is happening on stderr, with a spinner and the seconds elapsed when stderr is
-a terminal, and the time it took at the end.
+numba compiles a kernel on its first call in a fresh installation and caches it on disk,
+so later processes load it in a second or two. :func:`compile_notice` wraps that first
+call: when the kernel is neither in memory nor in numba's cache it prints what is
+happening on stderr (once per process and kernel), with a spinner and the seconds
+elapsed when stderr is a terminal, and the time it took at the end.
+
+How long it takes depends on the machine and its load (7 to 44 s for the right-hand side
+alone, 30 s to a few minutes for the whole kernel were seen): the notice gives no number
+of its own. It says how long the same kernel took the last time it compiled on this
+machine, measured then and kept beside numba's cache (:func:`measured_seconds`).
 """
 
 from __future__ import annotations
 
+import json
 import sys
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any, TextIO
 
-__all__ = ["COMPILE_SECONDS", "TANGENT_COMPILE_SECONDS", "compile_notice", "needs_compiling",
-           "warm_kernel"]
+__all__ = ["announce_by_default", "compile_notice", "measured_seconds", "needs_compiling",
+           "tangent_notice"]
 
-#: Typical time to compile the kernel [s]: 44-67 s measured on a loaded 2-core machine,
-#: 118 s on one under heavier load; benchmarks/bench_simulate.py measures it on yours.
-COMPILE_SECONDS = 90
-#: Typical time to compile the kernel with tangent vectors (orbits, Lyapunov exponents),
-#: once more after the plain one [s]: 80-120 s measured on a 2-core machine.
-TANGENT_COMPILE_SECONDS = 120
 _FRAMES = "|/-\\"
 _TICK = 0.25  # [s] between spinner frames
+_TIMES_FILE = "fivdisc-compile-seconds.json"
+# What this process has announced already, and whether notices are shown when the caller
+# does not say (the command line turns them on; a library call stays quiet).
+_announced: set[str] = set()
+_default_show = False
+
+
+def announce_by_default(show: bool = True) -> None:
+    """Show compilation notices where a caller does not say (``show=None``): the command
+    line turns them on for every command, library calls leave them off."""
+    global _default_show
+    _default_show = show
 
 
 def needs_compiling(dispatcher: Any) -> bool:
@@ -50,28 +63,73 @@ def needs_compiling(dispatcher: Any) -> bool:
         return True
 
 
+def _times_file(dispatcher: Any) -> Path | None:
+    """The file beside `dispatcher`'s numba cache that keeps measured compile times."""
+    path = getattr(getattr(dispatcher, "_cache", None), "_cache_path", None)
+    return Path(path) / _TIMES_FILE if isinstance(path, str | Path) else None
+
+
+def measured_seconds(dispatcher: Any, what: str) -> float | None:
+    """How long compiling `what` (the kernel whose first call is `dispatcher`) took the last
+    time on this machine [s], or None if it was never measured here."""
+    path = _times_file(dispatcher)
+    try:
+        value = json.loads(path.read_text())[what] if path is not None else None
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    return float(value) if isinstance(value, int | float) and value > 0 else None
+
+
+def _record_seconds(dispatcher: Any, what: str, seconds: float) -> None:
+    path = _times_file(dispatcher)
+    if path is None:
+        return
+    try:
+        try:
+            times = json.loads(path.read_text())
+        except (OSError, ValueError):
+            times = {}
+        if not isinstance(times, dict):
+            times = {}
+        times[what] = round(seconds, 1)
+        from fivdisc.files import write_atomic
+
+        write_atomic(path, lambda target: Path(target).write_text(json.dumps(times)))
+    except OSError:
+        pass  # a read-only cache: the next notice gives no number
+
+
 @contextmanager
-def compile_notice(dispatcher: Any, show: bool = True, stream: TextIO | None = None,
-                   what: str = "simulation kernel",
-                   seconds: float = COMPILE_SECONDS) -> Iterator[None]:
+def compile_notice(dispatcher: Any | Sequence[Any], show: bool | None = True,
+                   stream: TextIO | None = None,
+                   what: str = "simulation kernel") -> Iterator[None]:
     """Print a notice on `stream` while the body compiles `dispatcher`, if it will.
 
     Parameters
     ----------
     dispatcher
-        The numba dispatcher the body calls first.
+        The numba dispatcher the body calls first, or several: the notice is printed if
+        any of them will compile (the first one's cache keeps the measured time).
     show
-        False: say nothing (the body still runs).
+        False: say nothing (the body still runs); None: what
+        :func:`announce_by_default` set (off unless the command line turned it on).
     stream
         Where to write [default: sys.stderr].
-    what, seconds
-        What compiles, and about how long it takes [s].
+    what
+        What compiles, in words; a notice for it is printed once per process.
     """
-    if not show or not needs_compiling(dispatcher):
+    dispatchers = list(dispatcher) if isinstance(dispatcher, Sequence) else [dispatcher]
+    if show is None:
+        show = _default_show
+    if not show or what in _announced or not any(map(needs_compiling, dispatchers)):
         yield
         return
+    _announced.add(what)
     out = stream if stream is not None else sys.stderr
-    line = f"compiling the {what}, once: about {seconds:.0f} s"
+    before = measured_seconds(dispatchers[0], what)
+    line = f"compiling the {what}, once"
+    line += (f" (it took {before:.0f} s when last compiled on this machine)"
+             if before is not None else " (numba keeps it for later runs)")
     live = out.isatty()
     start = time.perf_counter()
     done = threading.Event()
@@ -105,32 +163,17 @@ def compile_notice(dispatcher: Any, show: bool = True, stream: TextIO | None = N
     except BaseException:
         stop("")
         raise
-    stop(f"compiled the {what} in {time.perf_counter() - start:.0f} s; later runs load it")
+    seconds = time.perf_counter() - start
+    _record_seconds(dispatchers[0], what, seconds)
+    stop(f"compiled the {what} in {seconds:.0f} s; later runs load it")
 
 
 @contextmanager
-def tangent_notice(show: bool = True) -> Iterator[None]:
+def tangent_notice(show: bool | None = True) -> Iterator[None]:
     """:func:`compile_notice` for the kernel with tangent vectors: its first use compiles
     a second version of the kernel (and of its helpers, such as
     ``fivdisc._kernels.tangent.prepare``, compiled only for it)."""
     from fivdisc._kernels import tangent
 
-    with compile_notice(tangent.prepare, show=show, what="kernel with tangent vectors",
-                        seconds=TANGENT_COMPILE_SECONDS):
+    with compile_notice(tangent.prepare, show=show, what="kernel with tangent vectors"):
         yield
-
-
-def warm_kernel(show: bool = False) -> None:
-    """Compile or load the simulation kernel now, with a run of 1 ms of simulated time.
-
-    Parameters
-    ----------
-    show
-        Print the notice of :func:`compile_notice` if the kernel compiles.
-    """
-    from fivdisc._kernels import integrate
-    from fivdisc.case import Case
-    from fivdisc.simulate import simulate
-
-    with compile_notice(integrate.run, show=show):
-        simulate(Case(simulation={"duration": 1e-3, "output_rate": 1000.0}))

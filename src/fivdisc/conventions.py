@@ -10,11 +10,13 @@ its ``units`` and a ``long_name``, with the paper's symbol in ``symbol``.
 from __future__ import annotations
 
 import datetime
+import functools
 from typing import Any
 
 from fivdisc.case import describe_key
 
-__all__ = ["CONVENTIONS", "DOI", "REFERENCES", "axis_label", "global_attrs", "key_attrs", "units"]
+__all__ = ["CONVENTIONS", "DOI", "REFERENCES", "axis_label", "fivdisc_version", "global_attrs",
+           "key_attrs", "units"]
 
 CONVENTIONS = "CF-1.11"
 #: DOI of the paper fivdisc implements.
@@ -30,6 +32,14 @@ def units(unit: str) -> str:
     return unit or "1"
 
 
+@functools.cache
+def fivdisc_version() -> str:
+    """The installed fivdisc's version (looked up once per process)."""
+    from importlib.metadata import version
+
+    return version("fivdisc")
+
+
 def global_attrs(title: str, producer: str) -> dict[str, str]:
     """The global attributes of a dataset fivdisc writes.
 
@@ -40,9 +50,7 @@ def global_attrs(title: str, producer: str) -> dict[str, str]:
     producer
         What made it, for ``history``, e.g. ``"fivdisc.simulate"``.
     """
-    import fivdisc as package  # its version is looked up once per process
-
-    fivdisc = f"fivdisc {package.__version__}"
+    fivdisc = f"fivdisc {fivdisc_version()}"
     now = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
     return {
         "Conventions": CONVENTIONS,

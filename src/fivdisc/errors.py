@@ -23,6 +23,21 @@ class SimulationError(FivdiscError, RuntimeError):
     """A simulation could not start (bad initial state, no equilibrium, ...)."""
 
 
+class AnalysisError(FivdiscError, ValueError):
+    """Invalid input to an analysis or plotting function.
+
+    The message names the parameter, its value and what is allowed.
+    """
+
+
+class SweepError(FivdiscError, ValueError):
+    """A sweep file or sweep value is invalid; the message names the key, value and allowed."""
+
+
+class MissingExtraError(FivdiscError, ImportError):
+    """An optional extra that a command or function needs is not installed."""
+
+
 def nearest(name: str, names: Iterable[str]) -> str:
     """The valid name closest to `name`, as the end of a message: ``"; did you mean
     'slider.mass'?"`` ("" if there are no names).

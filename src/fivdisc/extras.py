@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import importlib.util
 
-from fivdisc.errors import FivdiscError
+from fivdisc.errors import MissingExtraError
 
 __all__ = ["EXTRAS", "MissingExtraError", "require"]
 
@@ -19,10 +19,6 @@ EXTRAS: dict[str, tuple[str, ...]] = {
     "plot": ("matplotlib",),
     "distributed": ("zarr", "dask", "distributed"),
 }
-
-
-class MissingExtraError(FivdiscError, ImportError):
-    """An optional extra that a command or function needs is not installed."""
 
 
 def _installed(module: str) -> bool:

@@ -37,7 +37,7 @@ from fivdisc.analysis.trajectories import (
     separation_intervals,
 )
 from fivdisc.conventions import axis_label
-from fivdisc.result import select_slider
+from fivdisc.selection import select_slider
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -45,6 +45,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "KINDS",
+    "content_band",
     "default_segment",
     "plot_eigen_branches",
     "plot_friction",
@@ -69,6 +70,8 @@ KINDS = _plot_kinds.KINDS
 # most this fraction of the frequency range shown.
 _SEGMENTS_PER_RECORD = 100
 _BINS_PER_RANGE = 50
+# A time series drawn without a window shows its last this many oscillations.
+_READABLE_CYCLES = 30
 # Average width of a character of the default font, in units of its size (for wrapping).
 _CHAR_WIDTH = 0.6
 
@@ -104,10 +107,29 @@ def _axes(ax: Axes | None) -> tuple[Figure, Axes]:
     return fig, new_ax
 
 
-def _label(da: xr.DataArray, fallback: str) -> str:
+def _label(da: xr.DataArray, fallback: str, prefix: str = "") -> str:
     name = da.attrs.get("long_name", fallback)
     units = da.attrs.get("units", "")
-    return f"{name} [{units}]" if units and units != "1" else name
+    return f"{name} [{prefix}{units}]" if units and units != "1" else name
+
+
+# SI prefixes for axis values, so that ticks read 0.1 [mm] rather than 0.0001 [m].
+_PREFIXES = {-9: "n", -6: "µ", -3: "m", 0: "", 3: "k", 6: "M"}
+_SCALED_UNITS = ("m", "m/s", "rad", "rad/s", "N", "J")
+
+
+def _engineering(da: xr.DataArray) -> tuple[float, str]:
+    """(factor, prefix) that bring the largest |value| of `da` into [1, 1000) with an SI
+    prefix of its unit; (1, "") for units not scaled (or rad/s, N beyond their ranges)."""
+    units = da.attrs.get("units", "")
+    values = np.abs(np.asarray(da.values, dtype=float))
+    top = float(np.nanmax(values)) if values.size and np.isfinite(values).any() else 0.0
+    if units not in _SCALED_UNITS or not top > 0:
+        return 1.0, ""
+    power = int(np.clip(3 * np.floor(np.log10(top) / 3), min(_PREFIXES), max(_PREFIXES)))
+    if units == "rad" and power > 0:  # kilo-radians read worse than radians
+        power = 0
+    return 10.0 ** -power, _PREFIXES[power]
 
 
 def _bounds(window: Window) -> tuple[float | None, float | None]:
@@ -149,8 +171,6 @@ def _title(ax: Axes, ds: xr.Dataset, what: str, where: str = "", detail: str = "
 
 def _fit(ax: Axes, text: str, size: str) -> str:
     """`text` wrapped to the width of `ax` (at font `size`), never inside $math$."""
-    import textwrap
-
     from matplotlib.font_manager import FontProperties
 
     points = FontProperties(size=size).get_size_in_points()
@@ -159,9 +179,36 @@ def _fit(ax: Axes, text: str, size: str) -> str:
     # Spaces inside $...$ are kept from the line breaks.
     parts = text.split("$")
     parts[1::2] = [part.replace(" ", "\0") for part in parts[1::2]]
-    wrapped = "\n".join(textwrap.fill(line, chars, break_on_hyphens=False)
+    wrapped = "\n".join(_fill_phrases(line, chars)
                          for line in "$".join(parts).split("\n"))
     return wrapped.replace("\0", " ")
+
+
+def _fill_phrases(line: str, chars: int) -> str:
+    """`line` broken only after ", " or "; " outside parentheses (never inside a phrase
+    such as "slider circumferential angle"), at most about `chars` characters a line; a
+    phrase longer than a line and a half is itself broken between words."""
+    import textwrap
+
+    phrases, start, depth = [], 0, 0
+    for i, char in enumerate(line):
+        depth += {"(": 1, ")": -1}.get(char, 0)
+        if char in ",;" and depth == 0 and line[i + 1:i + 2] == " ":
+            phrases.append(line[start:i + 1])
+            start = i + 2
+    phrases.append(line[start:])
+    out: list[str] = []
+    for phrase in phrases:
+        if len(phrase) > 1.5 * chars:
+            pieces = textwrap.wrap(phrase, chars, break_on_hyphens=False)
+        else:
+            pieces = [phrase]
+        for piece in pieces:
+            if out and len(out[-1]) + 1 + len(piece) <= chars:
+                out[-1] += " " + piece
+            else:
+                out.append(piece)
+    return "\n".join(out)
 
 
 def _nyquist(ds: xr.Dataset) -> float:
@@ -192,6 +239,36 @@ def check_fmax(fmax: float | None, nyquist: float, name: str = "fmax") -> None:
     if not 0 < fmax <= nyquist * (1 + 1e-9):
         raise AnalysisError(f"{name} = {fmax:g} [Hz] is invalid: must be in (0, {nyquist:g}] "
                             "Hz, up to the Nyquist frequency (half the output rate)")
+
+
+def content_band(da: xr.DataArray, nyquist: float, share: float = 0.999) -> float:
+    """Default highest frequency of a spectrogram [Hz]: the frequency below which `share`
+    of the series' power lies (its mean removed), with a fifth more room, rounded up to
+    1, 2 or 5 times a power of ten; never above `nyquist`.
+
+    Parameters
+    ----------
+    da
+        The series (a time dimension only).
+    nyquist
+        Half the sampling rate [Hz].
+    share
+        Fraction of the power the band holds, in (0, 1].
+    """
+    values = np.asarray(da.values, dtype=float)
+    values = values[np.isfinite(values)]
+    if values.size < 4:
+        return nyquist
+    power = np.abs(np.fft.rfft(values - values.mean())) ** 2
+    if not power.sum() > 0:
+        return nyquist
+    freqs = np.linspace(0.0, nyquist, power.size)
+    edge = 1.2 * float(freqs[np.searchsorted(np.cumsum(power) / power.sum(), share)])
+    if not edge > 0:
+        return nyquist
+    decade = 10.0 ** np.floor(np.log10(edge))
+    step = next(s for s in (1.0, 2.0, 5.0, 10.0) if s * decade >= edge)
+    return float(min(step * decade, nyquist))
 
 
 def default_segment(duration: float, fmax: float) -> float:
@@ -238,10 +315,12 @@ def plot_timeseries(data: xr.Dataset | object, var: str, probe: int | None = Non
         values = np.atleast_1d(da.attrs["flag_values"]).tolist()
         meanings = str(da.attrs.get("flag_meanings", "")).split()
         ax.set_yticks(values, meanings if len(meanings) == len(values) else None)
+        ax.set_ylabel(_label(da, var))
     else:
-        ax.plot(da["time"].values, da.values, lw=0.8)
+        factor, prefix = _engineering(da)
+        ax.plot(da["time"].values, da.values * factor, lw=0.8)
+        ax.set_ylabel(_label(da, var, prefix))
     ax.set_xlabel(_label(da["time"], "time"))
-    ax.set_ylabel(_label(da, var))
     _title(ax, ds, str(da.attrs.get("long_name", var)), _where(da))
     return fig
 
@@ -269,7 +348,8 @@ def plot_spectrogram(data: xr.Dataset | object, var: str = "phi", probe: int | N
     overlap, taper
         Overlap fraction and scipy window of :func:`fivdisc.analysis.spectra.stft`.
     fmax : float, optional
-        Highest frequency shown [Hz], up to the Nyquist frequency (the default).
+        Highest frequency shown [Hz], up to the Nyquist frequency; default
+        :func:`content_band`, the band that holds the variable's content.
     dynamic_range : float
         Magnitudes more than this below the maximum share the lowest colour [dB], > 0.
     ax : matplotlib Axes, optional
@@ -281,6 +361,8 @@ def plot_spectrogram(data: xr.Dataset | object, var: str = "phi", probe: int | N
     t0, t1 = _bounds(window)
     nyquist = _nyquist(ds)
     check_fmax(fmax, nyquist)
+    if fmax is None:
+        fmax = content_band(series(ds, var, probe, t0, t1), nyquist)
     if segment is None:
         span = time_window(ds[["time"]], t0, t1)["time"].values
         segment = default_segment(float(span[-1] - span[0]), fmax or nyquist)
@@ -304,7 +386,7 @@ def plot_spectrogram(data: xr.Dataset | object, var: str = "phi", probe: int | N
     ax.set_ylabel(_label(mag["frequency"], "frequency"))
     long_name = ds[var].attrs.get("long_name", var)
     _title(ax, ds, f"spectrogram of {long_name}", _where(mag),
-           f"{segment:g} s segments ({1 / segment:.3g} Hz bins)")
+           f"0-{fmax:g} Hz, {segment:g} s segments ({1 / segment:.3g} Hz bins)")
     return fig
 
 
@@ -424,9 +506,10 @@ def plot_friction(data: xr.Dataset | object, window: Window = None,
 def _trajectory(ds: xr.Dataset, x: str, y: str, what: str, ax: Axes | None) -> Figure:
     """One variable of ``ds`` against another, labelled with names and units."""
     fig, ax = _axes(ax)
-    ax.plot(ds[x].values, ds[y].values, lw=0.8)
-    ax.set_xlabel(_label(ds[x], x))
-    ax.set_ylabel(_label(ds[y], y))
+    (fx, px), (fy, py) = _engineering(ds[x]), _engineering(ds[y])
+    ax.plot(ds[x].values * fx, ds[y].values * fy, lw=0.8)
+    ax.set_xlabel(_label(ds[x], x, px))
+    ax.set_ylabel(_label(ds[y], y, py))
     time = ds["time"].values
     _title(ax, ds, what, _where(ds), f"{time[0]:g} s to {time[-1]:g} s")
     return fig
@@ -507,10 +590,21 @@ def plot_kind(data: xr.Dataset | object, kind: str = "timeseries", var: str | No
         if value is not None and kind not in users]
     if unused:
         raise AnalysisError(f"{unused[0]} is not used by kind = {kind!r}: leave it out")
-    ds = select_slider(as_dataset(data), slider)
+    full = as_dataset(data)
+    ds = select_slider(full, slider)
     name = "phi" if var is None else var
+    if name in full and "slider" not in full[name].dims and "slider" in full.dims:
+        ds = full  # a disc variable (w, q, disc_speed): no slider to name
     if kind == "timeseries":
-        return plot_timeseries(ds, name, probe, window, ax=ax)
+        note = ""
+        if window is None:
+            window, note = _readable_window(series(ds, name, probe))
+        fig = plot_timeseries(ds, name, probe, window, ax=ax)
+        if note:
+            axes = fig.axes[0] if ax is None else ax
+            axes.set_title(axes.get_title() + "\n" + _fit(axes, note, "medium"),
+                           fontsize="medium")
+        return fig
     if kind == "spectrogram":
         return plot_spectrogram(ds, name, probe, window, segment=segment, fmax=fmax, ax=ax)
     if kind == "spectrum":
@@ -520,6 +614,25 @@ def plot_kind(data: xr.Dataset | object, kind: str = "timeseries", var: str | No
     if kind == "friction":
         return plot_friction(ds, window, ax=ax)
     return plot_normal_force(ds, window, ax=ax)
+
+
+def _readable_window(da: xr.DataArray) -> tuple[Window, str]:
+    """The last stretch of a series that shows about ``_READABLE_CYCLES`` of its
+    oscillations (counted by crossings of its mean), and a note saying so for the title;
+    (None, "") when the whole record is readable."""
+    values = np.asarray(da.values, dtype=float)
+    time = da["time"].values
+    if values.size < 3 or time[-1] <= time[0]:
+        return None, ""
+    above = values > np.nanmean(values)
+    cycles = 0.5 * np.count_nonzero(above[1:] != above[:-1])
+    if cycles <= _READABLE_CYCLES:
+        return None, ""
+    span = float(time[-1] - time[0])
+    length = float(f"{span * _READABLE_CYCLES / cycles:.1g}")
+    t0 = float(time[-1]) - length
+    return (t0, None), (f"the last {length:g} s of {span:g} s shown (about "
+                        f"{_READABLE_CYCLES} oscillations; --window for others)")
 
 
 @_drawing

@@ -1,31 +1,48 @@
-"""Progress of long computations on a terminal: a tqdm bar on stderr, silent when stderr
-is not a terminal or when not asked for."""
+"""Progress bars for long work: a tqdm bar on stderr when it is a terminal, nothing
+otherwise (a pipe, a log file, a notebook's captured stream).
+
+>>> from fivdisc.progress import progress_bar
+>>> with progress_bar(total=10, desc="Newton", unit="it", show=True) as bar:
+...     for _ in range(10):
+...         bar.update()
+"""
 
 from __future__ import annotations
 
 import sys
-from collections.abc import Iterator
-from contextlib import contextmanager
 from typing import Any
 
+__all__ = ["SIMULATED_TIME", "progress_bar"]
 
-@contextmanager
-def progress_bar(show: bool, **options: Any) -> Iterator[Any]:
-    """A :class:`tqdm.tqdm` bar on stderr when `show` and stderr is a terminal, else one
-    that draws nothing (its ``update`` and ``set_postfix_str`` still work).
+#: ``bar_format`` of a bar counting simulated seconds (``total`` and ``update`` in [s]).
+SIMULATED_TIME = "{l_bar}{bar}| {n:.3g}/{total:.3g} s [{elapsed}<{remaining}]"
+
+
+def progress_bar(total: float | None, desc: str, unit: str = "it", show: bool = True,
+                 **options: Any) -> Any:
+    """A tqdm bar, shown only if `show` and stderr is a terminal.
 
     Parameters
     ----------
+    total
+        What a finished run counts (iterations, points, simulated seconds); None if not
+        known beforehand.
+    desc
+        What is counted, shown before the bar.
+    unit
+        The unit of one count.
     show
-        False: draw nothing.
+        False: never show it.
     **options
-        Passed to tqdm (``total``, ``desc``, ``unit``, ...).
+        Passed to :class:`tqdm.tqdm` (``bar_format``, ``postfix``, ...).
+
+    Returns
+    -------
+    tqdm.tqdm
+        Use it as tqdm (``update``, ``set_postfix_str``, ``close``, ``with``).
     """
     from tqdm import tqdm
 
-    live = show and sys.stderr.isatty()
-    bar = tqdm(file=sys.stderr, disable=not live, leave=False, dynamic_ncols=True, **options)
-    try:
-        yield bar
-    finally:
-        bar.close()
+    # disable=None is tqdm's "only on a terminal".
+    return tqdm(total=total, desc=desc, unit=unit, file=sys.stderr,
+                disable=None if show else True, **options)

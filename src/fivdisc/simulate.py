@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import time as _time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 
 import numpy as np
 
@@ -12,98 +12,21 @@ from fivdisc._kernels import integrate as kern
 from fivdisc._kernels import slots
 from fivdisc.case import Case
 from fivdisc.compilation import compile_notice
+from fivdisc.conventions import fivdisc_version
 from fivdisc.errors import SimulationError
 from fivdisc.integration import STATUS, Integration, check_steps
 from fivdisc.limits import check_simulation
 from fivdisc.model import Model, build_model
+from fivdisc.progress import SIMULATED_TIME, progress_bar
 from fivdisc.result import EVENT_KINDS, PHASE_NAMES, Result, build_dataset
 from fivdisc.speed import SpeedProfile
 from fivdisc.split_compile import compile_split
+from fivdisc.start import initial_state
 from fivdisc.warmup import warm_up
 
 # Failures in which a state beyond the plate theory's range means the model diverged.
 _BLOW_UPS = ("nonfinite", "step_size_underflow")
 _CHUNKS = 200
-#: Largest initial rotation of a slider [rad].
-MAX_PHI = 1e6
-
-
-def initial_state(model: Model, initial=None) -> np.ndarray:
-    """Kernel state at t = 0 (without energy accumulators).
-
-    Parameters
-    ----------
-    model : Model
-        The model.
-    initial : None, "rest", "equilibrium", mapping or array
-        ``None`` takes the case's ``simulation.initial_state``. A mapping may give
-        ``q`` [m] and ``q_dot`` [m/s] (one per modal coordinate), ``phi`` [rad] and
-        ``phi_dot`` [rad/s] (one per slider, or one number for all); missing ones are
-        zero. An array is a full state of length ``2 (n + 2 S)``.
-    """
-    sim = model.case.simulation
-    if initial is None:
-        initial = sim.initial_state
-    n, ns = model.n, model.n_sliders
-    y = np.zeros(model.state_size)
-    phi = slice(model.index("phi"), model.index("phi") + ns)
-    phi_dot = slice(model.index("phi_dot"), model.index("phi_dot") + ns)
-    if isinstance(initial, str):
-        if initial == "rest":
-            return y
-        if initial == "equilibrium":
-            from fivdisc.analysis.equilibrium import sliding_equilibrium
-
-            y = sliding_equilibrium(model).state.copy()
-            y[phi] += sim.perturbation.phi
-            y[phi_dot] += sim.perturbation.phi_dot
-            return _checked(y, phi)
-        raise SimulationError(
-            f"initial = {initial!r} is invalid: must be 'rest', 'equilibrium', a mapping "
-            "or a state array"
-        )
-    if isinstance(initial, Mapping):
-        allowed = {"q", "q_dot", "phi", "phi_dot"}
-        unknown = set(initial) - allowed
-        if unknown:
-            raise SimulationError(
-                f"initial has unknown keys {sorted(unknown)}: allowed are {sorted(allowed)}"
-            )
-        blocks = (("q", slice(0, n), n, "modal coordinate"),
-                  ("q_dot", slice(n + 2 * ns, 2 * n + 2 * ns), n, "modal coordinate"),
-                  ("phi", phi, ns, "slider"), ("phi_dot", phi_dot, ns, "slider"))
-        for key, sl, size, what in blocks:
-            if key not in initial:
-                continue
-            val = np.asarray(initial[key], dtype=float)
-            if what == "slider" and val.ndim == 0:
-                val = np.full(ns, float(val))
-            if val.shape != (size,):
-                raise SimulationError(
-                    f"initial[{key!r}] has shape {val.shape}: must be ({size},), one per {what}"
-                )
-            y[sl] = val
-    else:
-        y = np.array(initial, dtype=float)
-        if y.shape != (model.state_size,):
-            raise SimulationError(
-                f"initial state has shape {y.shape}: must be ({model.state_size},) = "
-                "2 (n + 2 S)"
-            )
-    return _checked(y, phi)
-
-
-def _checked(y: np.ndarray, phi: slice) -> np.ndarray:
-    """``y``, refused unless finite with slider rotations within :data:`MAX_PHI`."""
-    if not np.all(np.isfinite(y)):
-        raise SimulationError("initial state is invalid: all values must be finite")
-    largest = float(np.max(np.abs(y[phi]), initial=0.0))
-    if largest > MAX_PHI:
-        raise SimulationError(
-            f"initial phi = {largest:g} rad is invalid: must be within +-{MAX_PHI:g} rad "
-            "(further out a double resolves the slider's angle to no better than 1e-10 rad)"
-        )
-    return y
 
 
 def simulate(
@@ -185,12 +108,8 @@ def simulate(
         compile_split(run)
         run.advance(0.0)
     imported = warm_up("xarray")
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=sim.duration, unit="s", unit_scale=False, desc="simulating",
-                   bar_format="{l_bar}{bar}| {n:.3g}/{total:.3g} s [{elapsed}<{remaining}]")
+    bar = progress_bar(sim.duration, "simulating", "s", show=progress,
+                       bar_format=SIMULATED_TIME)
     start = _time.perf_counter()
     status = slots.ST_RUNNING
     with Interrupt() as interrupt:
@@ -231,8 +150,6 @@ def simulate(
     n_done = run.n_samples
     times = np.minimum(np.arange(n_done) / sim.output_rate, sim.duration)
     ist = run.ist
-    import fivdisc as package  # its version is looked up once per process
-
     attrs = {
         "status": name,
         "message": message,
@@ -241,7 +158,7 @@ def simulate(
         "case": case.to_toml(),
         "speed_source": "case" if speed is None else
         f"{speed.source} given to simulate (the case's [speed] table is not used)",
-        "fivdisc_version": package.__version__,
+        "fivdisc_version": fivdisc_version(),
         "wall_time": wall,
         "n_steps": int(ist[slots.I_STEPS]),
         "n_rejected": int(ist[slots.I_REJECTED]),
@@ -443,3 +360,14 @@ def _message(name: str, t: float, phase: str, case: Case, run: Integration) -> s
         "loosen simulation.rtol/atol or check the parameters (a stiff spring or damper)",
     }.get(name, f"ended {where}")
 
+
+def warm_kernel(show: bool = False) -> None:
+    """Compile or load the simulation kernel now, with a run of 1 ms of simulated time.
+
+    Parameters
+    ----------
+    show
+        Print the notice of :func:`compile_notice` if the kernel compiles.
+    """
+    with compile_notice(kern.run, show=show):
+        simulate(Case(simulation={"duration": 1e-3, "output_rate": 1000.0}))

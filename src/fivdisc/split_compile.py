@@ -104,7 +104,7 @@ def helper_main() -> None:
     from fivdisc.case import Case
     from fivdisc.integration import Integration
     from fivdisc.model import build_model
-    from fivdisc.simulate import initial_state
+    from fivdisc.start import initial_state
 
     model = build_model(Case())
     run = Integration(model, initial_state(model), duration=1.0, output_rate=1.0)

@@ -675,8 +675,8 @@ def _run(branch: _Branch, first, to: float, max_points: int, step: float, max_st
 
     deadline = time.monotonic() + time_budget
     walk = _Walk()
-    with progress_bar(progress, total=max_points, desc=f"continuing in {branch.key}",
-                      unit="point") as bar:
+    with progress_bar(max_points, f"continuing in {branch.key}", "point",
+                      show=progress) as bar:
         walk.points.append(first(deadline))
         bar.update()
         _walk(branch, walk, to, max_points, step, max_step, min_step, deadline, bar)

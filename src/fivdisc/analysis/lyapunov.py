@@ -16,18 +16,22 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from fivdisc.case import Case
 from fivdisc.errors import FivdiscError
 from fivdisc.integration import Integration, check_steps, tangent_step
-from fivdisc.model import build_model
+from fivdisc.model import Model, build_model
+from fivdisc.progress import SIMULATED_TIME, progress_bar
 
 __all__ = ["LyapunovSpectrum", "lyapunov"]
 
 # Blocks of the run whose exponents give the uncertainty (their spread).
 _BLOCKS = 10
+# Pieces of the transient, for its progress.
+_TRANSIENT_CHUNKS = 50
 # [s]: the default re-orthonormalisation interval.
 DEFAULT_INTERVAL = 0.05
 #: Most re-orthonormalisations of one measurement (each keeps a row of n logarithms).
@@ -179,8 +183,9 @@ def lyapunov(
     seed : int
         Seed of the random initial tangent vectors.
     progress : bool
-        Show a progress bar over the measurement, and a notice when the kernel with
-        tangent vectors compiles (first use).
+        Show a progress bar in simulated time over the transient and the measurement (on
+        a terminal), and a notice when the kernel with tangent vectors compiles (first
+        use).
 
     Returns
     -------
@@ -205,7 +210,6 @@ def lyapunov(
             "must be >= duration / 1e6 [s]")
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise FivdiscError(f"n = {n!r} is invalid: must be an integer >= 1")
-    from fivdisc.analysis.orbits import energy_scales
     from fivdisc.simulate import Deflection, initial_state
 
     model = build_model(case)
@@ -216,10 +220,29 @@ def lyapunov(
     run = Integration(model, initial_state(model, initial), duration=transient + duration,
                       rtol=rtol, atol=atol, max_step=cap)
     run.advance(0.0)
+    # One bar in simulated time over the transient and the measurement: a long transient
+    # is the first minutes of a run.
     limit = Deflection(model)
-    if transient > 0:
-        run.run_to(transient)
-        _check(run, limit, "the transient")
+    bar = progress_bar(transient + duration, "Lyapunov exponents", "s", show=progress,
+                       bar_format=SIMULATED_TIME)
+    try:
+        for chunk in range(1, _TRANSIENT_CHUNKS + 1 if transient > 0 else 1):
+            run.run_to(transient * chunk / _TRANSIENT_CHUNKS)
+            _check(run, limit, "the transient")
+            bar.update(run.t - bar.n)
+        spectrum = _measure(run, model, limit, n, seed, transient, duration, interval, progress,
+                            bar)
+    finally:
+        bar.close()
+    return spectrum
+
+
+def _measure(run: Integration, model: Model, limit: Any, n: int, seed: int | None,
+             transient: float, duration: float, interval: float, progress: bool,
+             bar: Any) -> LyapunovSpectrum:
+    """The exponents over `duration` after the transient, with `bar` counting it."""
+    from fivdisc.analysis.orbits import energy_scales
+
     free = run.free()
     if n > free.sum():
         raise FivdiscError(f"n = {n} is invalid: must be at most {int(free.sum())}, the "
@@ -234,24 +257,14 @@ def lyapunov(
     times = np.zeros(steps)
     from fivdisc.compilation import tangent_notice
 
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=steps, desc="Lyapunov exponents", unit="QR")
-    try:
-        # The first interval compiles the kernel with tangents in a fresh installation.
-        with tangent_notice(show=progress):
-            run.set_tangents((q * sc[:, None]).T)
-            _interval(run, limit, 0, logs, times, t0, interval, transient + duration, sc)
-        for k in range(steps):
-            if k:
-                _interval(run, limit, k, logs, times, t0, interval, transient + duration, sc)
-            if bar is not None:
-                bar.update()
-    finally:
-        if bar is not None:
-            bar.close()
+    # The first interval compiles the kernel with tangents in a fresh installation.
+    with tangent_notice(show=progress):
+        run.set_tangents((q * sc[:, None]).T)
+        _interval(run, limit, 0, logs, times, t0, interval, transient + duration, sc)
+    for k in range(steps):
+        if k:
+            _interval(run, limit, k, logs, times, t0, interval, transient + duration, sc)
+        bar.update(run.t - bar.n)
     # Over a finite run the QR order need not be the order of the values: sort.
     order = np.argsort(-logs.sum(axis=0), kind="stable")
     logs = logs[:, order]

@@ -558,8 +558,7 @@ def periodic_orbit(
 
     with tangent_notice(show=progress):
         shooting.shoot(x0, min(period, 1e-6), tangents=True)
-    with progress_bar(progress, total=max_iterations, desc="Newton shooting",
-                      unit="iteration") as bar:
+    with progress_bar(max_iterations, "Newton shooting", "iteration", show=progress) as bar:
         sol = _newton(shooting, x0, period, tol, max_iterations, deadline, bar)
     if not sol.reason:
         k = _returns_at(shooting, sol.x0, sol.period)

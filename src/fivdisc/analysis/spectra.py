@@ -21,7 +21,7 @@ import numpy as np
 import scipy.fft
 import xarray as xr
 
-from fivdisc.errors import FivdiscError
+from fivdisc.errors import AnalysisError
 
 __all__ = [
     "AnalysisError",
@@ -43,13 +43,6 @@ WindowSpec = str | tuple
 # Oscillations whose amplitude is below this fraction of the signal's magnitude are
 # rounding noise (a response at rest still leaves ~1e-16 relative residue after detrending).
 _NOISE_FLOOR = 1e-10
-
-
-class AnalysisError(FivdiscError, ValueError):
-    """Invalid input to an analysis or plotting function.
-
-    The message names the parameter, its value and what is allowed.
-    """
 
 
 def as_dataset(data: xr.Dataset | object) -> xr.Dataset:

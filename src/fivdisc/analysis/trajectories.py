@@ -10,7 +10,7 @@ import numpy as np
 import xarray as xr
 
 from fivdisc.analysis.spectra import as_dataset, time_window
-from fivdisc.result import select_slider
+from fivdisc.selection import select_slider
 
 __all__ = ["friction_trajectory", "phase_portrait", "separation_intervals", "separation_stats"]
 

@@ -1,4 +1,4 @@
-"""``fivdisc plot FILE.nc [--run LABEL] --kind KIND [--var NAME] [--probe I] [--slider J]
+"""``fivdisc plot RESULT.nc [--run LABEL] --kind KIND [--var NAME] [--probe I] [--slider J]
 [--window T0:T1] -o FIG.png``: any netCDF file fivdisc writes, drawn."""
 
 from __future__ import annotations
@@ -95,10 +95,12 @@ def _check(ds, kind: str, var: str | None, probe: int | None) -> str | None:
 @click.option("--slider", type=int, default=0, show_default=True,
               help="Which slider's variables (phi, normal_force, ...) and events to plot.")
 @click.option("--window", "window_text", metavar="T0:T1", default=None,
-              help="Time window in s; either side may be empty [default: all].")
+              help="Time window in s; either side may be empty [default: all, except a "
+              "timeseries with many oscillations: its last 30, as its title says].")
 @click.option("--fmax", type=float, default=None,
               help="Highest frequency shown by spectrogram and spectrum, up to the Nyquist "
-              "frequency (half the output rate) [Hz].")
+              "frequency (half the output rate) [Hz] [default: spectrogram: the band "
+              "holding 99.9 % of the variable's power; spectrum: Nyquist].")
 @click.option("--segment", type=float, default=None,
               help="STFT segment length of spectrogram [s] [default: from the window's "
               "length and the frequencies shown].")
@@ -109,7 +111,7 @@ def _check(ds, kind: str, var: str | None, probe: int | None) -> str | None:
 def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int | None,
          slider: int, window_text: str | None, fmax: float | None, segment: float | None,
          output: Path | None, dpi: int) -> None:
-    """Draw a netCDF FILE that fivdisc wrote to a figure file.
+    """Draw RESULT, a netCDF file that fivdisc wrote, to a figure file.
 
     A simulation result (``fivdisc simulate``, or a run of ``fivdisc reproduce``) is drawn
     as --kind says; a stability map (``fivdisc stability -o map.nc``) or a separation map

@@ -154,8 +154,9 @@ class PaperCase:
             text.append(f"Starts from the perturbed sliding equilibrium of Fig. "
                         f"{self.start_from}, which fivdisc.paper passes as the initial state; "
                         "alone, this file starts at rest.")
-        text.append(f"Written by fivdisc.paper.cases.write_examples from FIG{self.figure}; "
-                    "edit the code, not this file.")
+        text.append(f"To vary it, start from a copy: fivdisc examples {self.stem}{label} > "
+                    f"mycase.toml (this file is written from fivdisc.paper.FIG{self.figure}, "
+                    "the case fivdisc reproduce runs).")
         lines = [f"# {line}" for part in text for line in textwrap.wrap(part, 88)]
         return "\n".join(lines) + "\n\n" + self.runs[label].to_toml()
 

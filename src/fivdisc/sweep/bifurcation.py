@@ -1,8 +1,11 @@
 """Bifurcation diagrams: the values of a section over the one swept key of a sweep.
 
-Every point's section values (see :mod:`fivdisc.sweep.sections`) are drawn as small dots
-above its value of the swept key; where the sweep keeps ``largest_lyapunov``, a second
-panel below, sharing the axis, draws the exponent with a line at zero.
+Every point's section values (see :mod:`fivdisc.sweep.sections`) are drawn as dots above
+its value of the swept key (small ones where the points are many, visible ones where they
+are few); where the sweep keeps ``largest_lyapunov``, a second panel below, sharing the
+axis, draws the exponent with a line at zero, and its standard error as error bars where
+the sweep keeps ``largest_lyapunov_uncertainty`` too: a finite-time exponent whose bar
+reaches across zero does not tell chaos from a regular motion.
 """
 
 from __future__ import annotations
@@ -15,9 +18,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import xarray as xr
 
-from fivdisc.errors import nearest
+from fivdisc.errors import SweepError, nearest
 from fivdisc.files import write_atomic
-from fivdisc.sweep.reductions import SweepError
 from fivdisc.sweep.sections import VARIABLES, Section
 
 if TYPE_CHECKING:
@@ -28,7 +30,8 @@ if TYPE_CHECKING:
 __all__ = ["check_diagram", "diagram_section", "plot_bifurcation"]
 
 _DPI = 150
-_DOT = 1.5  # marker size of the section values [pt]
+_DOT = 1.5  # marker size of the section values [pt] where they are many
+_FEW = 2_000  # below this many values, markers grow to stay visible
 
 
 def diagram_section(axes: list[str], sections: list[dict[str, Any]],
@@ -141,7 +144,8 @@ def plot_bifurcation(
         top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=(2.2, 1.0))
     else:
         top = bottom = fig.add_subplot()
-    top.plot(xs, ys, linestyle="none", marker=".", ms=_DOT, mew=0.0, color="k",
+    dot = _DOT if ys.size >= _FEW else _DOT + 3.0 * (1.0 - ys.size / _FEW)
+    top.plot(xs, ys, linestyle="none", marker=".", ms=dot, mew=0.0, color="k",
              rasterized=ys.size > 20_000)
     if branch is not None:
         from fivdisc.analysis.branch import Branch, open_branch
@@ -160,7 +164,10 @@ def plot_bifurcation(
     if lyapunov:
         exponent = np.ravel(data["largest_lyapunov"].values)
         bottom.axhline(0.0, color="0.5", lw=0.8, zorder=1)
-        bottom.plot(x[ok], exponent[ok], ".-", color="tab:blue", ms=3, lw=0.8)
+        error = (np.ravel(data["largest_lyapunov_uncertainty"].values)[ok]
+                 if "largest_lyapunov_uncertainty" in data else None)
+        bottom.errorbar(x[ok], exponent[ok], yerr=error, fmt=".-", color="tab:blue", ms=3,
+                        lw=0.8, elinewidth=0.6, ecolor="tab:blue", capsize=0)
         bottom.set_ylabel("largest Lyapunov\n" r"exponent $\lambda_1$ [1/s]")
     bottom.set_xlabel(axis_label(data[key]))
     fig.align_ylabels()
@@ -172,6 +179,10 @@ def plot_bifurcation(
         where = f"the {chosen.at} switches of slider {chosen.slider}"
     title = (f"{name + ': ' if name else ''}{chosen.variable}{chosen.selection} at {where}, "
              f"t >= {chosen.after:g} s")
+    others = [s["name"] for s in json.loads(data.attrs.get("sweep_sections", "[]"))
+              if s["name"] != chosen.name]
+    if others:  # e.g. one section per slider
+        title += f"\n(other sections: {', '.join(others)}; pick one with --section NAME)"
     top.set_title(title, fontsize="medium")
     if path is not None:
         write_atomic(path, lambda p: fig.savefig(p, dpi=_DPI))

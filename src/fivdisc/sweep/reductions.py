@@ -16,11 +16,11 @@ import math
 import numbers
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from functools import cache, partial
+from functools import cache, lru_cache, partial
 from typing import TYPE_CHECKING, Any
 
 from fivdisc.case import Case
-from fivdisc.errors import FivdiscError, nearest
+from fivdisc.errors import FivdiscError, SweepError, nearest
 from fivdisc.result import Result
 
 if TYPE_CHECKING:
@@ -28,6 +28,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BUILTIN",
+    "LYAPUNOV_REDUCTIONS",
     "LyapunovSettings",
     "Reduction",
     "RunFailed",
@@ -36,10 +37,6 @@ __all__ = [
     "resolve",
     "stop_events",
 ]
-
-
-class SweepError(FivdiscError, ValueError):
-    """A sweep file or sweep value is invalid; the message names the key, value and allowed."""
 
 
 class RunFailed(FivdiscError):
@@ -161,14 +158,24 @@ class LyapunovSettings:
         return transient, duration
 
 
-def _largest_lyapunov(result: Result | None, case: Case,
-                      settings: LyapunovSettings | None = None) -> float:
+@lru_cache(maxsize=2)
+def _lyapunov_run(case: Case, settings: LyapunovSettings) -> Any:
+    """The exponent's run, once for both reductions that read it."""
     from fivdisc.analysis.lyapunov import lyapunov
 
-    settings = settings or LyapunovSettings()
     transient, duration = settings.window(case)
     return lyapunov(case, n=1, transient=transient, duration=duration,
-                    interval=settings.interval).largest
+                    interval=settings.interval)
+
+
+def _largest_lyapunov(result: Result | None, case: Case,
+                      settings: LyapunovSettings | None = None) -> float:
+    return _lyapunov_run(case, settings or LyapunovSettings()).largest
+
+
+def _largest_lyapunov_uncertainty(result: Result | None, case: Case,
+                                  settings: LyapunovSettings | None = None) -> float:
+    return float(_lyapunov_run(case, settings or LyapunovSettings()).uncertainty[0])
 
 
 def _builtin(
@@ -246,8 +253,19 @@ BUILTIN: dict[str, Reduction] = {
             "(settings: [reduce.largest_lyapunov])",
             needs_run=False,
         ),
+        _builtin(
+            "largest_lyapunov_uncertainty",
+            _largest_lyapunov_uncertainty,
+            "1/s",
+            "standard error of largest_lyapunov, from the spread of its estimates over ten "
+            "blocks of the measurement (the same run)",
+            needs_run=False,
+        ),
     )
 }
+
+#: The reductions that read the Lyapunov run, set by ``[reduce.largest_lyapunov]``.
+LYAPUNOV_REDUCTIONS = ("largest_lyapunov", "largest_lyapunov_uncertainty")
 
 # Modules the built-ins import when they run: checked up front so that a missing one
 # stops the sweep before it starts rather than failing every point.
@@ -255,6 +273,7 @@ _NEEDS_MODULE = {
     "dominant_frequency": "fivdisc.analysis.spectra",
     "max_growth_rate": "fivdisc.analysis.stability",
     "largest_lyapunov": "fivdisc.analysis.lyapunov",
+    "largest_lyapunov_uncertainty": "fivdisc.analysis.lyapunov",
 }
 
 
@@ -311,8 +330,8 @@ def _resolve(keep: tuple[str, ...], lyapunov: LyapunovSettings | None) -> tuple[
                     f"be imported ({exc})"
                 ) from None
         reduction = BUILTIN[spec]
-        if spec == "largest_lyapunov" and lyapunov is not None:
-            reduction = replace(reduction, func=partial(_largest_lyapunov, settings=lyapunov))
+        if spec in LYAPUNOV_REDUCTIONS and lyapunov is not None:
+            reduction = replace(reduction, func=partial(reduction.func, settings=lyapunov))
         reductions.append(reduction)
     seen: dict[str, str] = {}
     for r in reductions:

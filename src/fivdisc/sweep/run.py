@@ -27,8 +27,8 @@ from pathlib import Path
 from typing import Any
 
 from fivdisc.case import Case
-from fivdisc.compilation import warm_kernel
 from fivdisc.errors import FivdiscError
+from fivdisc.simulate import warm_kernel
 from fivdisc.sweep.reductions import LyapunovSettings, SweepError, evaluate
 from fivdisc.sweep.sections import Section
 from fivdisc.sweep.spec import Sweep

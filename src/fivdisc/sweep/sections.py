@@ -39,8 +39,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from fivdisc.errors import nearest
-from fivdisc.sweep.reductions import SweepError
+from fivdisc.errors import SweepError, nearest
 
 if TYPE_CHECKING:
     from fivdisc.case import Case

@@ -17,8 +17,8 @@ import xarray as xr
 
 from fivdisc.case import Case
 from fivdisc.conventions import axis_label
+from fivdisc.errors import SweepError
 from fivdisc.files import write_atomic
-from fivdisc.sweep.reductions import SweepError
 from fivdisc.sweep.spec import Sweep
 
 if TYPE_CHECKING:

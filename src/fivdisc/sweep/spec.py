@@ -4,6 +4,8 @@ A sweep file is TOML::
 
     base = "fig27_base.toml"             # a case file (relative to this file), or a [base] table
     mode = "grid"                        # or "zip": all axes the same length, walked together
+    [override]                           # optional: keys of the base changed for this sweep
+    "simulation.duration" = 2.0          # (or [override.simulation] duration = 2.0)
     [axes]
     "speed.initial" = "2.0:20.0:40"      # start:stop:n (inclusive linspace), or a list of values
     "speed.duration" = [5.0, 10.0, 35.0]
@@ -44,6 +46,7 @@ from fivdisc.errors import CaseError, nearest
 from fivdisc.files import read_text
 from fivdisc.limits import check_memory, check_simulation, simulation_bytes
 from fivdisc.sweep.reductions import (
+    LYAPUNOV_REDUCTIONS,
     LyapunovSettings,
     Reduction,
     SweepError,
@@ -56,7 +59,9 @@ __all__ = ["Sweep", "SweepError", "load_sweep", "parse_range"]
 
 FORMAT = "fivdisc-sweep/1"
 MODES = ("grid", "zip")
-_FILE_KEYS = ("base", "mode", "axes", "link", "reduce")
+_FILE_KEYS = ("base", "override", "mode", "axes", "link", "reduce")
+# A TOML file cannot give `base` a value and open a [base.X] table as well.
+_BASE_CONFLICT = re.compile(r"^\s*base\s*=.*^\s*\[\s*base[.\]]", re.MULTILINE | re.DOTALL)
 _REDUCE_KEYS = ("keep", "section", "largest_lyapunov")
 _LYAPUNOV_KEYS = ("transient", "duration", "interval")
 # Names the store gives its own variables.
@@ -319,7 +324,7 @@ class Sweep:
     def _lyapunov_settings(self) -> LyapunovSettings | None:
         """The settings of ``largest_lyapunov``, validated, defaults from the sections."""
         raw = self.lyapunov
-        kept = "largest_lyapunov" in self.keep
+        kept = any(name in self.keep for name in LYAPUNOV_REDUCTIONS)
         if raw is not None and not kept:
             raise SweepError(
                 "reduce.largest_lyapunov sets the reduction 'largest_lyapunov', which "
@@ -492,6 +497,13 @@ class Sweep:
         try:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
+            if _BASE_CONFLICT.search(text):
+                raise SweepError(
+                    f"{prefix}base = \"FILE\" and a [base.TABLE] table cannot both be in a "
+                    "TOML file (TOML gives the key 'base' one value: a file name or a table); "
+                    "change keys of the base file in an [override] table instead, e.g. "
+                    "[override.simulation] with duration = 2.0"
+                ) from None
             raise SweepError(f"{prefix}invalid TOML: {exc}") from None
         try:
             kwargs = _file_fields(data, Path(root) if root is not None else Path.cwd())
@@ -519,6 +531,20 @@ def _file_fields(data: dict[str, Any], root: Path) -> dict[str, Any]:
             raise CaseError(f"base: {exc}") from None
     else:
         raise SweepError(f"base = {raw_base!r} is invalid: must be a case file name or a table")
+    override = data.get("override", {})
+    if not isinstance(override, dict):
+        raise SweepError(f"override = {override!r} is invalid: must be a table of case keys, "
+                         "e.g. [override.simulation] with duration = 2.0")
+    if override:
+        updates = dict(_dotted(override))
+        for key in updates:
+            if not is_case_key(key):
+                raise SweepError(f"unknown key 'override.{key}': not a case key"
+                                 f"{nearest(key, keys_like(key))}")
+        try:
+            base = base.replace(updates)
+        except CaseError as exc:
+            raise CaseError(f"override: {exc}") from None
     for table in ("axes", "link", "reduce"):
         if not isinstance(data.get(table, {}), dict):
             raise SweepError(f"{table} = {data[table]!r} is invalid: must be a table")
@@ -543,6 +569,16 @@ def _file_fields(data: dict[str, Any], root: Path) -> dict[str, Any]:
         "sections": sections,
         "lyapunov": reduce.get("largest_lyapunov"),
     }
+
+
+def _dotted(table: Mapping[str, Any], prefix: str = "") -> Iterator[tuple[str, Any]]:
+    """(dotted key, value) of every leaf of a nested table: ``{"simulation": {"duration":
+    2.0}}`` and ``{"simulation.duration": 2.0}`` both give ``("simulation.duration", 2.0)``."""
+    for key, value in table.items():
+        if isinstance(value, Mapping):
+            yield from _dotted(value, f"{prefix}{key}.")
+        else:
+            yield f"{prefix}{key}", value
 
 
 def load_sweep(path: str | PathLike[str]) -> Sweep:

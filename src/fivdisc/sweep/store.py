@@ -74,8 +74,9 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from fivdisc.errors import SweepError
 from fivdisc.files import write_atomic
-from fivdisc.sweep.reductions import BUILTIN, SweepError
+from fivdisc.sweep.reductions import BUILTIN
 from fivdisc.sweep.spec import Sweep, strides_of
 
 __all__ = [
