@@ -37,8 +37,8 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
                 "fivdisc.split_compile", "fivdisc.start", "fivdisc.simulate",
                 "fivdisc.progress")),
     ("analysis", ("fivdisc.analysis",)),
-    ("top", ("fivdisc.plots", "fivdisc.sweep", "fivdisc.paper", "fivdisc.cli",
-             "fivdisc.__main__", "fivdisc")),
+    ("top", ("fivdisc.plots", "fivdisc.branch_plots", "fivdisc.sweep", "fivdisc.paper",
+             "fivdisc.cli", "fivdisc.__main__", "fivdisc")),
 )
 
 # Imports that go up a layer on purpose: a method that hands its object to the layer
