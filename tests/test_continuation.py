@@ -125,7 +125,7 @@ def test_orbit_command_exits_1_when_not_converged(tmp_path):
     path = tmp_path / "rigid.toml"
     path.write_text(RIGID.replace({"simulation.duration": 4.0}).to_toml())
     res = CliRunner().invoke(cli, ["orbit", str(path), "--json", "--no-progress",
-                                   "--period", "1e-3", "--window", "0.01"])
+                                   "--period", "0.005", "--window", "0.01"])
     assert res.exit_code == 1
     data = json.loads(res.stdout)
     assert data["converged"] is False

@@ -203,7 +203,7 @@ def test_stability_command_branches_and_boundary(tmp_path):
 
 @pytest.mark.parametrize(("args", "message"), [
     (["--x", "law=0:1:5"], "friction.law is invalid: its value 'exponential' is not a number"),
-    (["--x", "decay=1:1:5"], "empty"),
+    (["--x", "decay=1:1:5"], "must be distinct"),
     (["--x", "decay=-1:1:5"], "friction.decay = -1.0 is invalid: must be >= 0"),
     (["--boundary", "decay=0:1", "decay=1:2"], "varies the same key"),
     (["--boundary", "decay=0:1", "normal_damping=1"], "write KEY=START:STOP"),

@@ -202,6 +202,8 @@ def _predicted_dip(a, b, c, r):
     fractions ``-r``, 0 and 1 of the step (the previous step's start, this step's ends)
     has its minimum, if inside the step and deep enough that the function may cross zero
     there although both ends are positive: the fraction, else 2."""
+    if not r > 0.0 or not np.isfinite(r):
+        return 2.0  # no previous step to fit (a step of zero length, or one too long)
     gamma = (a - b + (c - b) * r) / (r * (1.0 + r))
     if not gamma > 0.0:
         return 2.0
@@ -507,7 +509,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
                     have_rc = True
                 th = locate(i, 0.0, 1.0, ev_prev[i], evn[i], t, hs, rc, ph, sg, mdl, wk,
                             dy, ytmp, evt, ist)
-            elif (ev_prev[i] > 0.0 and ev_old[i] < np.inf
+            elif (ev_prev[i] > 0.0 and ev_old[i] < np.inf and hs > 0.0
                   and _predicted_dip(ev_old[i], ev_prev[i], evn[i], h_old / hs) <= 1.0):
                 # Positive at both ends, but the parabola through this and the previous
                 # step's values dips inside the step: an excursion through zero narrower

@@ -100,7 +100,7 @@ def plot_bifurcation(
         Name of the section to draw (default: the sweep's first).
     name
         Name of the case, for the title (default: the store's name without suffix).
-    branch : Branch or path, optional
+    branch : Branch or str, optional
         A branch of periodic orbits in the same key (:func:`fivdisc.continue_orbit`, or
         its netCDF file) to lay over the diagram, stable solid and unstable dashed.
 
