@@ -89,6 +89,21 @@ def test_continuation_in_a_slider_key_matches_independent_solves():
     assert ds["phi_dot_max"].values[:, 0] == pytest.approx(LIGHT.speed.value, rel=1e-6)
 
 
+def test_a_branch_lands_on_a_bound_of_the_key_range():
+    """Continued to zero disc damping (the lowest value allowed): the predictor and the
+    parameter derivative never step outside the range, the branch ends exactly at zero,
+    and the period is the closed form's all along (the disc mode is at rest on the
+    rigid-disc orbit, so its damping does not change the period)."""
+    case = RIGID.replace({"disc.damping_ratio": 0.05})
+    start = periodic_orbit(case, transient=4.0)
+    br = continue_orbit(case, "disc.damping_ratio", 0.0, orbit=start, max_points=40)
+    assert br.stop_reason.startswith("reached")
+    assert br.parameter[-1] == 0.0
+    expected = _rigid_disc_closed_form()[0]
+    assert br.period == pytest.approx(np.full(len(br), expected), rel=1e-9)
+    assert br.bifurcations() == []
+
+
 def test_a_multiple_of_the_period_is_reduced_to_the_minimal_period():
     """Started with three times the closed-form period as its guess, Newton converges on
     the orbit traversed three times; it is reported at its minimal period, with the

@@ -203,7 +203,12 @@ class _Branch:
         if p not in self._models:
             if len(self._models) > 64:
                 self._models.clear()
-            self._models[p] = model_at(self.base, self.case, {self.key: p})
+            try:
+                self._models[p] = model_at(self.base, self.case, {self.key: p})
+            except CaseError as exc:
+                # A corrector or predictor that leaves the key's allowed range has taken
+                # too long a step: the walk halves it (and lands on a boundary target).
+                raise ConvergenceError(str(exc), reason=str(exc)) from None
         return self._models[p]
 
     def shooter(self, p: float) -> Shooting:
@@ -215,13 +220,27 @@ class _Branch:
         return (shot.end - x)[self.free] / self.scale[self.free] / self.xs
 
     def dgap_dp(self, x: np.ndarray, period: float, p: float) -> np.ndarray:
-        """``d (phi_T - x) / d p`` in the scaled unknowns, by a central difference."""
+        """``d (phi_T - x) / d p`` in the scaled unknowns, by a central difference, or a
+        one-sided one of the same order where ``p`` lies within the difference step of
+        a bound of the key's range (a damping continued to zero)."""
         h = _DP * self.ps
-        ends = []
-        for q in (p + h, p - h):
-            ends.append(self.shooter(q).shoot(x, period, tangents=False).end)
-        return (ends[0] - ends[1])[self.free] / self.scale[self.free] / self.xs / (2 * h) \
-            * self.ps
+
+        def end(q: float) -> np.ndarray:
+            return self.shooter(q).shoot(x, period, tangents=False).end
+
+        try:
+            diff = (end(p + h) - end(p - h)) / (2 * h)
+        except ConvergenceError:
+            side = h if self._allowed(p + 2 * h) else -h
+            diff = (4 * end(p + side) - end(p + 2 * side) - 3 * end(p)) / (2 * side)
+        return diff[self.free] / self.scale[self.free] / self.xs * self.ps
+
+    def _allowed(self, p: float) -> bool:
+        try:
+            self.model(p)
+        except ConvergenceError:
+            return False
+        return True
 
     def jacobian(self, shot: Shot, shooting: Shooting, dp: np.ndarray,
                  ref: np.ndarray) -> np.ndarray:
@@ -315,12 +334,37 @@ class _Branch:
         if best is None:
             raise ConvergenceError(reason, reason=reason)
         z, residual, it = best
+        point = self._linearised(z, phase, residual, it)
+        if residual > _POLISH * self.tol:
+            # The chord iterations stalled above the polish level (the previous point's
+            # Jacobian no longer contracts well enough): one Newton step on this point's
+            # own Jacobian, kept if it lowers the residual.
+            lhs = np.vstack([point.jac, row])
+            rhs = -np.r_[self.gap_of(point.shot, point.x), phase @ (z[:m] - x_ref),
+                         row @ z - target]
+            z_new = z + np.linalg.solve(lhs, rhs)
+            x, period, p = self.unpack(z_new)
+            try:
+                shot = self.shooter(p).shoot(x, period, tangents=False)
+                better = (np.array_equal(shot.free, self.free)
+                          and self.shooter(p).residual(shot, x, period) < residual)
+            except FivdiscError:
+                better = False
+            if better:
+                point = self._linearised(z_new, phase,
+                                         self.shooter(p).residual(shot, x, period), it + 1)
+        return point
+
+    def _linearised(self, z: np.ndarray, phase: np.ndarray, residual: float,
+                    iterations: int) -> _Point:
+        """The point ``z`` with its monodromy, multipliers and Jacobian (one run with
+        tangents)."""
         x, period, p = self.unpack(z)
         shooting = self.shooter(p)
         shot = shooting.shoot(x, period)
         jac = self.jacobian(shot, shooting, self.dgap_dp(x, period, p), phase)
         mult, trivial = self.shooting.stability(shot)
-        return _Point(z, x, shot, jac, np.zeros_like(z), mult, trivial, residual, it)
+        return _Point(z, x, shot, jac, np.zeros_like(z), mult, trivial, residual, iterations)
 
     def finish(self, point: _Point, previous: np.ndarray | None, sign: float) -> _Point:
         point.tangent = self.tangent(point.jac, previous, sign)
@@ -473,6 +517,39 @@ def _test_value(pt: _Point, kind: str) -> float:
     return float(abs(_nearest_to(pt.multipliers, pt.trivial, kind)) - 1.0)
 
 
+def _of_kind(pt: _Point, kind: str) -> np.ndarray:
+    """``pt``'s multipliers (flow direction left out) of the class whose passage makes
+    ``kind``: real negative (period doubling), complex with a positive imaginary part
+    (torus; one of each pair), real positive (branch point)."""
+    others = np.delete(pt.multipliers, pt.trivial)
+    real = np.abs(others.imag) <= _REAL * np.abs(others)
+    if kind == "period doubling":
+        return others[real & (others.real < 0)]
+    if kind == "torus":
+        return others[~real & (others.imag > 0)]
+    return others[real & (others.real > 0)]
+
+
+def _passage(mu: complex, kind: str) -> float:
+    """One multiplier's test function: zero where it passes -1, the unit circle or +1."""
+    if kind == "period doubling":
+        return mu.real + 1.0
+    if kind == "torus":
+        return abs(mu) - 1.0
+    return mu.real - 1.0
+
+
+def _crossings(a: _Point, b: _Point, kind: str) -> list[tuple[complex, complex]]:
+    """The multipliers of ``kind``'s class that pass between ``a`` and ``b``, each as its
+    values at ``a`` and at ``b`` (matched by nearness)."""
+    from scipy.optimize import linear_sum_assignment
+
+    at_a, at_b = _of_kind(a, kind), _of_kind(b, kind)
+    rows, cols = linear_sum_assignment(np.abs(at_a[:, None] - at_b[None, :]))
+    return [(complex(at_a[i]), complex(at_b[j])) for i, j in zip(rows, cols, strict=True)
+            if _passage(at_a[i], kind) * _passage(at_b[j], kind) < 0]
+
+
 def _smooth_kinds(a: _Point, b: _Point) -> list[str]:
     kinds = []
     if a.tangent[-1] * b.tangent[-1] < 0:
@@ -487,10 +564,34 @@ def _smooth_kinds(a: _Point, b: _Point) -> list[str]:
     return kinds
 
 
+def _located(branch: _Branch, a: _Point, b: _Point, s_ab: float, kind: str,
+             deadline: float, depth: int = 0) -> list[tuple[_Point, _Point]]:
+    """Each bifurcation of smooth ``kind`` between ``a`` and ``b``, located. Where several
+    multipliers pass in one interval (two pairs leaving the unit circle close together)
+    the interval is halved until each holds one, and each passage is followed by its own
+    multiplier: the multiplier nearest the circle jumps from one pair to the other
+    between them, and a root search on it would find the jump."""
+    if kind == "fold":
+        return [_locate(branch, a, b, s_ab, kind, deadline)]
+    passing = _crossings(a, b, kind)
+    if not passing:
+        # the class changed inside the interval (real multipliers meeting as a pair)
+        return [_locate(branch, a, b, s_ab, kind, deadline)] if depth == 0 else []
+    if len(passing) == 1 or depth == 4:
+        return [_locate(branch, a, b, s_ab, kind, deadline, passing[0])]
+    mid = branch.step_from(a, 0.5 * s_ab, deadline)
+    return [found for lo, hi in ((a, mid), (mid, b))
+            for found in _located(branch, lo, hi, float(np.linalg.norm(hi.z - lo.z)), kind,
+                                  deadline, depth + 1)]
+
+
 def _locate(branch: _Branch, a: _Point, b: _Point, s_ab: float, kind: str,
-            deadline: float) -> tuple[_Point, _Point]:
+            deadline: float, track: tuple[complex, complex] | None = None
+            ) -> tuple[_Point, _Point]:
     """The bifurcation of ``kind`` between ``a`` and ``b`` (arclength ``s_ab`` apart):
-    the located point, or for a signature change the two points bracketing it."""
+    the located point, or for a signature change the two points bracketing it. With
+    ``track`` (the passing multiplier at ``a`` and at ``b``), the test function is that
+    multiplier's, followed from its straight-line guess."""
     from scipy.optimize import brentq
 
     p_tol = _LOCATE * max(abs(branch.unpack(a.z)[2]), 1e-12) / branch.ps
@@ -510,7 +611,11 @@ def _locate(branch: _Branch, a: _Point, b: _Point, s_ab: float, kind: str,
     def value(s: float) -> float:
         if s not in memo:
             memo[s] = branch.step_from(a, s, deadline)
-        return _test_value(memo[s], kind)
+        near = _of_kind(memo[s], kind) if track is not None else np.zeros(0)
+        if near.size == 0:
+            return _test_value(memo[s], kind)
+        guess = track[0] + (track[1] - track[0]) * s / s_ab
+        return _passage(complex(near[np.argmin(np.abs(near - guess))]), kind)
 
     # |dp/ds| <= 1 in the scaled unknowns, so s to p_tol gives p to p_tol.
     s = brentq(value, 0.0, s_ab, xtol=p_tol, rtol=4 * np.finfo(float).eps)
@@ -680,7 +785,20 @@ def _run(branch: _Branch, first, to: float, max_points: int, step: float, max_st
         walk.points.append(first(deadline))
         bar.update()
         _walk(branch, walk, to, max_points, step, max_step, min_step, deadline, bar)
+    walk.bifurcations = _without_fold_echoes(walk.bifurcations)
     return Branch.from_walk(branch, walk, start)
+
+
+def _without_fold_echoes(found: list[Bifurcation]) -> list[Bifurcation]:
+    """``found`` without the branch points next to a fold.
+
+    At a fold the critical multiplier meets the flow direction's in a Jordan block, so
+    near it which of the two is the trivial one is ill-determined, and the critical one's
+    passage through +1 may be counted in the interval before or after the one in which
+    the parameter turns. A fold is that passage; it is not reported twice."""
+    folds = [b.point for b in found if b.kind == "fold"]
+    return [b for b in found
+            if not (b.kind == "branch point" and any(abs(b.point - f) <= 1 for f in folds))]
 
 
 def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
@@ -693,8 +811,12 @@ def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
         if time.monotonic() > deadline:
             walk.stop = _Stop("the time budget ran out")
             return
+        # A predictor past the target goes to the target itself: beyond it the key may
+        # leave its allowed range (a damping continued to zero).
+        landing = np.sign(target - (a.z[-1] + ds * a.tangent[-1])) != side
         try:
-            b = branch.step_from(a, ds, deadline)
+            b = branch.at_value(a, to, deadline) if landing else branch.step_from(a, ds,
+                                                                                 deadline)
             if float(b.tangent @ a.tangent) < _MIN_COSINE:
                 reason = "the tangent turned by more than 60 degrees"
                 raise ConvergenceError(reason, reason=reason)
@@ -721,8 +843,8 @@ def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
             walk.stop = _Stop(f"the period left [{lo_period:.3g}, {hi_period:.3g}] s "
                               "(a period growing without bound: a homoclinic orbit?)")
             return
-        passed = np.sign(target - b.z[-1]) != side
-        if passed:
+        passed = landing or np.sign(target - b.z[-1]) != side
+        if passed and not landing:
             try:
                 b = branch.at_value(a, to, deadline)
             except ConvergenceError:
@@ -745,15 +867,14 @@ def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
 
 def _slip_margin(branch: _Branch, a: _Point) -> float:
     """The smallest slip speed ``|Omega - phidot|`` over ``a``'s orbit, relative to the
-    disc speed (over the sliders that slip throughout; 0 if one sticks)."""
+    disc speed, over the sliders that slip throughout (infinite if none does: a lost
+    stick-slip orbit has not grazed)."""
     _, _, p = branch.unpack(a.z)
     speed = p if branch.key == "speed.value" else branch.case.speed.value
     speed = abs(speed)
     margins = []
     for j, sig in enumerate(a.cycle.signature):
-        if "stick" in sig:
-            return 0.0
-        if sig.startswith("slip"):
+        if sig.startswith("slip") and "stick" not in sig:
             hi = a.cycle.measures["phi_dot_max"][j]
             lo = a.cycle.measures["phi_dot_min"][j]
             margins.append(min(abs(speed - hi), abs(speed - lo)))
@@ -859,8 +980,8 @@ def _record(branch: _Branch, walk: _Walk, a: _Point, b: _Point, s_ab: float,
         return
     for kind in _smooth_kinds(a, b):
         try:
-            lo, hi = _locate(branch, a, b, s_ab, kind, deadline)
+            found = _located(branch, a, b, s_ab, kind, deadline)
         except (ConvergenceError, ValueError):
-            lo, hi = a, b
-        walk.bifurcations.append(_bifurcation(branch, kind, lo, hi, index))
+            found = [(a, b)]
+        walk.bifurcations.extend(_bifurcation(branch, kind, lo, hi, index) for lo, hi in found)
 
