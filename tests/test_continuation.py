@@ -104,6 +104,34 @@ def test_a_branch_lands_on_a_bound_of_the_key_range():
     assert br.bifurcations() == []
 
 
+def test_torus_points_lie_where_independent_solves_cross_the_unit_circle():
+    """The Fig. 13 orbit continued in the disc's damping ratio from 1e-5 down to zero
+    loses stability through two complex pairs (rotation numbers near 0.16 and 0.41)
+    within a factor 1.5 of each other. At 2 % either side of each located torus point,
+    periodic_orbit started from the branch's state gives that pair's modulus on the
+    far side of 1 on each side: |mu| - 1 is there about 3e-7, thirty times the
+    monodromy's error at rtol 1e-12 (1e-8, test_orbits), so the sign is certain."""
+    from fivdisc import paper
+
+    case = paper.FIG13.case.replace({"disc.damping_ratio": 1e-5})
+    start = periodic_orbit(case, transient=5.0)
+    br = continue_orbit(case, "disc.damping_ratio", 0.0, orbit=start, max_points=60)
+    tori = [b for b in br.bifurcations() if b["kind"] == "torus"]
+    assert len(tori) == 2
+    assert abs(tori[0]["rotation"] - tori[1]["rotation"]) > 0.1
+    for torus in tori:
+        for factor, outside in ((0.98, True), (1.02, False)):
+            alone = periodic_orbit(
+                case.replace({"disc.damping_ratio": torus["parameter"] * factor}),
+                guess=torus["state"], period=torus["period"])
+            mu = alone.multipliers
+            pair = mu[np.abs(mu.imag) > 1e-9]
+            rotation = np.abs(np.angle(pair)) / (2 * np.pi)
+            closest = pair[np.argmin(np.abs(rotation - torus["rotation"]))]
+            assert (abs(closest) > 1.0) == outside
+            assert abs(abs(closest) - 1.0) > 1e-7
+
+
 def test_a_multiple_of_the_period_is_reduced_to_the_minimal_period():
     """Started with three times the closed-form period as its guess, Newton converges on
     the orbit traversed three times; it is reported at its minimal period, with the
