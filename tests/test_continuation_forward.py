@@ -113,3 +113,17 @@ def test_multipliers_equal_the_growth_of_a_perturbation_in_a_forward_run(branch,
     assert abs(abs(dominant) - abs(leading)) < 1e-3
     assert np.min(np.abs(others - dominant)) < 1e-3
     assert (abs(dominant) > 1.0) == (which == "unstable")
+
+
+@pytest.mark.slow
+def test_the_fold_is_the_same_from_a_distant_start(fold):
+    """From the orbit at 2 pi rad/s, 6.2 rad/s below, the branch reaches the same fold
+    after about 120 points of other step sizes: its location agrees with the one found
+    from 12.3 rad/s to 1e-6 (the location's accuracy), and, as there, the fold's own
+    multiplier passing +1 is not reported as a branch point beside it."""
+    case = CASE.replace({"speed.value": 2.0 * np.pi})
+    start = periodic_orbit(case, transient=5.0)
+    far = continue_orbit(case, "speed.value", 20.0, orbit=start, max_points=125)
+    found = [b for b in far.bifurcations() if abs(b["parameter"] - 12.5) < 0.1]
+    assert [b["kind"] for b in found] == ["fold"]
+    assert found[0]["parameter"] == pytest.approx(fold["parameter"], rel=1e-6)
