@@ -127,3 +127,22 @@ def test_the_fold_is_the_same_from_a_distant_start(fold):
     found = [b for b in far.bifurcations() if abs(b["parameter"] - 12.5) < 0.1]
     assert [b["kind"] for b in found] == ["fold"]
     assert found[0]["parameter"] == pytest.approx(fold["parameter"], rel=1e-6)
+
+
+def test_a_pair_turning_real_at_a_fold_is_not_a_torus():
+    """Near 2.647 rad/s the damped-disc orbit's branch folds just after a complex pair of
+    small rotation (0.002) leaves the unit circle: past the circle the pair meets the
+    real axis and splits, one of the two real multipliers being the fold's. The pair's
+    passage is a torus point; its turning real is no second torus (rotation 0) at the
+    fold, and the fold is reported once."""
+    case = CASE.replace({"speed.value": 3.0})
+    start = periodic_orbit(case, transient=6.0)
+    br = continue_orbit(case, "speed.value", 0.5, orbit=start, max_points=50)
+    near = [b for b in br.bifurcations() if abs(b["parameter"] - 2.647) < 0.01]
+    assert [b["kind"] for b in near] == ["torus", "fold"]
+    torus, fold = near
+    assert torus["rotation"] > 1e-3
+    # the pair leaves the circle on the way to the fold: stable before, not after
+    assert torus["parameter"] > fold["parameter"]
+    assert np.all(br.stable[: torus["point"] + 1])
+    assert not br.stable[torus["point"] + 1]

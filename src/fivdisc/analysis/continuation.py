@@ -575,8 +575,10 @@ def _located(branch: _Branch, a: _Point, b: _Point, s_ab: float, kind: str,
         return [_locate(branch, a, b, s_ab, kind, deadline)]
     passing = _crossings(a, b, kind)
     if not passing:
-        # the class changed inside the interval (real multipliers meeting as a pair)
-        return [_locate(branch, a, b, s_ab, kind, deadline)] if depth == 0 else []
+        # No multiplier of the class passes: the count changed because a pair outside
+        # the circle became two real ones (next to a fold) or the reverse, which is no
+        # bifurcation of this kind.
+        return []
     if len(passing) == 1 or depth == 4:
         return [_locate(branch, a, b, s_ab, kind, deadline, passing[0])]
     mid = branch.step_from(a, 0.5 * s_ab, deadline)
