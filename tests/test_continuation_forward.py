@@ -146,3 +146,24 @@ def test_a_pair_turning_real_at_a_fold_is_not_a_torus():
     assert torus["parameter"] > fold["parameter"]
     assert np.all(br.stable[: torus["point"] + 1])
     assert not br.stable[torus["point"] + 1]
+
+
+@pytest.mark.slow
+def test_stability_changes_only_at_the_folds():
+    """At 11 rad/s, continued in the disc's damping ratio, the orbit's branch folds twice
+    within 3 % of the damping (8.304e-4 and 8.515e-4): between the folds one multiplier
+    lies outside the unit circle by at most 1e-3, nearly parallel in its eigenvector to
+    the flow's own multiplier 1. The verdict is unstable exactly between the folds and
+    stable elsewhere, the flow's multiplier is 1 to the orbits' residual at every point,
+    and nothing but the two folds is reported."""
+    case = CASE.replace({"speed.value": 11.0})
+    start = periodic_orbit(case, transient=6.0)
+    br = continue_orbit(case, "disc.damping_ratio", 0.0, orbit=start, max_points=60)
+    folds = [b for b in br.bifurcations()]
+    assert [b["kind"] for b in folds] == ["fold", "fold"]
+    first, second = folds[0]["point"], folds[1]["point"]
+    expected = np.ones(len(br), bool)
+    expected[first + 1: second + 1] = False
+    assert np.array_equal(br.stable, expected)
+    for mult in br.multipliers:
+        assert np.min(np.abs(mult - 1.0)) < 1e-6

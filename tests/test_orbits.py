@@ -116,6 +116,36 @@ def test_multipliers_match_finite_differences_of_the_return_map():
     assert np.sort(orbit.moduli) == pytest.approx(ref, abs=1e-6)
 
 
+@pytest.mark.parametrize("mu", [1.0 + 1e-4, 1.0 - 1e-4, 1.0 + 1e-6])
+def test_the_flow_multiplier_is_told_apart_near_a_fold(mu):
+    """A monodromy built by hand as an orbit near a fold of cycles has it: the flow
+    direction f with multiplier 1, a direction v at 1e-7 rad from f with multiplier mu
+    close to 1 (the two eigenvectors merge at the fold), and -0.5 and 0.3 elsewhere. The
+    non-trivial multipliers come out as mu, -0.5 and 0.3 to 1e-12, and the flow's as 1:
+    the eigenvectors of mu and 1 are too nearly parallel to tell them apart, which is
+    what labelled such orbits stable or unstable at random."""
+    from fivdisc.analysis.orbits import Shooting, Shot
+
+    rng = np.random.default_rng(7)
+    f = rng.normal(size=4)
+    f /= np.linalg.norm(f)
+    w = rng.normal(size=4)
+    w -= (w @ f) * f
+    w /= np.linalg.norm(w)
+    v = np.cos(1e-7) * f + np.sin(1e-7) * w
+    basis = np.column_stack([f, v, rng.normal(size=4), rng.normal(size=4)])
+    monodromy = basis @ np.diag([1.0, mu, -0.5, 0.3]) @ np.linalg.inv(basis)
+    shooting = Shooting.__new__(Shooting)
+    shooting.scale = np.ones(4)
+    shot = Shot(end=np.zeros(4), monodromy=monodromy, rate_end=f, rate_start=f,
+                free=np.ones(4, bool))
+    mult, trivial = shooting.stability(shot)
+    assert mult[trivial] == pytest.approx(1.0, abs=1e-9)
+    others = np.sort(np.delete(mult, trivial).real)
+    assert others == pytest.approx(np.sort([mu, -0.5, 0.3]), abs=1e-9)
+    assert np.all(np.diff(np.abs(mult)) <= 0)  # largest modulus first
+
+
 def test_orbit_needs_constant_speed():
     case = RIGID.replace({"speed": {"profile": "decelerating", "initial": 1.0,
                                     "duration": 10.0}})

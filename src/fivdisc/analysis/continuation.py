@@ -77,6 +77,7 @@ _REAL = 1e-6
 # A lost branch of slipping orbits whose smallest slip speed is below this fraction of
 # the disc speed ends grazing the stick boundary.
 _GRAZING = 1e-3
+_DOUBLED_AMPLITUDE = 1e-3  # first doubled orbit's distance from the period doubling
 
 
 @dataclass
@@ -390,12 +391,19 @@ class _Branch:
 
 
 def _start_point(branch: _Branch, orbit: PeriodicOrbit, direction: float,
-                 along: np.ndarray | None) -> _Point:
+                 along: np.ndarray | None, deadline: float) -> _Point:
     """The first point: the orbit moved to the middle of its longest interval without a
     switch in which no slider sticks (so that the point stays away from switches along
-    the branch, and no coordinate of it is held by a sticking slider). With ``along``
-    (a state direction: branch switching) the orbit's point is kept and the first
-    tangent is ``along``."""
+    the branch, and no coordinate of it is held by a sticking slider).
+
+    With ``along`` (branch switching at a period doubling: ``orbit`` is the orbit at the
+    point traversed twice, ``along`` the eigenvector of its multiplier -1) the first
+    point is a doubled orbit itself, of amplitude 1e-3 of the orbit's size along
+    ``along``. At the period-doubling point the doubled orbits leave the twice-traversed
+    one with the parameter changing only at second order: there two branches cross and
+    the Jacobian is singular in both their directions, so no corrector converges from
+    it. At a small amplitude, held while the parameter is free (as from a Hopf point),
+    it is regular."""
     model = branch.base
     x, phases = orbit.state, orbit.phases
     if along is None:
@@ -410,6 +418,12 @@ def _start_point(branch: _Branch, orbit: PeriodicOrbit, direction: float,
             run.run_to(shift)
             x, phases = run.out_y[1, : model.state_size].copy(), run.ph.copy()
     branch.shooting = Shooting(model, phases, branch.rtol, branch.atol, branch.scale)
+    if along is not None:
+        branch.set_free(branch.shooting.shoot(x, orbit.period, tangents=False), x)
+        unit = along / np.linalg.norm(along[branch.free] / branch.scale[branch.free]
+                                      / branch.xs)
+        return _hopf_start(branch, x, unit, _DOUBLED_AMPLITUDE, _DOUBLED_AMPLITUDE,
+                           deadline)
     shot = branch.shooting.shoot(x, orbit.period)
     branch.set_free(shot, x)
     z = branch.pack(x, orbit.period, branch.p0)
@@ -418,12 +432,7 @@ def _start_point(branch: _Branch, orbit: PeriodicOrbit, direction: float,
     mult, trivial = branch.shooting.stability(shot)
     residual = branch.shooting.residual(shot, x, orbit.period)
     pt = _Point(z, x, shot, jac, np.zeros_like(z), mult, trivial, residual, 0)
-    pt = branch.finish(pt, None, direction)
-    if along is not None:
-        t = np.zeros_like(z)
-        t[: branch.m] = along[branch.free] / branch.scale[branch.free]
-        pt.tangent = t / np.linalg.norm(t)
-    return pt
+    return branch.finish(pt, None, direction)
 
 
 def _hopf_start(branch: _Branch, state: np.ndarray, direction: np.ndarray, eps: float,
@@ -744,7 +753,8 @@ def continue_orbit(
                                reason="not converged")
     direction = 1.0 if to > p0 else -1.0
     branch = _Branch(case, key, orbit.phases, orbit.period, rtol, atol_run, tol)
-    return _run(branch, lambda deadline: _start_point(branch, orbit, direction, along), to,
+    return _run(branch, lambda deadline: _start_point(branch, orbit, direction, along,
+                                                      deadline), to,
                 max_points, step, max_step, min_step, time_budget, progress, orbit.start)
 
 
@@ -794,10 +804,11 @@ def _run(branch: _Branch, first, to: float, max_points: int, step: float, max_st
 def _without_fold_echoes(found: list[Bifurcation]) -> list[Bifurcation]:
     """``found`` without the branch points next to a fold.
 
-    At a fold the critical multiplier meets the flow direction's in a Jordan block, so
-    near it which of the two is the trivial one is ill-determined, and the critical one's
-    passage through +1 may be counted in the interval before or after the one in which
-    the parameter turns. A fold is that passage; it is not reported twice."""
+    At a fold the critical multiplier passes +1 where the parameter turns; the two test
+    functions (the multiplier, the tangent's parameter component) are different
+    quantities, so where the fold lies within their errors of a point of the branch the
+    passage may be counted in the interval beside the turn. A fold is that passage; it
+    is not reported twice."""
     folds = [b.point for b in found if b.kind == "fold"]
     return [b for b in found
             if not (b.kind == "branch point" and any(abs(b.point - f) <= 1 for f in folds))]

@@ -306,12 +306,33 @@ class Shooting:
         return jac
 
     def stability(self, shot: Shot) -> tuple[np.ndarray, int]:
-        """The monodromy's eigenvalues, largest modulus first, and the index of the flow
-        direction's."""
-        mult, vecs = np.linalg.eig(shot.monodromy)
+        r"""The monodromy's eigenvalues, largest modulus first, and the index of the flow
+        direction's.
+
+        Notes
+        -----
+        The flow direction's multiplier is 1. Near a fold of cycles a second one is close
+        to 1 too, with an eigenvector nearly parallel to the flow (at the fold the two
+        form a Jordan block), so which eigenvalue of :math:`M` is the flow's cannot be
+        told from the eigenvectors there. The others are therefore taken as the
+        eigenvalues of :math:`Q M` with :math:`Q = I - \hat f \hat f^T` (in the scaled
+        state, :math:`\hat f` the unit vector field at the start): the Jacobian of a
+        Poincare map on the hyperplane normal to the flow, whose spectrum is the
+        non-trivial multipliers and a zero for the flow direction, which is dropped.
+        The flow direction's is :math:`\hat f^T M \hat f`, 1 to the orbit's residual.
+        """
+        sc = self.scale
+        f = shot.rate_start / sc
+        size = np.linalg.norm(f)
+        if not size > 0:
+            raise FivdiscError("the orbit's point is an equilibrium: it has no multipliers")
+        f /= size
+        m = shot.monodromy * (sc[None, :] / sc[:, None])
+        others = np.linalg.eigvals(m - np.outer(f, f @ m))
+        others = np.delete(others, np.argmin(np.abs(others)))
+        mult = np.r_[others, f @ m @ f]
         order = np.argsort(-np.abs(mult), kind="stable")
-        mult, vecs = mult[order], vecs[:, order]
-        return mult, _flow_multiplier(mult, vecs, shot.rate_start, self.scale)
+        return mult[order], int(np.flatnonzero(order == mult.size - 1)[0])
 
 
 def verdict_of(mult: np.ndarray, trivial: int) -> str:
@@ -612,17 +633,3 @@ def saved_start(path: str | PathLike[str]) -> tuple[Case | None, np.ndarray, np.
         return case, state, phases, None, f"from the final state of the run in {path}"
     raise FivdiscError(f"--from {path}: holds neither a periodic orbit (fivdisc orbit -o) "
                        "nor a simulation result (fivdisc simulate -o)")
-
-
-def _flow_multiplier(mult: np.ndarray, vecs: np.ndarray, flow: np.ndarray,
-                     sc: np.ndarray) -> int:
-    """Index of the flow direction's multiplier: among those near 1, the one whose
-    eigenvector is most nearly parallel to the vector field at the start."""
-    f = flow / sc
-    f = f / (np.linalg.norm(f) or 1.0)
-    near = np.flatnonzero(np.abs(mult - 1.0) < 1e-2)
-    if near.size == 0:
-        return int(np.argmin(np.abs(mult - 1.0)))
-    cosines = [abs(np.vdot(vecs[:, i] / sc / np.linalg.norm(vecs[:, i] / sc), f))
-               for i in near]
-    return int(near[int(np.argmax(cosines))])
