@@ -170,7 +170,7 @@ def _locate(
         owner = model
         field = model.model_fields.get(part) if model is not None else None
         model = None
-        if field is None or owner is None:
+        if field is None:
             continue
         if part in getattr(owner, "_unions", {}):
             union = owner._unions[part]
@@ -272,8 +272,8 @@ def describe(exc: ValidationError, root: type[BaseModel], data: Any = None) -> s
             len(loc) > len(e["loc"]) and loc[: len(e["loc"])] == e["loc"] for loc in item_locs
         )
     ]
-    arrays = [data.get(name) for name in getattr(root, "_arrays", {})] \
-        if isinstance(data, Mapping) else []
+    given = data if isinstance(data, Mapping) else {}
+    arrays = [given.get(name) for name in getattr(root, "_arrays", {})]
     single = all(not isinstance(items, list | tuple) or len(items) == 1 for items in arrays)
     messages = [_describe_error(e, root, single) for e in errors[:_MAX_REPORTED_ERRORS]]
     if len(errors) > _MAX_REPORTED_ERRORS:
