@@ -28,6 +28,8 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("foundation", ("fivdisc.errors", "fivdisc.files", "fivdisc.extras", "fivdisc.warmup",
                     "fivdisc._lazy", "fivdisc._plot_kinds", "fivdisc.selection",
                     "fivdisc.examples")),
+    # A case's keys and error messages, which its tables use: they import no table.
+    ("case messages", ("fivdisc.case.tree", "fivdisc.case.messages")),
     ("case", ("fivdisc.case", "fivdisc.plate", "fivdisc.speed", "fivdisc.limits",
               "fivdisc.conventions")),
     ("model", ("fivdisc.model", "fivdisc._kernels", "fivdisc._kernels.cache",

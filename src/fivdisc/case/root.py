@@ -1,0 +1,333 @@
+"""The case itself (:class:`Case`): the tables of one simulation, read from a file, written
+back, changed by dotted keys."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from os import PathLike
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+import tomli_w
+from pydantic import BaseModel, Field, model_validator
+
+from fivdisc.case.disc import Disc
+from fivdisc.case.fields import Table, TaggedUnion
+from fivdisc.case.friction import FRICTION, ExponentialFriction, FrictionLaw
+from fivdisc.case.messages import join, plain, rule, show, unknown_key
+from fivdisc.case.simulation import Simulation
+from fivdisc.case.slider import Slider
+from fivdisc.case.speed import SPEED, ConstantSpeed, Speed
+from fivdisc.case.toml import inline_arrays, read_toml
+from fivdisc.case.tree import catalog, template
+from fivdisc.errors import CaseError
+from fivdisc.files import read_text
+from fivdisc.limits import MAX_SLIDERS
+
+# Sliders whose angles differ by no more than this [rad] (modulo 2 pi) are in one place.
+_SAME_ANGLE = 1e-12
+_EPS = float(np.finfo(float).eps)
+
+
+class Case(Table):
+    """One simulation case: the disc, its sliders, friction, disc speed and run settings.
+
+    Build it with keyword tables (``Case(slider={"normal_damping": 2.0})`` or
+    ``Case(sliders=[{...}, {...}])``), from TOML (:func:`load_case`,
+    :meth:`from_toml`) or from another case (:meth:`replace`). Instances are
+    immutable; equal cases compare equal.
+
+    Attributes
+    ----------
+    disc
+        The annular disc, its modes and damping.
+    sliders
+        The sliders (one or more), each with its springs, dampers, preload, base
+        angle and face. A file gives either one ``[slider]`` table or an array of
+        ``[[sliders]]`` tables.
+    friction
+        The friction law (the same for every slider).
+    speed
+        The disc speed profile Omega(t).
+    simulation
+        Run settings.
+    """
+
+    _unions: ClassVar[Mapping[str, TaggedUnion]] = {"speed": SPEED, "friction": FRICTION}
+    _arrays: ClassVar[Mapping[str, tuple[str, type[Table]]]] = {"sliders": ("slider", Slider)}
+
+    disc: Disc = Disc()
+    sliders: tuple[Slider, ...] = Field((Slider(),), min_length=1)
+    friction: FrictionLaw = ExponentialFriction()
+    speed: Speed = ConstantSpeed()
+    simulation: Simulation = Simulation()
+
+    @model_validator(mode="before")
+    @classmethod
+    def _one_slider_table(cls, data: Any) -> Any:
+        # `[slider]` is the one-slider spelling of `[[sliders]]`.
+        if isinstance(data, Mapping) and "slider" in data:
+            if "sliders" in data:
+                raise rule(
+                    "a case has either one [slider] table or [[sliders]] tables, not both; "
+                    "pick one",
+                    "slider",
+                    data["slider"],
+                )
+            data = {("sliders" if k == "slider" else k): v for k, v in data.items()}
+            data["sliders"] = [plain(data["sliders"])]
+        return data
+
+    @property
+    def slider(self) -> Slider:
+        """The slider of a one-slider case.
+
+        Raises
+        ------
+        CaseError
+            The case has several sliders (use :attr:`sliders`).
+        """
+        if len(self.sliders) != 1:
+            raise CaseError(
+                f"the case has {len(self.sliders)} sliders: use case.sliders[j] "
+                "(and keys sliders.J.KEY) instead of case.slider"
+            )
+        return self.sliders[0]
+
+    def slider_key(self, j: int) -> str:
+        """Dotted prefix of slider `j` in keys and messages: ``slider`` or ``sliders.J``."""
+        return "slider" if len(self.sliders) == 1 else f"sliders.{j}"
+
+    @model_validator(mode="after")
+    def _check_geometry_and_start(self) -> Case:
+        a, b = self.disc.inner_radius, self.disc.outer_radius
+        if len(self.sliders) > MAX_SLIDERS:
+            raise rule(f"must have at most {MAX_SLIDERS} sliders (got {len(self.sliders)}: "
+                        "the work per step grows as the cube of their number)", "sliders",
+                        f"[{len(self.sliders)} tables]")
+        for j, slider in enumerate(self.sliders):
+            r0 = slider.track_radius
+            if not a < r0 < b:
+                raise rule(
+                    f"must lie in (disc.inner_radius, disc.outer_radius) = ({a!r}, {b!r}) [m]",
+                    f"{self.slider_key(j)}.track_radius",
+                    r0,
+                )
+            for i, other in enumerate(self.sliders[:j]):
+                if (other.track_radius, other.face) != (r0, slider.face):
+                    continue
+                # Angles are the same place modulo 2 pi, up to their round-off.
+                gap = abs(math.remainder(slider.angle - other.angle, math.tau))
+                if gap <= _SAME_ANGLE + 8 * _EPS * max(abs(slider.angle), abs(other.angle)):
+                    raise rule(
+                        f"puts sliders.{j} where sliders.{i} is (r = {r0!r} m on the "
+                        f"{slider.face} face, angles equal modulo 2 pi): sliders on one face "
+                        "need different angles or radii",
+                        f"sliders.{j}.angle",
+                        slider.angle,
+                    )
+        for i, probe in enumerate(self.simulation.probes):
+            if not a <= probe[0] <= b:
+                raise rule(
+                    "radius must lie in [disc.inner_radius, disc.outer_radius] "
+                    f"= [{a!r}, {b!r}] [m]",
+                    f"simulation.probes[{i}]",
+                    probe,
+                )
+        if self.simulation.initial_state == "equilibrium" and self.speed.profile != "constant":
+            raise rule(
+                f'must be "rest" when speed.profile = "{self.speed.profile}" '
+                "(a sliding equilibrium exists only at constant speed)",
+                "simulation.initial_state",
+                self.simulation.initial_state,
+            )
+        return self
+
+    @classmethod
+    def from_toml(cls, text: str) -> Case:
+        """Parse and validate a case from TOML text.
+
+        Parameters
+        ----------
+        text
+            The case file's content.
+
+        Raises
+        ------
+        CaseError
+            Invalid TOML or an invalid case.
+        """
+        return _parse(text, source=None)
+
+    def to_toml(self) -> str:
+        """The case as TOML text, every key written out (defaults included).
+
+        One slider is written as a ``[slider]`` table, several as ``[[sliders]]``.
+        """
+        data = self.model_dump(mode="json")
+        if len(self.sliders) == 1:
+            data = {("slider" if k == "sliders" else k): (v[0] if k == "sliders" else v)
+                    for k, v in data.items()}
+        return inline_arrays(tomli_w.dumps(data))
+
+    def save(self, path: str | PathLike[str]) -> None:
+        """Write the case as a TOML file (see :meth:`to_toml`)."""
+        Path(path).write_text(self.to_toml(), encoding="utf-8")
+
+    @classmethod
+    def valid_keys(cls) -> list[str]:
+        """All dotted keys of values (not tables), e.g. ``"slider.mass"``.
+
+        The keys of every speed profile and friction law are included
+        (``speed.value``, ``speed.initial``, ``friction.decay``, ...). A slider's
+        keys are listed as ``slider.KEY`` (the one slider); slider ``J`` of a case
+        with several is ``sliders.J.KEY``.
+        """
+        return list(catalog(Case).leaves)
+
+    def get(self, key: str) -> Any:
+        """The value (or table) at a dotted key, e.g. ``case.get("slider.mass")``.
+
+        Raises
+        ------
+        CaseError
+            The key does not exist in this case.
+        """
+        node: Any = self
+        for name in self._path(key):
+            if isinstance(node, tuple):
+                node = node[name]
+            elif isinstance(node, BaseModel) and name in type(node).model_fields:
+                node = getattr(node, name)
+            else:
+                raise CaseError(self._unknown(key))
+        return node
+
+    def _unknown(self, key: str) -> str:
+        """Message for an unknown dotted key (a key of another speed profile or friction
+        law is explained as such)."""
+        table = key.rpartition(".")[0]
+        keys = catalog(Case)
+        names = keys.names.get(template(table) if table else table)
+        member = type(getattr(self, table)) if table in self._unions else None
+        return unknown_key(key, names, member, everything=[*keys.leaves, *keys.tables])
+
+    def _path(self, key: str) -> list[str | int]:
+        """Path of a dotted key through the model: ``slider.X`` and ``sliders.J.X`` lead to
+        ``["sliders", J, "X"]``."""
+        parts: list[str | int] = list(key.split("."))
+        if parts[0] == "slider":
+            if len(self.sliders) != 1:
+                raise CaseError(
+                    f"'{key}' is ambiguous: the case has {len(self.sliders)} sliders; write "
+                    f"sliders.J.{'.'.join(map(str, parts[1:])) or 'KEY'} with J from 0 to "
+                    f"{len(self.sliders) - 1}"
+                )
+            return ["sliders", 0, *parts[1:]]
+        if parts[0] == "sliders" and len(parts) > 1:
+            index = parts[1]
+            if not (isinstance(index, str) and index.isdigit()
+                    and int(index) < len(self.sliders)):
+                raise CaseError(
+                    f"'{key}': slider index {index!r} is invalid: the case has "
+                    f"{len(self.sliders)} slider(s), numbered from 0"
+                )
+            return ["sliders", int(index), *parts[2:]]
+        return parts
+
+    def replace(self, updates: Mapping[str, Any]) -> Case:
+        """A new, validated case with some values changed.
+
+        Parameters
+        ----------
+        updates
+            Dotted key -> new value, e.g. ``{"slider.normal_damping": 2.0}`` or, with
+            several sliders, ``{"sliders.1.preload": 300.0}``. A key may also name a
+            whole table (``"speed"``, ``"simulation"``, ``"sliders.1"``,
+            ``"simulation.perturbation"``) or the list ``"sliders"``, whose value (a
+            dict or model, or a list of them) then replaces it; keys it leaves out take
+            their defaults. Tables are applied before the keys inside them. Setting
+            ``speed.profile`` (``friction.law``) to a different profile (law) starts
+            that table afresh, so ``{"speed.profile": "decelerating",
+            "speed.initial": 10.0}`` works from any case.
+
+        Raises
+        ------
+        CaseError
+            An unknown key or an invalid resulting case.
+        """
+        if not isinstance(updates, Mapping):
+            raise CaseError(f"updates = {show(updates)} is invalid: must be a mapping of "
+                            "dotted keys to values, e.g. {'slider.mass': 0.2}")
+        for key in updates:
+            if not isinstance(key, str):
+                raise CaseError(f"updates key {key!r} is invalid: must be a dotted key "
+                                "(str), e.g. 'slider.mass'")
+        data = self.model_dump()
+        keys = catalog(Case)
+        tags = {f"{u.table}.{u.tag}" for u in self._unions.values()}
+        # Shallow keys first, then a union's tag before its sibling keys.
+        for key in sorted(updates, key=lambda k: (k.count("."), k not in tags)):
+            if template(key) not in keys.leaves and template(key) not in keys.tables:
+                raise CaseError(self._unknown(key))
+            *path, name = self._path(key)
+            table: Any = data
+            for i, part in enumerate(path):
+                child = table[part] if isinstance(part, int) else table.get(part, {})
+                if isinstance(child, BaseModel):
+                    child = child.model_dump()
+                elif not isinstance(child, Mapping | list | tuple):
+                    raise CaseError(
+                        f"cannot set '{key}': {join(path[: i + 1])} = {show(child)} "
+                        "is not a table"
+                    )
+                table[part] = list(child) if isinstance(child, list | tuple) else dict(child)
+                table = table[part]
+            if key in tags:
+                union = self._unions[key.split(".")[0]]
+                if updates[key] != table.get(union.tag, union.default):
+                    table.clear()
+            table[name] = plain(updates[key])
+        return _validate(data, source=None)
+
+
+def load_case(path: str | PathLike[str]) -> Case:
+    """Read and validate a TOML case file.
+
+    Parameters
+    ----------
+    path
+        The case file.
+
+    Returns
+    -------
+    Case
+        The validated case; keys the file leaves out take their defaults.
+
+    Raises
+    ------
+    CaseError
+        Invalid TOML or an invalid case; the message starts with the file's path.
+    FivdiscError
+        The path is a directory, cannot be read, or is not UTF-8 text.
+    FileNotFoundError
+        The file does not exist.
+    """
+    return _parse(read_text(path), source=str(path))
+
+
+def _parse(text: str, source: str | None) -> Case:
+    """Parse TOML `text` and validate it; `source` (a path) prefixes error messages."""
+    return _validate(read_toml(text, source), source)
+
+
+def _validate(data: Any, source: str | None) -> Case:
+    """Validate a dict as a case; `source` (a path) prefixes error messages."""
+    try:
+        return Case.model_validate(data)
+    except CaseError as exc:
+        if source is None:
+            raise
+        raise CaseError(f"{source}: {exc}") from None
