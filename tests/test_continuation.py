@@ -119,6 +119,15 @@ def test_torus_points_lie_where_independent_solves_cross_the_unit_circle():
     tori = [b for b in br.bifurcations() if b["kind"] == "torus"]
     assert len(tori) == 2
     assert abs(tori[0]["rotation"] - tori[1]["rotation"]) > 0.1
+    # Upwards from the undamped disc both pairs pass within the first step: each is
+    # found, at the same place.
+    undamped = paper.FIG13.case
+    up = continue_orbit(undamped, "disc.damping_ratio", 1e-5,
+                        orbit=periodic_orbit(undamped, transient=5.0), max_points=3)
+    found = sorted((b for b in up.bifurcations() if b["kind"] == "torus"),
+                   key=lambda b: -b["parameter"])
+    assert [b["parameter"] for b in found] == pytest.approx(
+        [b["parameter"] for b in tori], rel=1e-6)
     for torus in tori:
         for factor, outside in ((0.98, True), (1.02, False)):
             alone = periodic_orbit(

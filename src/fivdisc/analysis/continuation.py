@@ -588,8 +588,10 @@ def _located(branch: _Branch, a: _Point, b: _Point, s_ab: float, kind: str,
         # the circle became two real ones (next to a fold) or the reverse, which is no
         # bifurcation of this kind.
         return []
-    if len(passing) == 1 or depth == 4:
-        return [_locate(branch, a, b, s_ab, kind, deadline, passing[0])]
+    if len(passing) == 1 or depth == 6:
+        # each followed by its own multiplier (still together after six halvings: the
+        # straight-line guesses tell them apart)
+        return [_locate(branch, a, b, s_ab, kind, deadline, track) for track in passing]
     mid = branch.step_from(a, 0.5 * s_ab, deadline)
     return [found for lo, hi in ((a, mid), (mid, b))
             for found in _located(branch, lo, hi, float(np.linalg.norm(hi.z - lo.z)), kind,
