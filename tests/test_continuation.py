@@ -141,6 +141,39 @@ def test_torus_points_lie_where_independent_solves_cross_the_unit_circle():
             assert abs(abs(closest) - 1.0) > 1e-7
 
 
+def test_an_interrupted_continuation_keeps_its_branch(rigid_orbit, tmp_path, monkeypatch):
+    """Ctrl-C during the walk ends it as a time budget does: the points so far are the
+    branch (the API returns it, the command writes it and exits 130)."""
+    from fivdisc.analysis import continuation
+
+    step_from = continuation._Branch.step_from
+    calls = {"n": 0}
+
+    def interrupted_later(self, a, s, deadline):
+        calls["n"] += 1
+        if calls["n"] == 4:
+            raise KeyboardInterrupt
+        return step_from(self, a, s, deadline)
+
+    monkeypatch.setattr(continuation._Branch, "step_from", interrupted_later)
+    br = continue_orbit(RIGID, "speed.value", 3.0, orbit=rigid_orbit, max_points=20)
+    assert br.stop_reason == continuation.INTERRUPTED
+    assert len(br) == 4
+    for p, period in zip(br.parameter, br.period, strict=True):
+        assert period == pytest.approx(_rigid_disc_closed_form(p)[0], rel=1e-9)
+
+    case, orbit_file, out = tmp_path / "rigid.toml", tmp_path / "orbit.nc", tmp_path / "b.nc"
+    case.write_text(RIGID.replace({"simulation.duration": 4.0}).to_toml())
+    runner = CliRunner()
+    result = runner.invoke(cli, ["orbit", str(case), "--no-progress", "-o", str(orbit_file)])
+    assert result.exit_code == 0, result.output
+    calls["n"] = 0
+    result = runner.invoke(cli, ["continue", "--from", str(orbit_file), "--key",
+                                 "speed.value", "--to", "3", "--no-progress", "-o", str(out)])
+    assert result.exit_code == 130, result.output
+    assert len(open_branch(out)) == 4
+
+
 def test_a_multiple_of_the_period_is_reduced_to_the_minimal_period():
     """Started with three times the closed-form period as its guess, Newton converges on
     the orbit traversed three times; it is reported at its minimal period, with the
@@ -220,7 +253,9 @@ def test_orbit_and_branch_files_round_trip(tmp_path):
 @pytest.mark.parametrize(("args", "message"), [
     (["--key", "speed.profile", "--to", "1"], "is not a number"),
     (["--key", "disc.modes", "--to", "1"], "is not a number"),
-    (["--key", "simulation.impact", "--to", "1"], "is not a number"),
+    (["--key", "simulation.impact", "--to", "1"], "simulation settings"),
+    (["--key", "simulation.duration", "--to", "2"], "simulation settings"),
+    (["--key", "simulation.perturbation.phi", "--to", "0.1"], "simulation settings"),
     (["--key", "speed.valeu", "--to", "1"], "did you mean 'speed.value'"),
     (["--key", "speed.value", "--to", "-1"], "must be >= 0"),
     (["--key", "speed.value", "--to", "inf"], "finite"),

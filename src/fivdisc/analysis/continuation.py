@@ -77,7 +77,8 @@ _REAL = 1e-6
 # A lost branch of slipping orbits whose smallest slip speed is below this fraction of
 # the disc speed ends grazing the stick boundary.
 _GRAZING = 1e-3
-_DOUBLED_AMPLITUDE = 1e-3  # first doubled orbit's distance from the period doubling
+INTERRUPTED = "interrupted (Ctrl-C)"
+_DOUBLED_AMPLITUDE = 1e-4  # first doubled orbit's distance from the period doubling
 
 
 @dataclass
@@ -155,12 +156,17 @@ def check_key(case: Case, key: str, option: str = "key") -> float:
     Raises
     ------
     CaseError
-        The key is unknown, or not a single number (a table, a list, a name, a switch).
+        The key is unknown, a simulation setting, or not a single number (a table, a
+        list, a name, a switch).
     """
     if not is_case_key(key):
         from fivdisc.analysis.stability import resolve_key
 
         key = resolve_key(key, option)
+    if key.startswith("simulation."):
+        raise CaseError(f"{option} = {key!r} is invalid: the simulation settings do not "
+                        "change the system, so its periodic orbits do not depend on them; "
+                        "continue in a key of disc, slider(s), friction or speed")
     value = case.get(key)
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise CaseError(f"{option} = {key!r} is invalid: its value {value!r} is not a number; "
@@ -398,7 +404,7 @@ def _start_point(branch: _Branch, orbit: PeriodicOrbit, direction: float,
 
     With ``along`` (branch switching at a period doubling: ``orbit`` is the orbit at the
     point traversed twice, ``along`` the eigenvector of its multiplier -1) the first
-    point is a doubled orbit itself, of amplitude 1e-3 of the orbit's size along
+    point is a doubled orbit itself, of amplitude 1e-4 of the orbit's size along
     ``along``. At the period-doubling point the doubled orbits leave the twice-traversed
     one with the parameter changing only at second order: there two branches cross and
     the Jacobian is singular in both their directions, so no corrector converges from
@@ -798,7 +804,12 @@ def _run(branch: _Branch, first, to: float, max_points: int, step: float, max_st
                       show=progress) as bar:
         walk.points.append(first(deadline))
         bar.update()
-        _walk(branch, walk, to, max_points, step, max_step, min_step, deadline, bar)
+        try:
+            _walk(branch, walk, to, max_points, step, max_step, min_step, deadline, bar)
+        except KeyboardInterrupt:
+            # The points and bifurcations so far are a branch: kept, as a time budget
+            # running out keeps them.
+            walk.stop = _Stop(INTERRUPTED)
     walk.bifurcations = _without_fold_echoes(walk.bifurcations)
     return Branch.from_walk(branch, walk, start)
 

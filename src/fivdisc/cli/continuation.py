@@ -64,7 +64,7 @@ def continuation(case_file: Path | None, key: str, target: float, from_file: Pat
     event signature (stick phases appearing, grazing, ...) located to 1e-6 in the key.
     CASE_FILE is a TOML file or a packaged example.
     """
-    from fivdisc.analysis.continuation import continue_orbit
+    from fivdisc.analysis.continuation import INTERRUPTED, continue_orbit
     from fivdisc.errors import ConvergenceError, FivdiscError
     from fivdisc.files import check_output
 
@@ -84,7 +84,7 @@ def continuation(case_file: Path | None, key: str, target: float, from_file: Pat
         if out is not None:
             branch.to_netcdf(out)
         click.echo(branch.to_json() if as_json else str(branch))
-        sys.exit(1 if branch.lost else 0)
+        sys.exit(130 if branch.stop_reason == INTERRUPTED else 1 if branch.lost else 0)
     try:
         case, orbit, along, search = _start(case_file, from_file, which, key, target, rtol,
                                             transient, period)
@@ -97,6 +97,8 @@ def continuation(case_file: Path | None, key: str, target: float, from_file: Pat
     if out is not None:
         branch.to_netcdf(out)
     click.echo(branch.to_json() if as_json else str(branch))
+    if branch.stop_reason == INTERRUPTED:
+        sys.exit(130)
     if branch.lost:
         sys.exit(1)
 
