@@ -167,3 +167,18 @@ def test_stability_changes_only_at_the_folds():
     assert np.array_equal(br.stable, expected)
     for mult in br.multipliers:
         assert np.min(np.abs(mult - 1.0)) < 1e-6
+
+
+def test_a_closed_branch_stops_where_it_came_round():
+    """In the friction law's decay the 12.3 rad/s orbit lies on a closed curve of orbits
+    (an isola between folds at 0.8343 and 2.3194 s/m). The walk goes round once and
+    stops at the first fold met a second time, instead of drawing the curve again; the
+    verdict changes only at the folds (one multiplier passes +1 at each)."""
+    start = periodic_orbit(CASE, transient=5.0)
+    br = continue_orbit(CASE, "friction.decay", 0.0, orbit=start, max_points=400)
+    assert "closed on itself" in br.stop_reason
+    kinds = [b["kind"] for b in br.bifurcations()]
+    assert kinds == ["fold", "fold", "fold"]
+    first, last = br.bifurcations()[0], br.bifurcations()[-1]
+    assert last["parameter"] == pytest.approx(first["parameter"], rel=1e-6)
+    assert np.count_nonzero(np.diff(br.stable.astype(int))) == 2

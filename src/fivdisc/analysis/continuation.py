@@ -119,8 +119,9 @@ class Bifurcation:
     state : ndarray
         The orbit's point there.
     before, after : ndarray of complex
-        Floquet multipliers on either side (the same located point for a smooth
-        bifurcation, the two sides of the bracket for a signature change).
+        Floquet multipliers on either side: of the branch's points either side for a
+        smooth bifurcation (the passing multiplier is inside the circle on one side and
+        outside on the other), of the two sides of the bracket for a signature change.
     signature_before, signature_after : tuple of str
         Event signatures on either side.
     rotation : float
@@ -642,7 +643,13 @@ def _locate(branch: _Branch, a: _Point, b: _Point, s_ab: float, kind: str,
     return memo[s], memo[s]
 
 
-def _bifurcation(branch: _Branch, kind: str, lo: _Point, hi: _Point, index: int) -> Bifurcation:
+def _bifurcation(branch: _Branch, kind: str, lo: _Point, hi: _Point, index: int,
+                 sides: tuple[_Point, _Point] | None = None) -> Bifurcation:
+    """The record of a bifurcation located at ``lo`` (a smooth one, ``hi`` the same) or
+    between ``lo`` and ``hi`` (a signature change). Its multipliers before and after are
+    those of ``sides`` if given (the branch's points either side of a smooth one, where
+    the passing multiplier shows), else of ``lo`` and ``hi``."""
+    before, after = sides if sides is not None else (lo, hi)
     _, t_lo, p_lo = branch.unpack(lo.z)
     _, t_hi, p_hi = branch.unpack(hi.z)
     at = hi if kind == "signature change" else lo
@@ -663,7 +670,7 @@ def _bifurcation(branch: _Branch, kind: str, lo: _Point, hi: _Point, index: int)
                  enumerate(zip(lo.cycle.signature, hi.cycle.signature, strict=True)) if u != v]
         note = "the event signature changes (" + "; ".join(sides) + ")"
     return Bifurcation(kind=kind, parameter=0.5 * (p_lo + p_hi), period=0.5 * (t_lo + t_hi),
-                       state=at.x.copy(), before=lo.multipliers, after=hi.multipliers,
+                       state=at.x.copy(), before=before.multipliers, after=after.multipliers,
                        signature_before=lo.cycle.signature, signature_after=hi.cycle.signature,
                        rotation=rotation, point=index, note=note)
 
@@ -876,8 +883,14 @@ def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
             except ConvergenceError:
                 ds *= 0.5
                 continue
+        found = len(walk.bifurcations)
         _record(branch, walk, a, b, float(np.linalg.norm(b.z - a.z)), deadline)
         walk.points.append(b)
+        again = _closed(walk.bifurcations, found)
+        if again is not None:
+            walk.stop = _Stop(f"the branch closed on itself (an isola): it passed the fold at "
+                              f"{branch.key} = {again.parameter:.9g} a second time")
+            return
         bar.update()
         _, _, p = branch.unpack(b.z)
         bar.set_postfix_str(f"{branch.key} = {p:.6g}, T = {period:.6g} s")
@@ -889,6 +902,21 @@ def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
         elif b.iterations >= 7:
             ds = max(ds * 0.5, min_step)
     walk.stop = _Stop(f"the largest number of points ({max_points}) is reached")
+
+
+def _closed(found: list[Bifurcation], new: int) -> Bifurcation | None:
+    """An earlier fold that one of ``found[new:]`` repeats (the same parameter and period
+    to 1e-5, ten times the location's accuracy), else None: the branch is a closed curve
+    and has come round."""
+    for b in found[new:]:
+        if b.kind != "fold":
+            continue
+        for earlier in found[:new]:
+            if (earlier.kind == "fold"
+                    and abs(earlier.parameter - b.parameter) <= 1e-5 * abs(b.parameter)
+                    and abs(earlier.period - b.period) <= 1e-5 * b.period):
+                return earlier
+    return None
 
 
 def _slip_margin(branch: _Branch, a: _Point) -> float:
@@ -1009,5 +1037,6 @@ def _record(branch: _Branch, walk: _Walk, a: _Point, b: _Point, s_ab: float,
             found = _located(branch, a, b, s_ab, kind, deadline)
         except (ConvergenceError, ValueError):
             found = [(a, b)]
-        walk.bifurcations.extend(_bifurcation(branch, kind, lo, hi, index) for lo, hi in found)
+        walk.bifurcations.extend(_bifurcation(branch, kind, lo, hi, index, sides=(a, b))
+                                 for lo, hi in found)
 
