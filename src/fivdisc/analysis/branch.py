@@ -118,15 +118,18 @@ class Branch:
     def hopf(self) -> dict[str, Any] | None:
         """For a branch from :func:`~fivdisc.analysis.hopf_cycle.hopf_cycles`: the Hopf
         point's ``value``, ``omega`` [rad/s], ``direction``, ``criticality``
-        (``"subcritical"`` or ``"supercritical"``) and the ``bistable`` range (low, high;
-        nan if none); else None."""
+        (``"subcritical"`` or ``"supercritical"``), the ``bistable`` range (low, high;
+        nan if none) and whether its end away from the Hopf point is only a bound
+        (``bistable_open``: the stick-slip orbits beyond a grazing are not followed);
+        else None."""
         attrs = self.dataset.attrs
         if "criticality" not in attrs:
             return None
         return {"value": float(attrs["hopf_value"]), "omega": float(attrs["hopf_omega"]),
                 "direction": int(attrs["hopf_direction"]),
                 "criticality": str(attrs["criticality"]),
-                "bistable": (float(attrs["bistable_low"]), float(attrs["bistable_high"]))}
+                "bistable": (float(attrs["bistable_low"]), float(attrs["bistable_high"])),
+                "bistable_open": bool(attrs.get("bistable_open", 0))}
 
     # --- writing ------------------------------------------------------------------------
 
@@ -286,8 +289,17 @@ class Branch:
             lines.append(f"from the Hopf point at {self.key} = {hopf['value']:.9g}{unit}: "
                          f"{hopf['criticality']}")
             low, high = hopf["bistable"]
-            lines.append("bistable range (stable sliding and a stable vibration): " + (
-                "none found" if math.isnan(low) else f"{low:.9g} to {high:.9g}{unit}"))
+            if math.isnan(low):
+                reach = "none found"
+            elif hopf["bistable_open"]:
+                near_hopf = high if high == hopf["value"] else low
+                far = low if high == hopf["value"] else high
+                reach = (f"from {near_hopf:.9g}{unit} to {far:.9g}{unit} at least (where the "
+                         "slipping orbits graze; the stick-slip orbits beyond are not "
+                         "followed: continue one to find where the range ends)")
+            else:
+                reach = f"{low:.9g} to {high:.9g}{unit}"
+            lines.append("bistable range (stable sliding and a stable vibration): " + reach)
         bifs = self.bifurcations()
         lines.append(f"bifurcations: {len(bifs) or 'none'}")
         for b in bifs:

@@ -95,12 +95,14 @@ def hopf_cycles(
     the first Lyapunov coefficient ``l1``: ``c`` has the sign of ``-l1 / (d Re lambda /
     dp)``). The bistable range is where the equilibrium is stable and a stable orbit of
     the branch exists: from the Hopf value to the farthest stable orbit on the
-    equilibrium's stable side (a fold of cycles), or to where unstable slipping orbits
-    on that side graze the stick boundary (there the stick-slip orbits begin, and the
-    unstable orbits separate the equilibrium's basin from them: the stick-slip orbits
-    themselves are not continued here; a simulation in the range shows both
-    attractors). The equilibrium's stability beyond other Hopf points of the key is not
-    checked.
+    equilibrium's stable side (a fold of cycles), or at least to where unstable
+    slipping orbits on that side graze the stick boundary. There stick-slip orbits
+    begin, and the unstable orbits separate the equilibrium's basin from them; the
+    stick-slip orbits themselves are not continued here and may coexist with the
+    equilibrium beyond the grazing value, so that end of the range is then a bound
+    only (``bistable_open``; continue a stick-slip orbit there with
+    :func:`~fivdisc.analysis.continuation.continue_orbit` to find where it ends). The
+    equilibrium's stability beyond other Hopf points of the key is not checked.
     """
     if not (np.isfinite(amplitude) and 0 < amplitude <= 0.5):
         raise FivdiscError(f"amplitude = {amplitude!r} is invalid: must be in (0, 0.5], a "
@@ -133,17 +135,20 @@ def _judge(result: Branch, hopf: HopfPoint) -> None:
     # Orbits on the side where the equilibrium is stable, and stable themselves.
     stable_side = (p - hopf.value) * unstable_side < 0
     coexist = list(p[result.stable & stable_side])
-    # Unstable slipping orbits that graze on the stable side: the stick-slip orbits leave
-    # the grazing orbit towards the Hopf value (a non-smooth fold), so they coexist
-    # with the equilibrium from there to the Hopf value.
-    coexist += [b["parameter"] for b in result.bifurcations()
-                if b["kind"] == "grazing" and (b["parameter"] - hopf.value) * unstable_side < 0]
-    coexist = np.array(coexist)
+    # Unstable slipping orbits that graze on the stable side: stick-slip orbits coexist
+    # with the equilibrium from there to the Hopf value, and may reach beyond the
+    # grazing value, where they are not followed: the range is then open on that side.
+    grazing = [b["parameter"] for b in result.bifurcations()
+               if b["kind"] == "grazing" and (b["parameter"] - hopf.value) * unstable_side < 0]
+    coexist = np.array(coexist + grazing)
+    open_end = False
     if hopf.on_boundary and coexist.size:
         far = coexist[np.argmax(np.abs(coexist - hopf.value))]
+        open_end = bool(far in grazing)
         low, high = sorted((float(far), hopf.value))
     else:
         low = high = np.nan
     result.dataset.attrs.update({"hopf_value": hopf.value, "hopf_omega": hopf.omega,
                                  "hopf_direction": hopf.direction, "criticality": kind,
-                                 "bistable_low": low, "bistable_high": high})
+                                 "bistable_low": low, "bistable_high": high,
+                                 "bistable_open": int(open_end)})
