@@ -83,6 +83,18 @@ def test_continuation_in_a_slider_key_matches_independent_solves():
     assert br.parameter[-1] == pytest.approx(40.0, rel=1e-12)
     alone = periodic_orbit(LIGHT.replace({"slider.normal_damping": 40.0}), transient=2.0)
     assert alone.period == pytest.approx(br.period[-1], rel=1e-9)
+    # The stored point is the orbit's in every coordinate, those the contact holds (the
+    # slider's z, zdot) included: one period of a plain run returns to it.
+    from fivdisc.analysis.orbits import Shooting, energy_scales
+    from fivdisc.model import build_model
+
+    model = build_model(LIGHT.replace({"slider.normal_damping": 40.0}))
+    x = br.dataset["state"].values[-1]
+    shot = Shooting(model, br.dataset["phase"].values, 1e-12, 1e-19).shoot(
+        x, float(br.period[-1]), tangents=False)
+    scale = energy_scales(model)
+    size = np.linalg.norm(shot.rate_start / scale) * br.period[-1]
+    assert np.linalg.norm((shot.end - x) / scale) < 1e-7 * size
     ds = br.dataset
     assert np.all(ds["phi_dot_max"].values >= ds["phi_dot_min"].values)
     # A sticking slider moves with the disc: the largest angular velocity is the speed.

@@ -372,6 +372,11 @@ class _Branch:
         shot = shooting.shoot(x, period)
         jac = self.jacobian(shot, shooting, self.dgap_dp(x, period, p), phase)
         mult, trivial = self.shooting.stability(shot)
+        # The coordinates held by the contact (a slider's z, zdot) are the template's in
+        # x; the kernel sets them from the disc's deflection, and after one period they
+        # are those of this orbit: the point kept has them.
+        held = ~shot.free
+        x[held] = shot.end[held]
         return _Point(z, x, shot, jac, np.zeros_like(z), mult, trivial, residual, iterations)
 
     def finish(self, point: _Point, previous: np.ndarray | None, sign: float) -> _Point:
