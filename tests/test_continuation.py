@@ -186,6 +186,44 @@ def test_an_interrupted_continuation_keeps_its_branch(rigid_orbit, tmp_path, mon
     assert len(open_branch(out)) == 4
 
 
+def test_the_doubled_orbits_are_born_at_the_period_doubling():
+    """The damped-disc orbit at 2.59 rad/s, continued in the disc damping towards zero,
+    has a real multiplier pass -1 at about 3.59e-6. From that point the branch of
+    doubled orbits: each of its points closes after 2 T (the branch's residual) but not
+    after T, by a distance a that vanishes at the period doubling as a pitchfork's does
+    (a^2 proportional to the distance in the key, the same constant to 5 % over the
+    branch's first points), on one side of it only."""
+    from fivdisc import examples, load_case
+    from fivdisc.analysis.continuation import doubled_start
+    from fivdisc.analysis.orbits import Shooting, energy_scales
+    from fivdisc.model import build_model
+
+    case = load_case(examples.path("damped-disc")).replace({"speed.value": 2.5911321532805127})
+    start = periodic_orbit(case, transient=6.0)
+    primary = continue_orbit(case, "disc.damping_ratio", 2e-6, orbit=start, max_points=120)
+    (pd,) = [b for b in primary.bifurcations() if b["kind"] == "period doubling"]
+    at = case.replace({"disc.damping_ratio": pd["parameter"]})
+    phases = primary.dataset["phase"].values
+    orbit, along = doubled_start(at, pd["state"], pd["period"], phases)
+    doubled = continue_orbit(at, "disc.damping_ratio", 0.0, orbit=orbit, along=along,
+                             max_points=8)
+    assert len(doubled) == 8
+    assert np.all(doubled.period == pytest.approx(2 * pd["period"], rel=1e-6))
+    distance = pd["parameter"] - doubled.parameter
+    assert np.all(distance > 0)
+    ratios = []
+    for i in range(len(doubled)):
+        model = build_model(at.replace({"disc.damping_ratio": float(doubled.parameter[i])}))
+        scale = energy_scales(model)
+        x = doubled.dataset["state"].values[i]
+        half = Shooting(model, doubled.dataset["phase"].values, 1e-12, 1e-19, scale).shoot(
+            x, 0.5 * float(doubled.period[i]), tangents=False)
+        size = np.linalg.norm(half.rate_start / scale) * doubled.period[i]
+        gap = np.linalg.norm(((half.end - x) / scale)[half.free]) / size
+        ratios.append(gap**2 / distance[i])
+    assert np.ptp(ratios) < 0.05 * np.mean(ratios)
+
+
 def test_a_multiple_of_the_period_is_reduced_to_the_minimal_period():
     """Started with three times the closed-form period as its guess, Newton converges on
     the orbit traversed three times; it is reported at its minimal period, with the
