@@ -68,7 +68,7 @@ _MAX_NEWTON = 10
 # Relative step of the central difference d phi_T / dp.
 _DP = 1e-6
 # Relative accuracy in the parameter to which bifurcations are located.
-_LOCATE = 1e-6
+_LOCATE = 1e-7
 # A converged point is refined while its residual falls, to below this fraction of the
 # tolerance (_Branch.correct).
 _POLISH = 1e-2
