@@ -231,3 +231,16 @@ def test_a_run_of_one_sample_reads_back(tmp_path: Path, simulation: dict, kind: 
                     "shorter than its output interval, or one that failed at its start); read "
                     "it with fivdisc.open_result, or simulate longer or with a higher "
                     "simulation.output_rate")
+
+
+@pytest.mark.parametrize("command", [["plot"], ["continue", "--key", "speed.value", "--to",
+                                                "13", "--from"], ["orbit", "--from"]])
+def test_a_case_file_given_for_a_result_is_named_so(tmp_path, command):
+    """A case file (TOML) where a command reads a file fivdisc wrote: one line saying it
+    is not a netCDF file, not that a result is damaged."""
+    case = tmp_path / "case.toml"
+    case.write_text("[speed]\nvalue = 12.3\n")
+    result = CliRunner().invoke(cli, [*command, str(case)])
+    assert result.exit_code == 2, result.output
+    assert "is not a netCDF file" in result.output
+    assert "damaged" not in result.output

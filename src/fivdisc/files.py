@@ -311,6 +311,15 @@ def read_dataset(path: str | PathLike[str], option: str):
     import xarray as xr
 
     try:
+        with open(path, "rb") as f:
+            magic = f.read(4)
+    except OSError as exc:
+        raise FivdiscError(f"{option} {path}: cannot be read ({exc.strerror})") from None
+    # netCDF classic files start with "CDF", netCDF-4 files with HDF5's signature.
+    if not (magic[:3] == b"CDF" or magic == b"\x89HDF"):
+        raise FivdiscError(f"{option} {path}: is not a netCDF file: give one that fivdisc "
+                           "wrote with -o (a case file goes where a command takes CASE_FILE)")
+    try:
         check_netcdf(path)
         with xr.open_dataset(path) as ds:
             return ds.load()
