@@ -1,6 +1,7 @@
 """Time the checks of a sweep store (issue 28): fivdisc's against reading it through Zarr.
 
-Run ``python benchmarks/bench_store.py`` (about a minute) or with ``--empty N --full M``.
+Run ``python benchmarks/bench_store.py`` (about a minute) or with ``--empty N --full M
+--previous COMMIT``.
 Every point's check needs one chunk of each stored variable; Zarr reads a chunk (or
 finds it missing) at about half a millisecond, so checking a 300 x 300 store through it
 took over a minute, before the sweep's first point and on every resume and ``--verify``.
@@ -10,12 +11,20 @@ points, and their ratio:
 
 1. an empty N x N store (a sweep's start: nothing to read but the ``done`` listing);
 2. a full M x M store (every point written, a seventh of them failed);
-3. the empty 300 x 300 store of the fault probe, fivdisc's check alone.
+3. the empty 300 x 300 store of the fault probe, fivdisc's check alone;
+4. the full M x M store checked by the fivdisc of ``--previous`` (default ``278cbee``, the
+   check reading one chunk file per point through Python file objects and hashing point by
+   point), its source taken from this repository's history and run with this Python, and
+   the ratio of this check to it.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import subprocess
+import sys
+import tarfile
 import tempfile
 import time
 from pathlib import Path
@@ -25,6 +34,10 @@ from fivdisc.sweep import Sweep, SweepStore, store_lock, verify_store
 from fivdisc.sweep.store import PointOutcome, checksummed
 
 PER = 100_000  # points, the unit of the reported costs
+REPO = Path(__file__).resolve().parents[1]
+# The commit before the check read only the chunk files listed, each distinct content
+# decoded once, and hashed a column at a time.
+PREVIOUS = "278cbee"
 
 
 def _spec(n: int) -> Sweep:
@@ -61,6 +74,25 @@ def fivdisc_check(path: Path) -> float:
     return time.perf_counter() - start
 
 
+def previous_check(path: Path, commit: str, tmp: Path) -> float:
+    """Wall time [s] of :func:`verify_store` of the fivdisc at `commit` (its ``src`` from
+    ``git archive``, imported by this Python) on the store at `path`."""
+    source = tmp / f"src-{commit}"
+    with tempfile.TemporaryFile() as archive:
+        subprocess.run(["git", "archive", "--format=tar", commit, "src"], cwd=REPO, check=True,
+                       stdout=archive)
+        archive.seek(0)
+        with tarfile.open(fileobj=archive) as tar:
+            tar.extractall(source, filter="data")
+    code = ("import time; from fivdisc.sweep import verify_store; verify_store(PATH); "
+            "start = time.perf_counter(); verify_store(PATH); "
+            "print(time.perf_counter() - start)").replace("PATH", repr(str(path)))
+    env = {**os.environ, "PYTHONPATH": str(source / "src")}
+    done = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
+                          text=True, env=env)
+    return float(done.stdout.split()[-1])
+
+
 def compare(label: str, path: Path, spec: Sweep) -> None:
     ours, theirs = fivdisc_check(path), through_zarr(path, spec)
     scale = PER / spec.n_points
@@ -72,12 +104,20 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--empty", type=int, default=100, help="side of the empty store")
     parser.add_argument("--full", type=int, default=40, help="side of the full store")
+    parser.add_argument("--previous", default=PREVIOUS, help="commit of the earlier check")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         empty = Path(tmp) / "empty.zarr"
         compare("empty store", empty, make_store(empty, args.empty, full=False))
         full = Path(tmp) / "full.zarr"
-        compare("full store", full, make_store(full, args.full, full=True))
+        spec = make_store(full, args.full, full=True)
+        fivdisc_check(full)  # the file system's cache warm for both
+        compare("full store", full, spec)
+        ours, before = fivdisc_check(full), previous_check(full, args.previous, Path(tmp))
+        scale = PER / spec.n_points
+        print(f"full store ({spec.n_points} points): fivdisc {ours * scale:.3g} s, fivdisc at "
+              f"{args.previous} {before * scale:.3g} s per {PER:,} points; ratio "
+              f"{ours / before:.3g}")
         big = Path(tmp) / "big.zarr"
         make_store(big, 300, full=False)
         print(f"empty 300 x 300 store: fivdisc {fivdisc_check(big):.3g} s")
