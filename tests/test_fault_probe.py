@@ -274,6 +274,17 @@ def test_lyapunov_of_a_diverging_run_is_refused(tables, word, tmp_path: Path) ->
     assert wall < 60
 
 
+def test_orbit_of_a_diverging_run_is_refused(tmp_path: Path) -> None:
+    """`orbit` at 1e4 rad/s ran 119 s to print a residual of 1.4e75, later overflow
+    warnings around a "not converged": the transient diverges, and says so."""
+    path = tmp_path / "c.toml"
+    Case(speed={"value": 1e4}).save(path)
+    result, wall = cli_run(["orbit", str(path)])
+    assert result.exit_code == 2
+    assert "periodic_orbit: the transient run diverged" in one_line_error(result)
+    assert wall < 60
+
+
 def test_a_sweep_stores_no_exponent_for_a_diverging_point(tmp_path: Path) -> None:
     """The probe's sweep (printed gyroscopic sign, speeds 6 and 30 rad/s) stored 81.55 1/s
     at 30 rad/s, where the run diverges; with max_abs_w kept too the point failed."""
