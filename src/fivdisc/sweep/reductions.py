@@ -299,9 +299,9 @@ def stored(keep: Sequence[str]) -> tuple[str, ...]:
     """The reductions a sweep keeping `keep` stores, in order: each kept one followed by
     its companions (:data:`COMPANIONS`) that `keep` does not list itself."""
     names: list[str] = []
-    for spec in keep:
-        names += [name for name in (spec, *COMPANIONS.get(spec, ()))
-                  if name not in names and (name == spec or name not in keep)]
+    for spec in keep:  # a spec given twice stays twice: resolve refuses it, naming it
+        names += [spec, *(name for name in COMPANIONS.get(spec, ())
+                          if name not in keep and name not in names)]
     return tuple(names)
 
 # Modules the built-ins import when they run: checked up front so that a missing one
