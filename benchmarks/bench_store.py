@@ -12,22 +12,23 @@ points, and their ratio:
 1. an empty N x N store (a sweep's start: nothing to read but the ``done`` listing);
 2. a full M x M store (every point written, a seventh of them failed);
 3. the empty 300 x 300 store of the fault probe, fivdisc's check alone;
-4. the full M x M store checked by the fivdisc of ``--previous`` (default ``278cbee``, the
-   check reading one chunk file per point through Python file objects and hashing point by
-   point), its source taken from this repository's history and run with this Python, and
-   the ratio of this check to it.
+4. the full M x M store checked by this fivdisc and by the store module of ``--previous``
+   (default ``278cbee``: one chunk file per point and variable tried through Python file
+   objects, hashing point by point), taken from this repository's history and imported
+   beside it; checked in turns, three times each, the medians and their ratio.
 """
 
 from __future__ import annotations
 
 import argparse
-import os
+import statistics
 import subprocess
 import sys
-import tarfile
 import tempfile
 import time
 from pathlib import Path
+from types import ModuleType
+from typing import Any
 
 from fivdisc.case import Case
 from fivdisc.sweep import Sweep, SweepStore, store_lock, verify_store
@@ -74,23 +75,32 @@ def fivdisc_check(path: Path) -> float:
     return time.perf_counter() - start
 
 
-def previous_check(path: Path, commit: str, tmp: Path) -> float:
-    """Wall time [s] of :func:`verify_store` of the fivdisc at `commit` (its ``src`` from
-    ``git archive``, imported by this Python) on the store at `path`."""
-    source = tmp / f"src-{commit}"
-    with tempfile.TemporaryFile() as archive:
-        subprocess.run(["git", "archive", "--format=tar", commit, "src"], cwd=REPO, check=True,
-                       stdout=archive)
-        archive.seek(0)
-        with tarfile.open(fileobj=archive) as tar:
-            tar.extractall(source, filter="data")
-    code = ("import time; from fivdisc.sweep import verify_store; verify_store(PATH); "
-            "start = time.perf_counter(); verify_store(PATH); "
-            "print(time.perf_counter() - start)").replace("PATH", repr(str(path)))
-    env = {**os.environ, "PYTHONPATH": str(source / "src")}
-    done = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
-                          text=True, env=env)
-    return float(done.stdout.split()[-1])
+def previous_store_module(commit: str) -> ModuleType:
+    """``fivdisc.sweep.store`` as it was at `commit` (from this repository's history),
+    imported beside the current one (its imports resolve to the current fivdisc)."""
+    source = subprocess.run(["git", "show", f"{commit}:src/fivdisc/sweep/store.py"], cwd=REPO,
+                            check=True, capture_output=True, text=True).stdout
+    name = f"store_at_{commit}"
+    module = ModuleType(name)
+    sys.modules[name] = module  # dataclasses look their module up
+    exec(compile(source, f"{commit}:store.py", "exec"), module.__dict__)
+    return module
+
+
+def alternate(path: Path, previous: ModuleType, rounds: int = 3) -> tuple[float, float]:
+    """Median wall times [s] of this check and the previous one on the store at `path`,
+    run in turns (the file system's cache warm for both)."""
+    from fivdisc.sweep import store
+
+    times: dict[Any, list[float]] = {store: [], previous: []}
+    for module in times:
+        module.verify_store(path)
+    for _ in range(rounds):
+        for module, spent in times.items():
+            start = time.perf_counter()
+            module.verify_store(path)
+            spent.append(time.perf_counter() - start)
+    return statistics.median(times[store]), statistics.median(times[previous])
 
 
 def compare(label: str, path: Path, spec: Sweep) -> None:
@@ -111,9 +121,8 @@ def main() -> None:
         compare("empty store", empty, make_store(empty, args.empty, full=False))
         full = Path(tmp) / "full.zarr"
         spec = make_store(full, args.full, full=True)
-        fivdisc_check(full)  # the file system's cache warm for both
         compare("full store", full, spec)
-        ours, before = fivdisc_check(full), previous_check(full, args.previous, Path(tmp))
+        ours, before = alternate(full, previous_store_module(args.previous))
         scale = PER / spec.n_points
         print(f"full store ({spec.n_points} points): fivdisc {ours * scale:.3g} s, fivdisc at "
               f"{args.previous} {before * scale:.3g} s per {PER:,} points; ratio "
