@@ -35,18 +35,3 @@ def test_simulate_shows_simulated_time_on_a_terminal(monkeypatch):
     monkeypatch.setattr(sys, "stderr", err)
     simulate(Case(simulation={"duration": 0.02}), progress=True)
     assert "simulating" in err.getvalue() and "0.02/0.02 s" in err.getvalue()
-
-
-def test_orbit_shows_its_transient_on_a_terminal(monkeypatch):
-    # Issue 28: `orbit` on the two-pad case sat silent for minutes in its transient (at
-    # the shooting's tolerance); its simulated time now shows, like the Newton steps.
-    from fivdisc import periodic_orbit
-    from fivdisc.errors import FivdiscError
-
-    err = _Terminal()
-    monkeypatch.setattr(sys, "stderr", err)
-    try:
-        periodic_orbit(Case(), transient=0.05, progress=True, time_budget=1.0)
-    except FivdiscError:  # converged or not: the transient ran before either
-        pass
-    assert "transient" in err.getvalue() and "0.05/0.05 s" in err.getvalue()

@@ -408,24 +408,6 @@ def _probe(model: Model, x0: np.ndarray, phases: np.ndarray | None, window: floa
     return probe.out_y[: probe.n_samples, : model.state_size], 1.0 / rate
 
 
-# Pieces of the transient run, so that its progress shows (at the shooting's tolerance a
-# transient of a second of several sliders is minutes).
-_TRANSIENT_PIECES = 50
-
-
-def _transient(run: Integration, duration: float, progress: bool) -> None:
-    """Run the transient to `duration` [s], showing simulated time on a terminal."""
-    from fivdisc.progress import SIMULATED_TIME, progress_bar
-
-    with progress_bar(duration, "transient", "s", show=progress,
-                      bar_format=SIMULATED_TIME) as bar:
-        for piece in range(1, _TRANSIENT_PIECES + 1):
-            run.run_to(duration * piece / _TRANSIENT_PIECES)
-            bar.update(run.t - bar.n)
-            if run.status_name not in ("running", "success"):
-                return
-
-
 def _first_return(model: Model, samples: np.ndarray, dt: float) -> float:
     """Time of the first close return of the sampled trajectory to its first point: the
     earliest local minimum of the distance (energy norm) that is close."""
@@ -547,7 +529,7 @@ def periodic_orbit(
         duration = case.simulation.duration if transient is None else transient
         _positive("transient", duration, "s")
         run = Integration(model, y0, duration=duration, rtol=rtol, atol=atol_run)
-        _transient(run, duration, progress)
+        run.run_to(duration)
         if run.status_name != "success":
             raise FivdiscError(f"periodic_orbit: the transient run ended with "
                                f"{run.status_name} at t = {run.t:.9g} s")
