@@ -484,6 +484,9 @@ def test_command_runs_the_sweep_and_draws_the_diagram(diagram, sweep_file) -> No
     (bars,) = [c for c in bottom.collections if isinstance(c, LineCollection)]
     lengths = [float(np.ptp(segment[:, 1])) for segment in bars.get_segments()]
     np.testing.assert_allclose(lengths, 2 * stored["largest_lyapunov_uncertainty"].values)
+    # Each exponent is stored with whether it is conclusive, as fivdisc.lyapunov says
+    # (issue 28, item 3).
+    assert bool(stored["largest_lyapunov_inconclusive"].values[1]) == (not direct.conclusive[0])
     # a second run draws the complete store without computing anything
     again = CliRunner().invoke(cli, ["bifurcation", str(sweep_file), "-o", str(figure),
                                      "--store", str(store), "--section", "phi_dot_stick",
@@ -522,3 +525,22 @@ def test_diagram_needs_a_section(tmp_path) -> None:
     result = CliRunner().invoke(cli, ["bifurcation", str(path)])
     assert result.exit_code == 2
     assert "needs a section: add a [[reduce.section]] table" in result.output
+
+
+def test_inconclusive_exponents_are_ringed_in_the_diagram(diagram) -> None:
+    # Issue 28, item 3: a reader of the diagram sees which exponents are not usable.
+    from fivdisc.sweep import plot_bifurcation
+
+    data = open_sweep(diagram[0])
+    flags = np.array([True, False, True])
+    data["largest_lyapunov_inconclusive"] = data["largest_lyapunov_inconclusive"].copy(
+        data=flags)
+    bottom = plot_bifurcation(data).axes[1]
+    (ringed,) = [line for line in bottom.lines if line.get_label().startswith("inconclusive")]
+    xs, ys = ringed.get_data()
+    np.testing.assert_array_equal(xs, data["speed.value"].values[flags])
+    np.testing.assert_array_equal(ys, data["largest_lyapunov"].values[flags])
+    assert bottom.get_legend() is not None
+    data["largest_lyapunov_inconclusive"][:] = False
+    bottom = plot_bifurcation(data).axes[1]
+    assert not any(line.get_label().startswith("inconclusive") for line in bottom.lines)

@@ -274,6 +274,61 @@ def test_lyapunov_of_a_diverging_run_is_refused(tables, word, tmp_path: Path) ->
     assert wall < 60
 
 
+def test_orbit_of_a_diverging_run_is_refused(tmp_path: Path) -> None:
+    """`orbit` at 1e4 rad/s ran 119 s to print a residual of 1.4e75, later overflow
+    warnings around a "not converged": the transient diverges, and says so."""
+    path = tmp_path / "c.toml"
+    Case(speed={"value": 1e4}).save(path)
+    result, wall = cli_run(["orbit", str(path)])
+    assert result.exit_code == 2
+    assert "periodic_orbit: the transient run diverged" in one_line_error(result)
+    assert wall < 60
+
+
+def test_a_sweep_stores_no_exponent_for_a_diverging_point(tmp_path: Path) -> None:
+    """The probe's sweep (printed gyroscopic sign, speeds 6 and 30 rad/s) stored 81.55 1/s
+    at 30 rad/s, where the run diverges; with max_abs_w kept too the point failed."""
+    from fivdisc.sweep import Sweep, open_sweep, run_sweep
+
+    base = Case(simulation={"printed_gyroscopic_sign": True, "duration": 1.0})
+    assert simulate(base.replace({"speed.value": 30.0})).status == "diverged"
+    for keep in (["largest_lyapunov"], ["largest_lyapunov", "max_abs_w"]):
+        store = tmp_path / f"{len(keep)}.zarr"
+        start = time.perf_counter()
+        report = run_sweep(Sweep(base=base, axes={"speed.value": [6.0, 30.0]}, keep=keep),
+                           store, workers=1, progress=False)
+        assert time.perf_counter() - start < 120
+        assert list(report.failed) == [1]
+        assert "diverged" in report.failed[1]
+        data = open_sweep(store)
+        assert np.isnan(data["largest_lyapunov"].values[1])
+        assert np.isfinite(data["largest_lyapunov"].values[0])
+
+
+def test_a_sweep_marks_an_inconclusive_exponent(tmp_path: Path) -> None:
+    """Issue 28, item 3: a stored largest_lyapunov comes with whether it is usable, as
+    fivdisc.lyapunov decides it. The 0.01 s run has one re-orthonormalisation, no spread,
+    so no uncertainty: inconclusive by construction."""
+    from fivdisc import lyapunov
+    from fivdisc.sweep import Sweep, open_sweep, run_sweep
+
+    spec = Sweep(base=Case(), axes={"simulation.duration": [0.01, 0.3]},
+                 keep=["largest_lyapunov"], lyapunov={"transient": 0.0, "interval": 0.01})
+    store = tmp_path / "l.zarr"
+    run_sweep(spec, store, workers=1, progress=False)
+    data = open_sweep(store)
+    flags = data["largest_lyapunov_inconclusive"]
+    assert flags.dtype == bool and "inconclusive" in flags.attrs["long_name"]
+    direct = [lyapunov(case, n=1, transient=0.0, duration=case.simulation.duration,
+                       interval=0.01) for case in spec.cases]
+    assert flags.values.tolist() == [not d.conclusive[0] for d in direct]
+    assert flags.values[0]
+    np.testing.assert_array_equal(data["largest_lyapunov"].values, [d.largest for d in direct])
+    # Readers filter with it.
+    usable = data["largest_lyapunov"].where(~flags)
+    assert np.isnan(usable.values[0])
+
+
 def test_an_inconclusive_exponent_is_marked_and_fails_the_command() -> None:
     """One re-orthonormalisation gives no spread, so no uncertainty: inconclusive in
     text, JSON and the exit status."""

@@ -23,7 +23,7 @@ from click.testing import CliRunner
 
 from fivdisc import Case, open_result, simulate
 from fivdisc.cli import cli
-from fivdisc.errors import FivdiscError
+from fivdisc.errors import AnalysisError, FivdiscError
 from fivdisc.files import CHECKSUM, check_netcdf
 
 SHORT = Case(simulation={"duration": 0.01, "output_rate": 1000.0})
@@ -213,24 +213,46 @@ def test_a_full_disk_keeps_the_run_in_the_temporary_directory(tmp_path: Path, mo
 # --- a run of one sample ---------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("simulation", [
+ONE_SAMPLE = [
     {"duration": 1e-5},  # shorter than the output interval
     {"duration": 0.01, "output_rate": 10.0},  # one output interval longer than the run
-], ids=["duration 1e-5", "output interval past the end"])
-@pytest.mark.parametrize("kind", ["timeseries", "spectrum"])
-def test_a_run_of_one_sample_reads_back(tmp_path: Path, simulation: dict, kind: str) -> None:
+]
+
+
+@pytest.mark.parametrize("simulation", ONE_SAMPLE,
+                         ids=["duration 1e-5", "output interval past the end"])
+@pytest.mark.parametrize("kind", ["timeseries", "phase", "friction", "normal-force"])
+def test_a_run_of_one_sample_reads_back_and_is_drawn(tmp_path: Path, simulation: dict,
+                                                     kind: str) -> None:
     run = simulate(Case(simulation=simulation))
     assert run.dataset.sizes["time"] == 1
     path = tmp_path / "one.nc"
     run.to_netcdf(path)
     assert open_result(path) == run
     assert open_result(path).summary().end_time == simulation["duration"]
-    # plot reads it as the run it is, and says in one line why it draws nothing.
+    # Every file fivdisc writes reads back, and plot draws what there is: one sample, a
+    # marker (a line through one point would draw nothing).
+    figure = tmp_path / "one.png"
+    done = CliRunner().invoke(cli, ["plot", str(path), "--kind", kind, "-o", str(figure)])
+    assert done.exit_code == 0, done.output
+    assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    (line,) = run.plot(kind).axes[0].lines
+    assert line.get_marker() == "o" and len(line.get_xdata()) == 1
+
+
+@pytest.mark.parametrize("kind", ["spectrum", "spectrogram"])
+def test_a_spectrum_of_one_sample_is_refused_saying_why(tmp_path: Path, kind: str) -> None:
+    path = tmp_path / "one.nc"
+    simulate(Case(simulation=ONE_SAMPLE[0])).to_netcdf(path)
     line = _one_line(["plot", str(path), "--kind", kind, "-o", str(tmp_path / "one.png")])
     assert line == (f"error: --kind {kind} needs at least 2 samples: {path} holds one (a run "
-                    "shorter than its output interval, or one that failed at its start); read "
-                    "it with fivdisc.open_result, or simulate longer or with a higher "
-                    "simulation.output_rate")
+                    "shorter than its output interval, or one that failed at its start), which "
+                    "has no frequencies; draw it with --kind timeseries, or simulate longer or "
+                    "with a higher simulation.output_rate")
+    with pytest.raises(AnalysisError, match="holds 1 sample"):
+        open_result(path).plot(kind)
+    line = _one_line(["plot", str(path), "--window", "0:1", "-o", str(tmp_path / "one.png")])
+    assert line == f"error: --window is not used for {path}: it holds one sample, drawn whole"
 
 
 @pytest.mark.parametrize("command", [["plot"], ["continue", "--key", "speed.value", "--to",

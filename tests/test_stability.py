@@ -209,6 +209,15 @@ def test_stability_command_branches_and_boundary(tmp_path):
     (["--boundary", "decay=0:1", "normal_damping=1"], "write KEY=START:STOP"),
     (["--x", "decay=0:1:5", "--y", "decay=0:2:3"], "varies the same key"),
     (["--y", "decay=0:1:5"], "--y needs --x"),
+    # Issue 28, item 4: a degenerate axis (START == STOP, or a value twice), also of
+    # --y and --curves, and the option and value named.
+    (["--x", "speed.value=0:0:5", "--y", "decay=0:1:2"],
+     "--x = 'speed.value=0:0:5' is invalid: its values must be distinct"),
+    (["--x", "decay=0:1:2", "--y", "speed.value=2,3,2"],
+     "--y = 'speed.value=2,3,2' is invalid: its values must be distinct"),
+    (["--x", "decay=0:1:2", "--y", "speed.value=1:2:2", "--curves", "slider.mass=0.1,0.1"],
+     "--curves = 'slider.mass=0.1,0.1' is invalid: its values must be distinct"),
+    (["--x", "decay=0:1:2", "--y", "speed.value=0,-0.0"], "its values must be distinct"),
 ])
 def test_stability_command_refuses_bad_scans(args, message):
     out = CliRunner().invoke(cli, ["stability", "fig03a", *args, "--no-progress"])
@@ -221,6 +230,44 @@ def test_stability_command_refuses_a_case_without_sliding_equilibrium():
                                    "--no-progress"])
     assert out.exit_code == 2 and "no sliding equilibrium" in out.output
     assert len(out.output.strip().splitlines()) == 1
+
+
+def test_a_map_without_any_sliding_equilibrium_says_so(tmp_path):
+    """Issue 28, item 4: a map whose every point is NaN (no preload: no sliding
+    equilibrium anywhere) was reported "stable at 0.0 % of the grid"."""
+    case = tmp_path / "p0.toml"
+    Case(slider={"preload": 0.0}).save(case)
+    target = tmp_path / "map.nc"
+    out = CliRunner().invoke(cli, ["stability", str(case), "--x", "speed.value=1:2:3",
+                                   "--y", "slider.mass=0.1:0.2:2", "-o", str(target),
+                                   "--no-progress"])
+    assert out.exit_code == 2, out.output
+    assert out.stderr.startswith("error: stability map: no point of the grid (--x "
+                                 "speed.value, --y slider.mass) has a sliding equilibrium")
+    assert len(out.output.strip().splitlines()) == 1 and "stable at" not in out.output
+    assert not target.exists()
+
+
+def test_a_map_counts_stability_among_the_points_with_an_equilibrium(tmp_path):
+    # One curve of the map without any equilibrium (zero preload), one with half of it
+    # (none at zero speed): the percentages count only the points with an equilibrium.
+    import xarray as xr
+
+    target = tmp_path / "map.nc"
+    out = CliRunner().invoke(cli, ["stability", "--x", "speed.value=0:2:3",
+                                   "--y", "slider.mass=0.1:0.2:2",
+                                   "--curves", "slider.preload=0,1", "-o", str(target),
+                                   "--no-progress"])
+    assert out.exit_code == 0, out.output
+    lines = out.stdout.splitlines()
+    assert lines[1] == ("slider.preload = 0: no sliding equilibrium at any point of the grid "
+                        "(no stability to map)")
+    growth = xr.open_dataset(target)["max_growth_rate"].sel({"slider.preload": 1.0}).values
+    known = np.isfinite(growth)
+    assert known.sum() == 4 and not known[:, 0].any()  # none at zero speed
+    share = (growth[known] < 0).mean()
+    assert lines[2].startswith(f"slider.preload = 1: stable at {share:.1%} of the 4 grid "
+                               "points with a sliding equilibrium (2 of 6 have none)")
 
 
 def test_plot_command_draws_saved_branches_and_boundaries(tmp_path):

@@ -290,3 +290,68 @@ def test_the_verify_command_in_a_fresh_process_is_bounded(store: Path) -> None:
                           capture_output=True, text=True, timeout=BOUND)
     assert done.returncode == 0 and time.perf_counter() - start < BOUND
     assert f"{N} points: {N} complete and verified (1 of them failed runs)" in done.stdout
+
+
+def test_checking_a_full_store_opens_each_chunk_file_there_is_once(store: Path,
+                                                                    monkeypatch) -> None:
+    # A chunk equal to the fill value is never written (here: separated = False, the empty
+    # errors); trying every point's file anyway cost a failed open each, and a full
+    # store's check is as many file operations as there are chunk files (its cost, against
+    # the former check, is measured in benchmarks/bench_store.py). Both ways of opening a
+    # file are watched, so that a check opening files through Python's `open` counts too.
+    import builtins
+
+    existing = {str(f) for f in store.rglob("*") if f.is_file() and "/c/" in str(f)}
+    opened: list[str] = []
+
+    def watch(real):
+        def opening(file, *args, **kwargs):
+            if "/c/" in str(file):
+                opened.append(str(Path(file)))
+            return real(file, *args, **kwargs)
+        return opening
+
+    monkeypatch.setattr(os, "open", watch(os.open))
+    monkeypatch.setattr(builtins, "open", watch(builtins.open))
+    health = verify_store(store)
+    monkeypatch.undo()
+    assert health.healthy and health.complete.all()
+    data_files = {f for f in existing if Path(f).relative_to(store).parts[0]
+                  not in SPEC.axes}  # coordinates are read through Zarr, whole
+    assert sorted(opened) == sorted(data_files)
+
+
+def _checksum_of(digest: str, index: int, row: list) -> int:
+    """The checksum of one point as its definition states it (one value at a time)."""
+    import hashlib
+    import math
+    import struct
+
+    h = hashlib.blake2b(f"{digest}:{index}".encode(), digest_size=8)
+    for value in row:
+        if isinstance(value, np.ndarray):  # a section's values: one NaN for every NaN
+            token = np.where(np.isnan(value), np.nan, value).astype("<f8").tobytes()
+        elif isinstance(value, bool | np.bool_):
+            token = b"T" if value else b"F"
+        elif isinstance(value, float | np.floating):
+            token = b"nan" if math.isnan(value) else struct.pack("<d", float(value))
+        else:
+            token = str(value).encode()
+        h.update(len(token).to_bytes(4, "little") + token)
+    return int.from_bytes(h.digest(), "little") or 1
+
+
+def test_checksums_a_column_at_a_time_are_the_point_by_point_definition() -> None:
+    # Stores written before the checksum was computed a column at a time verify unchanged.
+    from fivdisc.sweep.store import _STRING, _checksums
+
+    rng = np.random.default_rng(28)
+    n = 40
+    floats = np.where(rng.random(n) < 0.3, np.nan, rng.normal(size=n))
+    floats[:2] = [-0.0, np.float64("-nan")]
+    section = np.where(rng.random((n, 3)) < 0.3, np.nan, rng.normal(size=(n, 3)))
+    columns = [rng.random(n) < 0.5, floats, section, rng.integers(0, 4, n).astype(np.int32),
+               np.array(["", "RuntimeError: boom é"] * (n // 2), dtype=_STRING)]
+    indices = list(range(7, 7 + n))
+    expected = [_checksum_of("d1g", i, [c[k] for c in columns]) for k, i in enumerate(indices)]
+    assert _checksums("d1g", indices, columns).tolist() == expected

@@ -386,6 +386,21 @@ def test_analysis_reductions() -> None:
     assert values["dominant_frequency"] > 0 and math.isfinite(values["max_growth_rate"])
 
 
+def test_largest_lyapunov_is_stored_with_its_inconclusive_mark() -> None:
+    # Issue 28, item 3: no reader sees the exponent without whether it is usable; kept
+    # once, whatever the order, and a reduction kept twice is still refused.
+    def names(keep):
+        return [r.name for r in resolve(keep)]
+
+    assert names(["largest_lyapunov", "separated"]) == [
+        "largest_lyapunov", "largest_lyapunov_inconclusive", "separated"]
+    assert names(["largest_lyapunov_inconclusive", "largest_lyapunov"]) == [
+        "largest_lyapunov_inconclusive", "largest_lyapunov"]
+    assert BUILTIN["largest_lyapunov_inconclusive"].dtype == "bool"
+    with pytest.raises(SweepError, match="would both be stored as 'largest_lyapunov'"):
+        resolve(["largest_lyapunov", "largest_lyapunov"])
+
+
 def test_max_growth_rate_needs_constant_speed() -> None:
     with pytest.raises(SweepError, match="'max_growth_rate' needs a constant disc speed"):
         Sweep(base=_short(), axes={"speed.initial": [1.0]}, keep=["max_growth_rate"])

@@ -132,6 +132,12 @@ def _engineering(da: xr.DataArray) -> tuple[float, str]:
     return 10.0 ** -power, _PREFIXES[power]
 
 
+def _lone(data: xr.DataArray | xr.Dataset) -> dict[str, str]:
+    """Line options that show a record of one sample (a line through one point draws
+    nothing): a marker."""
+    return {"marker": "o"} if data.sizes.get("time") == 1 else {}
+
+
 def _bounds(window: Window) -> tuple[float | None, float | None]:
     if window is None:
         return None, None
@@ -212,8 +218,11 @@ def _fill_phrases(line: str, chars: int) -> str:
 
 
 def _nyquist(ds: xr.Dataset) -> float:
-    """Half the sampling rate of a result [Hz]."""
+    """Half the sampling rate of a result [Hz]; AnalysisError for a record of one sample."""
     time = ds["time"].values
+    if time.size < 2:
+        raise AnalysisError(f"the result holds {time.size} sample(s): frequencies need at "
+                            "least 2 (a run shorter than its output interval?)")
     return 0.5 * (time.size - 1) / (time[-1] - time[0])
 
 
@@ -311,14 +320,14 @@ def plot_timeseries(data: xr.Dataset | object, var: str, probe: int | None = Non
     da = series(ds, var, probe, *_bounds(window))
     fig, ax = _axes(ax)
     if "flag_values" in da.attrs:
-        ax.step(da["time"].values, da.values, where="post")
+        ax.step(da["time"].values, da.values, where="post", **_lone(da))
         values = np.atleast_1d(da.attrs["flag_values"]).tolist()
         meanings = str(da.attrs.get("flag_meanings", "")).split()
         ax.set_yticks(values, meanings if len(meanings) == len(values) else None)
         ax.set_ylabel(_label(da, var))
     else:
         factor, prefix = _engineering(da)
-        ax.plot(da["time"].values, da.values * factor, lw=0.8)
+        ax.plot(da["time"].values, da.values * factor, lw=0.8, **_lone(da))
         ax.set_ylabel(_label(da, var, prefix))
     ax.set_xlabel(_label(da["time"], "time"))
     _title(ax, ds, str(da.attrs.get("long_name", var)), _where(da))
@@ -507,7 +516,7 @@ def _trajectory(ds: xr.Dataset, x: str, y: str, what: str, ax: Axes | None) -> F
     """One variable of ``ds`` against another, labelled with names and units."""
     fig, ax = _axes(ax)
     (fx, px), (fy, py) = _engineering(ds[x]), _engineering(ds[y])
-    ax.plot(ds[x].values * fx, ds[y].values * fy, lw=0.8)
+    ax.plot(ds[x].values * fx, ds[y].values * fy, lw=0.8, **_lone(ds))
     ax.set_xlabel(_label(ds[x], x, px))
     ax.set_ylabel(_label(ds[y], y, py))
     time = ds["time"].values
@@ -534,7 +543,7 @@ def plot_normal_force(data: xr.Dataset | object, window: Window = None,
     ds = time_window(select_slider(as_dataset(data), slider), *_bounds(window))
     force = ds["normal_force"]
     fig, ax = _axes(ax)
-    ax.plot(ds["time"].values, force.values, lw=0.8)
+    ax.plot(ds["time"].values, force.values, lw=0.8, **_lone(ds))
     for i, (start, end) in enumerate(separation_intervals(ds)):
         ax.axvspan(start, end, color="C1", alpha=0.3, lw=0,
                    label="separation" if i == 0 else None)

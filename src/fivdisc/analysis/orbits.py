@@ -554,8 +554,18 @@ def periodic_orbit(
         if run.status_name != "success":
             raise FivdiscError(f"periodic_orbit: the transient run ended with "
                                f"{run.status_name} at t = {run.t:.9g} s")
+        from fivdisc.simulate import Deflection
+
+        # A run that left the model's range (fivdisc.simulate calls it diverged) has no
+        # orbit to find: its samples would overflow the search.
+        limit = Deflection(model)
+        if limit.beyond(run.state):
+            raise FivdiscError(f"periodic_orbit: the transient run {limit.message(run.t)}")
         phases = run.ph.copy()
         samples, dt = _probe(model, run.state, phases, window, rtol, atol_run)
+        if limit.beyond(samples[-1]):
+            raise FivdiscError(f"periodic_orbit: the run after the transient "
+                               f"{limit.message(duration + window)}")
         x0 = samples[0].copy()
         start = start or (f"after a {duration:g} s transient from the case's initial state "
                           f"({case.simulation.initial_state})")

@@ -76,11 +76,17 @@ def time_window(data: xr.Dataset | object, t0: float | None = None,
     Raises
     ------
     AnalysisError
-        If the window is empty, reversed or outside the data's time span.
+        If the window is empty, reversed or outside the data's time span, or a window is
+        asked of a record of one sample (returned whole without one).
     """
     ds = as_dataset(data)
-    if "time" not in ds.coords or ds.sizes["time"] < 2:
-        raise AnalysisError("data has no time coordinate with at least 2 samples")
+    if "time" not in ds.coords or ds.sizes["time"] < 1:
+        raise AnalysisError("data has no time coordinate with samples")
+    if ds.sizes["time"] == 1:  # a run of one sample: itself, but no window within it
+        if t0 is None and t1 is None:
+            return ds
+        raise AnalysisError(f"t0, t1 select within a record of one sample (t = "
+                            f"{float(ds['time'].values[0]):g} s): leave them out")
     time = ds["time"].values
     lo, hi = float(time[0]), float(time[-1])
     # Half a sample of slack so that windows typed from printed times are not refused.
@@ -278,6 +284,9 @@ def _finite(name: str, value: Any) -> float:
 def _samples(da: xr.DataArray) -> tuple[np.ndarray, float]:
     """Values and sampling rate [Hz] of a uniformly sampled, finite time series."""
     time = da["time"].values
+    if time.size < 2:
+        raise AnalysisError(f"var = {da.name!r} holds {time.size} sample(s): frequencies need "
+                            "at least 2 (a run shorter than its output interval?)")
     step = np.diff(time)
     mean = (time[-1] - time[0]) / (time.size - 1)
     if np.max(np.abs(step - mean)) > 1e-6 * mean:

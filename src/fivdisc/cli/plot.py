@@ -172,14 +172,19 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
         if fmax is not None and kind not in ("spectrogram", "spectrum"):
             raise FivdiscError(f"--fmax is not used by --kind {kind}: only by spectrogram and "
                                "spectrum")
-        if one.sizes["time"] < 2:  # read back (open_result), but nothing to draw
-            raise FivdiscError(
-                f"--kind {kind} needs at least 2 samples: {result} holds one (a run shorter "
-                "than its output interval, or one that failed at its start); read it with "
-                "fivdisc.open_result, or simulate longer or with a higher "
-                "simulation.output_rate")
-        plots.check_fmax(fmax, 0.5 * (one.sizes["time"] - 1)
-                         / float(one["time"].values[-1] - one["time"].values[0]), "--fmax")
+        if one.sizes["time"] < 2:  # drawn as a marker; a spectrum needs more
+            if kind in ("spectrogram", "spectrum"):
+                raise FivdiscError(
+                    f"--kind {kind} needs at least 2 samples: {result} holds one (a run "
+                    "shorter than its output interval, or one that failed at its start), "
+                    "which has no frequencies; draw it with --kind timeseries, or simulate "
+                    "longer or with a higher simulation.output_rate")
+            if window_text is not None:
+                raise FivdiscError(f"--window is not used for {result}: it holds one sample, "
+                                   "drawn whole")
+        else:
+            plots.check_fmax(fmax, 0.5 * (one.sizes["time"] - 1)
+                             / float(one["time"].values[-1] - one["time"].values[0]), "--fmax")
         if segment is not None and kind != "spectrogram":
             raise FivdiscError(f"--segment is not used by --kind {kind}: only by spectrogram")
         name = _check(one, kind, var, probe)

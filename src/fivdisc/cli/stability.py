@@ -200,6 +200,12 @@ def _map(case, case_file, x_spec, y_spec, curve_spec, output, progress) -> None:
                                "give each axis its own key")
         varied[key] = option
     ds = stability_map(case, axes["--x"], axes["--y"], axes.get("--curves"), progress=progress)
+    if not np.isfinite(ds["max_growth_rate"].values).any():
+        # A map of NaN would read as "stable at 0 %": nothing is written.
+        keys = ", ".join(f"{option} {key}" for option, (key, _) in axes.items())
+        raise FivdiscError(f"stability map: no point of the grid ({keys}) has a sliding "
+                           "equilibrium, so there is no stability to map; check the case "
+                           "(e.g. slider.preload > 0) and the axes' ranges")
     if case_file is not None:
         ds.attrs["case_name"] = case_file.stem
     if figure:
@@ -212,11 +218,21 @@ def _map(case, case_file, x_spec, y_spec, curve_spec, output, progress) -> None:
     for value in ds[ckey].values if ckey else [None]:
         one = ds if value is None else ds.sel({ckey: value})
         growth = one["max_growth_rate"].values
-        stable = one["stable"].values.astype(bool)
         label = "" if value is None else f"{ckey} = {value:g}: "
+        known = np.isfinite(growth)
+        if not known.any():
+            click.echo(f"{label}no sliding equilibrium at any point of the grid (no stability "
+                       "to map)")
+            continue
+        stable = one["stable"].values.astype(bool)[known]
+        share = f"stable at {stable.mean():.1%} of the grid"
+        if not known.all():
+            share = (f"stable at {stable.mean():.1%} of the {known.sum()} grid points with a "
+                     f"sliding equilibrium ({growth.size - known.sum()} of {growth.size} "
+                     "have none)")
         signs = np.sign(growth)
         crossed = (np.any(signs[:, 1:] * signs[:, :-1] < 0, axis=1).sum()
                    + np.any(signs[1:, :] * signs[:-1, :] < 0, axis=0).sum())
         where = (f"the boundary crosses {crossed} of {sum(growth.shape)} grid lines"
                  if crossed else "no stability boundary in the grid")
-        click.echo(f"{label}stable at {stable.mean():.1%} of the grid; {where}")
+        click.echo(f"{label}{share}; {where}")

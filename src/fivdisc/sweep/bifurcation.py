@@ -5,7 +5,9 @@ its value of the swept key (small ones where the points are many, visible ones w
 are few); where the sweep keeps ``largest_lyapunov``, a second panel below, sharing the
 axis, draws the exponent with a line at zero, and its standard error as error bars where
 the sweep keeps ``largest_lyapunov_uncertainty`` too: a finite-time exponent whose bar
-reaches across zero does not tell chaos from a regular motion.
+reaches across zero does not tell chaos from a regular motion. Exponents stored as
+inconclusive (``largest_lyapunov_inconclusive``: uncertainty unknown or larger than the
+exponent) are ringed and named in a legend.
 """
 
 from __future__ import annotations
@@ -87,7 +89,8 @@ def plot_bifurcation(
 
     The values of a section at every computed point are small dots over the swept key;
     failed points are marked along the bottom of the panel, points not yet computed are
-    left out. If the sweep keeps ``largest_lyapunov``, a second panel shows it.
+    left out. If the sweep keeps ``largest_lyapunov``, a second panel shows it, the
+    inconclusive values ringed.
 
     Parameters
     ----------
@@ -168,6 +171,12 @@ def plot_bifurcation(
                  if "largest_lyapunov_uncertainty" in data else None)
         bottom.errorbar(x[ok], exponent[ok], yerr=error, fmt=".-", color="tab:blue", ms=3,
                         lw=0.8, elinewidth=0.6, ecolor="tab:blue", capsize=0)
+        if "largest_lyapunov_inconclusive" in data:
+            marked = ok & np.ravel(data["largest_lyapunov_inconclusive"].values).astype(bool)
+            if marked.any():
+                bottom.plot(x[marked], exponent[marked], "o", mfc="none", mec="tab:orange",
+                            ms=7, label="inconclusive (uncertainty unknown or above |value|)")
+                bottom.legend(loc="best", fontsize="small")
         bottom.set_ylabel("largest Lyapunov\n" r"exponent $\lambda_1$ [1/s]")
     bottom.set_xlabel(axis_label(data[key]))
     fig.align_ylabels()

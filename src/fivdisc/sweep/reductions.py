@@ -4,6 +4,10 @@ Built-in reductions are named (see :data:`BUILTIN`); user reductions are named b
 import path, ``"package.module:function"``, and are called with the run's
 :class:`~fivdisc.result.Result`, returning a real number (stored as float64).
 
+A reduction whose value may not be usable brings its mark along: keeping
+``largest_lyapunov`` stores ``largest_lyapunov_inconclusive`` too (see :data:`COMPANIONS`
+and :func:`stored`).
+
 A reduction that is final once some event has happened (``separated`` after the
 first separation) lets the run stop there; see :func:`stop_events`. Sections
 (:class:`fivdisc.sweep.sections.Section`) keep many values per run and need it whole.
@@ -28,6 +32,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BUILTIN",
+    "COMPANIONS",
     "LYAPUNOV_REDUCTIONS",
     "LyapunovSettings",
     "Reduction",
@@ -36,6 +41,7 @@ __all__ = [
     "evaluate",
     "resolve",
     "stop_events",
+    "stored",
 ]
 
 
@@ -178,6 +184,11 @@ def _largest_lyapunov_uncertainty(result: Result | None, case: Case,
     return float(_lyapunov_run(case, settings or LyapunovSettings()).uncertainty[0])
 
 
+def _largest_lyapunov_inconclusive(result: Result | None, case: Case,
+                                   settings: LyapunovSettings | None = None) -> bool:
+    return not _lyapunov_run(case, settings or LyapunovSettings()).conclusive[0]
+
+
 def _builtin(
     name: str,
     func: Callable[[Result | None, Case], Any],
@@ -261,11 +272,37 @@ BUILTIN: dict[str, Reduction] = {
             "blocks of the measurement (the same run)",
             needs_run=False,
         ),
+        _builtin(
+            "largest_lyapunov_inconclusive",
+            _largest_lyapunov_inconclusive,
+            "1",
+            "largest_lyapunov is inconclusive: its uncertainty is unknown or larger than "
+            "its magnitude (even its sign is not known)",
+            dtype="bool",
+            needs_run=False,
+        ),
     )
 }
 
 #: The reductions that read the Lyapunov run, set by ``[reduce.largest_lyapunov]``.
-LYAPUNOV_REDUCTIONS = ("largest_lyapunov", "largest_lyapunov_uncertainty")
+LYAPUNOV_REDUCTIONS = ("largest_lyapunov", "largest_lyapunov_uncertainty",
+                       "largest_lyapunov_inconclusive")
+
+#: Built-in reductions stored whenever another is kept: the mark that says whether its
+#: value can be used, so that no reader sees the value without it.
+COMPANIONS: dict[str, tuple[str, ...]] = {
+    "largest_lyapunov": ("largest_lyapunov_inconclusive",),
+}
+
+
+def stored(keep: Sequence[str]) -> tuple[str, ...]:
+    """The reductions a sweep keeping `keep` stores, in order: each kept one followed by
+    its companions (:data:`COMPANIONS`) that `keep` does not list itself."""
+    names: list[str] = []
+    for spec in keep:  # a spec given twice stays twice: resolve refuses it, naming it
+        names += [spec, *(name for name in COMPANIONS.get(spec, ())
+                          if name not in keep and name not in names)]
+    return tuple(names)
 
 # Modules the built-ins import when they run: checked up front so that a missing one
 # stops the sweep before it starts rather than failing every point.
@@ -274,6 +311,7 @@ _NEEDS_MODULE = {
     "max_growth_rate": "fivdisc.analysis.stability",
     "largest_lyapunov": "fivdisc.analysis.lyapunov",
     "largest_lyapunov_uncertainty": "fivdisc.analysis.lyapunov",
+    "largest_lyapunov_inconclusive": "fivdisc.analysis.lyapunov",
 }
 
 
@@ -312,7 +350,7 @@ def _user(spec: str) -> Reduction:
 @cache
 def _resolve(keep: tuple[str, ...], lyapunov: LyapunovSettings | None) -> tuple[Reduction, ...]:
     reductions = []
-    for spec in keep:
+    for spec in stored(keep):
         if ":" in spec:
             reductions.append(_user(spec))
             continue
@@ -346,7 +384,8 @@ def _resolve(keep: tuple[str, ...], lyapunov: LyapunovSettings | None) -> tuple[
 
 def resolve(keep: Sequence[str], lyapunov: LyapunovSettings | None = None
             ) -> tuple[Reduction, ...]:
-    """The reductions named in `keep`, checked (user functions are imported).
+    """The reductions named in `keep` and their companions (see :func:`stored`), checked
+    (user functions are imported).
 
     Parameters
     ----------

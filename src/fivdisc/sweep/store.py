@@ -9,7 +9,9 @@ Layout (one Zarr v3 group, written through xarray, with consolidated metadata so
     coords      <axis key>                     the axis values, with units and long_name
                                                (JSON text if the values are not numbers,
                                                booleans or text); along point for a zip sweep
-    data vars   <reduction name>               one per kept reduction (bool or float64)
+    data vars   <reduction name>               one per kept reduction (bool or float64),
+                                               and its companions (largest_lyapunov's
+                                               largest_lyapunov_inconclusive)
                 <section name>                 one per section: (<dims>..., <name>_index)
                                                float64, one point's values NaN padded to
                                                the section's max_points
@@ -60,7 +62,6 @@ import math
 import os
 import shutil
 import socket
-import struct
 import sys
 import warnings
 from collections.abc import Callable, Iterator, Sequence
@@ -76,8 +77,8 @@ import xarray as xr
 
 from fivdisc.errors import SweepError
 from fivdisc.files import write_atomic
-from fivdisc.sweep.reductions import BUILTIN
-from fivdisc.sweep.spec import Sweep, strides_of
+from fivdisc.sweep.reductions import BUILTIN, stored
+from fivdisc.sweep.spec import Sweep
 
 __all__ = [
     "PointOutcome",
@@ -264,23 +265,53 @@ def _brief(exc: BaseException) -> str:
     return text if len(text) <= _BRIEF_CHARS else text[: _BRIEF_CHARS - 3] + "..."
 
 
-def _checksum(digest: str, index: int, row: Sequence[Any]) -> int:
-    """Checksum of one point: the sweep's digest, the index and the stored values, in order.
+def _framed(token: bytes) -> bytes:
+    return len(token).to_bytes(4, "little") + token
 
-    Never 0, the fill value of the ``checksum`` variable (nothing written).
+
+_NAN = _framed(b"nan")
+_BOOLS = np.array([_framed(b"F"), _framed(b"T")], dtype=object)
+
+
+def _tokens(column: np.ndarray) -> list[bytes]:
+    """What the checksum hashes of every value of a column, its length ahead (see
+    :func:`_checksums`): a boolean as T or F, a float as its little-endian bytes (nan for
+    NaN), a section's values as their little-endian bytes (one NaN for every NaN), anything
+    else as its text."""
+    n = len(column)
+    if column.dtype == bool:
+        return _BOOLS[column.astype(np.intp)].tolist()
+    if column.dtype.kind == "f":
+        values = column.reshape(n, -1)
+        nan = np.isnan(values)
+        size = 8 * values.shape[1]
+        framed = np.empty((n, 4 + size), dtype=np.uint8)
+        framed[:, :4] = np.frombuffer(size.to_bytes(4, "little"), dtype=np.uint8)
+        framed[:, 4:] = np.where(nan, np.nan, values).astype("<f8").view(np.uint8)
+        tokens = framed.view(f"V{4 + size}").ravel().tolist()
+        if column.ndim == 1:  # a reduction's value: NaN as nan
+            for i in np.flatnonzero(nan[:, 0]):
+                tokens[i] = _NAN
+        return tokens
+    return [_framed(str(value).encode()) for value in column.tolist()]
+
+
+def _checksums(digest: str, indices: Sequence[int], columns: Sequence[np.ndarray]
+               ) -> np.ndarray:
+    """Checksums of points: per point, the BLAKE2b (8 bytes) of the sweep's digest, its
+    index and its stored values, in order (`columns`: one per checksummed variable, one
+    row per point of `indices`).
+
+    Never 0, the fill value of the ``checksum`` variable (nothing written). Computed a
+    column at a time (the values' bytes in one NumPy operation), then one hash per point.
     """
-    h = hashlib.blake2b(f"{digest}:{index}".encode(), digest_size=8)
-    for value in row:
-        if isinstance(value, np.ndarray):  # a section's values: one NaN for every NaN
-            token = np.where(np.isnan(value), np.nan, value).astype("<f8").tobytes()
-        elif isinstance(value, bool | np.bool_):
-            token = b"T" if value else b"F"
-        elif isinstance(value, float | np.floating):
-            token = b"nan" if math.isnan(value) else struct.pack("<d", float(value))
-        else:
-            token = str(value).encode()
-        h.update(len(token).to_bytes(4, "little") + token)
-    return int.from_bytes(h.digest(), "little") or 1
+    blake2b = hashlib.blake2b
+    sums = np.empty(len(indices), dtype=np.uint64)
+    for k, (index, *row) in enumerate(zip(indices, *map(_tokens, columns), strict=True)):
+        head = f"{digest}:{index}".encode()
+        sums[k] = int.from_bytes(blake2b(head + b"".join(row), digest_size=8).digest(),
+                                 "little") or 1
+    return sums
 
 
 class _DamagedGroup(SweepError):
@@ -369,7 +400,7 @@ def _layout(attrs: dict[str, Any]) -> _Layout:
     sections = definition.get("sections", [])
     shape = (tuple(len(v) for v in axes.values()) if mode == "grid"
              else (len(next(iter(axes.values()))),))
-    names = {spec.partition(":")[2] or spec: spec for spec in definition["keep"]}
+    names = {spec.partition(":")[2] or spec: spec for spec in stored(definition["keep"])}
     ones = (1,) * len(shape)
     arrays: dict[str, tuple[tuple[int, ...], tuple[int, ...] | None, np.dtype | None]] = {
         name: (shape, ones, np.dtype(BUILTIN[spec].dtype if spec in BUILTIN else "float64"))
@@ -481,26 +512,72 @@ def _decoder(array: Any) -> Callable[[list[bytes]], np.ndarray] | None:
     return None
 
 
-def _chunk_files(directory: str, depth: int, head: tuple[int, ...] = ()
-                 ) -> Iterator[tuple[tuple[int, ...], str]]:
-    """(chunk index, file) of every chunk file under an array's ``c`` directory."""
+def _chunk_files(directory: str, depth: int) -> list[tuple[tuple[int, ...], str]]:
+    """(chunk index, file) of every chunk file under an array's ``c`` directory (a
+    directory in a file's place is listed too: it fails to read)."""
+    level: list[tuple[tuple[int, ...], str]] = [((), directory)]
+    for _ in range(depth):
+        deeper = []
+        for head, path in level:
+            try:
+                names = os.listdir(path)
+            except OSError:  # no chunk written yet, or a file in a directory's place
+                continue
+            deeper += [((*head, int(name)), f"{path}/{name}") for name in names
+                       if name.isdigit()]
+        level = deeper
+    return level
+
+
+_READ = 1 << 16  # bytes per read: a chunk of one point is far smaller
+
+
+def _read(file: str) -> bytes | None:
+    """The bytes of a chunk file (b"" if it cannot be read), None if it is gone.
+
+    Through the operating system's calls: a third of the cost of a Python file object for
+    the files of a few bytes a store is made of."""
     try:
-        entries = list(os.scandir(directory))
-    except OSError:  # no chunk written yet
-        return
-    for entry in entries:
-        if not entry.name.isdigit():
-            continue
-        index = (*head, int(entry.name))
-        if depth > 1 and entry.is_dir():
-            yield from _chunk_files(entry.path, depth - 1, index)
-        elif depth == 1 and entry.is_file():
-            yield index, entry.path
+        fd = os.open(file, os.O_RDONLY)
+    except FileNotFoundError:
+        return None
+    except OSError:
+        return b""
+    try:
+        parts = [os.read(fd, _READ)]
+        while len(parts[-1]) == _READ:
+            parts.append(os.read(fd, _READ))
+        return b"".join(parts)
+    except OSError:
+        return b""
+    finally:
+        os.close(fd)
 
 
-def _read(file: str) -> bytes:
-    with open(file, "rb", buffering=0) as f:
-        return f.read()
+def _decode_distinct(decode: Callable[[list[bytes]], np.ndarray], raws: list[bytes]
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """(rows, index) of chunk files' bytes: every distinct content decoded once (a flag,
+    an empty error or a repeated value is the same few bytes at every point), and per
+    chunk the row of its values in `rows`, -1 for a chunk that does not decode."""
+    distinct = dict.fromkeys(raws)
+    contents = list(distinct)
+    try:
+        rows = decode(contents)
+        valid = np.ones(len(contents), dtype=bool)
+    except Exception:  # one chunk or more is damaged: find which (the type varies)
+        decoded, valid = [], np.zeros(len(contents), dtype=bool)
+        for k, raw in enumerate(contents):
+            try:
+                decoded.append(decode([raw]))
+                valid[k] = True
+            except Exception:
+                pass
+        rows = np.concatenate(decoded) if decoded else np.empty(0)
+    code = np.full(len(contents), -1, dtype=np.intp)
+    code[valid] = np.arange(int(valid.sum()))
+    for k, raw in enumerate(contents):
+        distinct[raw] = code[k]
+    return rows, np.array([distinct[raw] for raw in raws], dtype=np.intp)
 
 
 def _readable(array: Any, grid: Sequence[int], points: np.ndarray | None = None
@@ -513,9 +590,10 @@ def _readable(array: Any, grid: Sequence[int], points: np.ndarray | None = None
     Chunk files are listed and decoded here rather than read through Zarr, which costs
     about half a millisecond per chunk (its store reads one file per asynchronous task,
     and a chunk never written costs as much): the checks of a 300 x 300 sweep took over
-    a minute (see ``benchmarks/bench_store.py``). Arrays of other codecs are read
-    through Zarr. A chunk cut short or damaged fails to decode (the error type varies
-    with the codec, hence the broad excepts); such points are unreadable.
+    a minute (see ``benchmarks/bench_store.py``). Only the chunk files listed are opened,
+    and each distinct content is decoded once. Arrays of other codecs are read through
+    Zarr. A chunk cut short or damaged fails to decode (the error type varies with the
+    codec, hence the broad excepts); such points are unreadable.
     """
     n = math.prod(grid)
     tail = array.shape[len(grid):]
@@ -531,41 +609,24 @@ def _readable(array: Any, grid: Sequence[int], points: np.ndarray | None = None
                 ok[i] = False
         return values, ok
     directory = os.path.join(str(array.store_path.store.root), array.path, "c")
-    rest = "/0" * (array.ndim - len(grid))  # a section's values: one chunk per point
-    if points is None:  # every chunk file there is
-        strides = strides_of(grid)
-        found: list[int] = []
-        files: list[str] = []
-        for chunk, file in _chunk_files(directory, array.ndim):
-            index = chunk[: len(grid)]
-            if any(chunk[len(grid):]) or not all(i < g for i, g in zip(index, grid,
-                                                                       strict=True)):
-                continue  # not a chunk of this array's shape
-            found.append(sum(i * s for i, s in zip(index, strides, strict=True)))
-            files.append(file)
-    else:  # the wanted points' chunk files, where they would be
-        found = np.flatnonzero(wanted).tolist()
-        indices = np.column_stack(np.unravel_index(found, grid)).tolist() if found else []
-        files = [f"{directory}/{'/'.join(map(str, index))}{rest}" for index in indices]
-    read: list[int] = []
-    raws: list[bytes] = []
-    for i, file in zip(found, files, strict=True):
-        try:
-            raws.append(_read(file))
-        except FileNotFoundError:  # never written (Zarr skips chunks of the fill value)
-            continue
-        except OSError:
-            raws.append(b"")
-        read.append(i)
-    found = read
-    try:
-        values[found] = decode(raws).reshape(len(found), *tail)
-    except Exception:  # one chunk or more is damaged: find which
-        for i, raw in zip(found, raws, strict=True):
-            try:
-                values[i] = decode([raw]).reshape(tail)
-            except Exception:
-                ok[i] = False
+    listed = _chunk_files(directory, array.ndim)
+    chunks = np.array([chunk for chunk, _ in listed], dtype=np.int64).reshape(-1, array.ndim)
+    # Chunks of this array's shape only (a section's values: one chunk per point).
+    own = (chunks[:, len(grid):] == 0).all(axis=1) & (chunks[:, :len(grid)] < grid).all(axis=1)
+    at = np.flatnonzero(own)
+    index = np.ravel_multi_index(tuple(chunks[at, :len(grid)].T), tuple(grid))
+    keep = wanted[index]
+    found, raws = [], []
+    for i, k in zip(index[keep].tolist(), at[keep].tolist(), strict=True):
+        raw = _read(listed[k][1])
+        if raw is not None:  # None: removed since listed, read as the fill value
+            found.append(i)
+            raws.append(raw)
+    rows, row = _decode_distinct(decode, raws)
+    found = np.array(found, dtype=np.intp)
+    good = row >= 0
+    values[found[good]] = rows[row[good]].reshape(-1, *tail)
+    ok[found[~good]] = False
     return values, ok
 
 
@@ -628,9 +689,11 @@ def _inspect(path: Path, attrs: dict[str, Any]) -> tuple[np.ndarray, np.ndarray,
         else:
             readable[:] = False
     complete = done & done_readable & readable
-    for i in np.flatnonzero(complete):
-        row = [columns[name][i] for name in layout.variables]
-        complete[i] = int(columns["checksum"][i]) == _checksum(attrs["sweep_hash"], int(i), row)
+    points = np.flatnonzero(complete)
+    if points.size:  # every variable readable
+        complete[points] = columns["checksum"][points] == _checksums(
+            attrs["sweep_hash"], points.tolist(),
+            [columns[name][points] for name in layout.variables])
     damaged = ~complete & (done | ~done_readable)
     failed = complete & (columns["error"] != "") if "error" in columns else np.zeros(n, bool)
     return complete, damaged, failed, broken
@@ -882,11 +945,8 @@ class SweepStore:
                     [0 if o.values is None else o.values[s.count_name] for o in run],
                     dtype=np.int32)
             data["error"] = np.array([o.error for o in run], dtype=_STRING)
-            data["checksum"] = np.array(
-                [_checksum(self.sweep.digest, o.index, [data[name][j] for name in names])
-                 for j, o in enumerate(run)],
-                dtype=np.uint64,
-            )
+            data["checksum"] = _checksums(self.sweep.digest, [o.index for o in run],
+                                          [data[name] for name in names])
             self._write_region(data, run)
         for run in runs:
             self._write_region({"done": np.ones(len(run), dtype=bool)}, run)
