@@ -298,6 +298,13 @@ def test_orbit_and_branch_files_round_trip(tmp_path):
     res = runner.invoke(cli, ["plot", str(branch_nc), "--var", "phi_dot", "-o", str(png)])
     assert res.exit_code == 0, res.output
     assert png.stat().st_size > 0
+    # options that do not apply to a branch are refused, not ignored
+    for extra in (["--kind", "spectrogram"], ["--slider", "0"]):
+        res = runner.invoke(cli, ["plot", str(branch_nc), *extra, "-o", str(png)])
+        assert res.exit_code == 2 and "is not used" in res.output, res.output
+    res = runner.invoke(cli, ["plot", str(branch_nc)])
+    assert res.exit_code == 0, res.output
+    assert (tmp_path / "branch-period.png").exists()
 
 
 @pytest.mark.parametrize(("args", "message"), [

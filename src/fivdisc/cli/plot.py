@@ -128,18 +128,25 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
     from fivdisc.files import check_netcdf, check_output, figure_suffixes, read_dataset
     from fivdisc.result import open_result, run_groups
 
-    out = check_output(output or result.with_name(f"{result.stem}-{kind}.png"), "-o",
-                       figure_suffixes(), inputs=[result])
     if not result.exists():
         raise FileNotFoundError(2, "No such file", str(result))
     from fivdisc.analysis.branch import CONTENT
 
     if read_dataset(result, "plot").attrs.get("content") == CONTENT:
+        given = click.get_current_context().get_parameter_source
+        default = click.core.ParameterSource.DEFAULT
+        out = check_output(output or result.with_name(f"{result.stem}-{var or 'period'}.png"),
+                           "-o", figure_suffixes(), inputs=[result])
         fig = _branch(result, var, slider, (("--run", run), ("--probe", probe),
                                             ("--window", window_text), ("--fmax", fmax),
-                                            ("--segment", segment)))
+                                            ("--segment", segment),
+                                            ("--kind", None if given("kind") == default
+                                             else kind)),
+                      slider_given=given("slider") != default)
         _save(fig, out, dpi)
         return
+    out = check_output(output or result.with_name(f"{result.stem}-{kind}.png"), "-o",
+                       figure_suffixes(), inputs=[result])
     groups = _groups(result, run_groups)
     if run is not None and run not in groups:
         raise FivdiscError(f"--run {run!r} is invalid: {result} holds "
@@ -208,7 +215,7 @@ def _save(fig, out: Path, dpi: int) -> None:
     click.echo(f"wrote {out}")
 
 
-def _branch(path: Path, var: str | None, slider: int, unused):
+def _branch(path: Path, var: str | None, slider: int, unused, slider_given: bool):
     """The figure of a branch (fivdisc continue -o): --var is the measure."""
     from fivdisc.analysis.branch import open_branch
     from fivdisc.branch_plots import BRANCH_MEASURES, plot_branch
@@ -221,6 +228,9 @@ def _branch(path: Path, var: str | None, slider: int, unused):
     if measure not in BRANCH_MEASURES:
         raise FivdiscError(f"--var {measure!r} is invalid for a branch: must be one of "
                            f"{', '.join(BRANCH_MEASURES)}")
+    if measure == "period" and slider_given:
+        raise FivdiscError("--slider is not used for --var period: the period is the "
+                           "orbit's, not a slider's (give a measure such as phi_dot)")
     return plot_branch(open_branch(path), measure, slider)
 
 
