@@ -9,14 +9,15 @@ needs compiles; the earlier commit runs from its unpacked sources
 (``previous.source_tree``) on the same interpreter and libraries. The two alternate, so
 that a change in the machine's load falls on both. It prints each process's wall time
 [s], the ratio of the medians (now / before) and the target of issue 29, item 1, with the
-load average before and after: on a machine shared with other work the absolute times
-say little, the ratios more.
+load average before and after, and each process's processor time (with its helpers'):
+on a machine shared with other work the absolute times say little, the ratios more.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -41,16 +42,26 @@ COMMANDS: dict[str, tuple[tuple[str, ...], float]] = {
     "stability": (("stability",), 5.0),
 }
 WARMUP = ("warmup",)
+# Processor time of each process timed, in order [s].
+CPU: list[float] = []
+
+
+def _cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
 
 
 def _seconds(args: tuple[str, ...], pythonpath: str, cache: Path, workdir: Path) -> float:
-    """Wall time of one process running the command line with ``args`` [s]."""
+    """Wall time of one process running the command line with ``args`` [s]; its processor
+    time (with its helper processes') goes to ``CPU``."""
     env = {**os.environ, "PYTHONPATH": pythonpath, "NUMBA_CACHE_DIR": str(cache),
            "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+    cpu = _cpu()
     start = time.perf_counter()
     out = subprocess.run([sys.executable, "-c", _CLI, *args], env=env, cwd=workdir,
                          stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     seconds = time.perf_counter() - start
+    CPU.append(_cpu() - cpu)
     # Exit status 1 is a result (an orbit not converged, an inconclusive exponent), not
     # a failure of the benchmark.
     if out.returncode not in (0, 1):
@@ -92,10 +103,13 @@ def main() -> None:
             cmd = COMMANDS[name][0]
             # The order alternates between rounds, so neither side always goes first.
             pair = [(now, 0), (before, 1)][:: 1 if round_ % 2 == 0 else -1]
+            cpu = {}
             for pythonpath, side in pair:
                 times[name][side].append(_first_use(cmd, pythonpath))
-            print(f"{name:<10} now {times[name][0][-1]:7.1f} s, at {args.baseline} "
-                  f"{times[name][1][-1]:7.1f} s", flush=True)
+                cpu[side] = CPU[-1]
+            print(f"{name:<10} now {times[name][0][-1]:7.1f} s (cpu {cpu[0]:.1f} s), at "
+                  f"{args.baseline} {times[name][1][-1]:7.1f} s (cpu {cpu[1]:.1f} s); load "
+                  f"{os.getloadavg()[0]:.1f}", flush=True)
         if args.warmup:
             warm.append(_after_warmup(names, now))
             print(f"fivdisc warmup {warm[-1][0]:.1f} s, then "

@@ -9,7 +9,8 @@ with the garbage collector's default thresholds, which the command line raises;
 commit, ``previous.source_tree``, on the same interpreter and libraries). The fivdisc on
 ``sys.path`` is timed: set ``PYTHONPATH=src`` to time a clone. It prints, per command, the
 median wall time of its fresh processes [s], its ratio to the interpreter's start
-(``python -c pass``), to ``python -c "import numpy"`` and to the baseline's, and its
+(``python -c pass``), to ``python -c "import numpy"`` and to the baseline's, the median
+processor time (user and system, all threads) and its ratio to the baseline's, and its
 target (issue 11, item 3; issue 29, item 2 for the Fig. 10 command). The commands take
 turns, so that a change in the machine's load during the run falls on all of them alike;
 each runs once before the timing (compiled bytecode, the kernel's cache, the file cache).
@@ -19,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -63,10 +65,15 @@ def _commands(workdir: Path, fig10: bool) -> list[tuple[str, list[str], float | 
     return commands
 
 
-def _seconds(argv: list[str], workdir: Path, env: dict[str, str] | None = None) -> float:
+def _seconds(argv: list[str], workdir: Path, env: dict[str, str] | None = None
+             ) -> tuple[float, float]:
+    """Wall time and processor time (user and system, all threads) of one process [s]."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     subprocess.run(argv, check=True, stdout=subprocess.DEVNULL, cwd=workdir, env=env)
-    return time.perf_counter() - start
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
 def main() -> None:
@@ -97,24 +104,30 @@ def main() -> None:
                      for label, argv, _ in commands[2:]]
         for _, argv, _, env in runs:
             _seconds(argv, workdir, env)
-        times: list[list[float]] = [[] for _ in runs]
+        times: list[list[tuple[float, float]]] = [[] for _ in runs]
         for _ in range(args.repeat):
             for (_, argv, _, env), samples in zip(runs, times, strict=True):
                 samples.append(_seconds(argv, workdir, env))
-        reference = _seconds([sys.executable, "-c", _REFERENCE], workdir) if (
+        reference = _seconds([sys.executable, "-c", _REFERENCE], workdir)[0] if (
             args.reference and args.fig10) else None
-    medians = [statistics.median(samples) for samples in times]
+    medians = [statistics.median(wall for wall, _ in samples) for samples in times]
+    cpus = [statistics.median(cpu for _, cpu in samples) for samples in times]
     interpreter, numpy = medians[0], medians[1]
-    before = dict(zip(range(2, len(commands)), medians[len(commands):], strict=True))
+    n = len(commands)
+    before = dict(zip(range(2, n), medians[n:], strict=True))
+    cpu_before = dict(zip(range(2, n), cpus[n:], strict=True))
     print(f"fresh processes, median of {args.repeat} each ({sys.executable}); "
           f"load average {load:.2f} before the run, {os.getloadavg()[0]:.2f} after")
+    # On a loaded machine the processor time (all threads) says more than the wall time.
     print(f"{'command':<44} {'median [s]':>10} {'/ pass':>8} {'/ numpy':>8} "
-          f"{'/ before':>9} {'target [s]':>11}")
-    for index, ((label, _, target, _), median) in enumerate(zip(runs, medians, strict=True)):
+          f"{'/ before':>9} {'cpu [s]':>8} {'/ before':>9} {'target [s]':>11}")
+    for index, ((label, _, target, _), median, cpu) in enumerate(
+            zip(runs, medians, cpus, strict=True)):
         goal = f"{target:.1f}" if target is not None else ""
         ratio = f"{median / before[index]:.2f}" if index in before else ""
+        cpu_ratio = f"{cpu / cpu_before[index]:.2f}" if index in cpu_before else ""
         print(f"{label:<44} {median:>10.3f} {median / interpreter:>8.1f} "
-              f"{median / numpy:>8.2f} {ratio:>9} {goal:>11}")
+              f"{median / numpy:>8.2f} {ratio:>9} {cpu:>8.3f} {cpu_ratio:>9} {goal:>11}")
     if reference is not None:
         command = medians[[label for label, _, _ in commands].index(_FIG10)]
         print(f"the slow scipy reference on the Fig. 10 case, one process: {reference:.1f} s, "
