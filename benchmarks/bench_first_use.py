@@ -1,7 +1,8 @@
 """First use of each command from an empty numba cache, side by side with an earlier commit.
 
 Run ``python benchmarks/bench_first_use.py`` (``--baseline COMMIT``, default ``278cbee``,
-the commit before issue 29; ``--rounds N``, default 1; ``--only NAME`` for some of the
+the commit before issue 29; ``--now COMMIT`` to time a commit's sources instead of the
+fivdisc on ``PYTHONPATH``; ``--rounds N``, default 1; ``--only NAME`` for some of the
 commands; ``--warmup`` also times ``fivdisc warmup`` from an empty cache and then each
 command on the cache it filled). Each command runs as a whole process, the way a new user
 starts it, with ``NUMBA_CACHE_DIR`` set to a new empty directory, so that every kernel it
@@ -86,6 +87,9 @@ def _after_warmup(names: list[str], pythonpath: str) -> tuple[float, dict[str, f
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--baseline", default="278cbee", help="earlier commit")
+    parser.add_argument("--now", metavar="COMMIT",
+                        help="time this commit's sources instead of the fivdisc on "
+                             "PYTHONPATH (so that editing the tree meanwhile changes nothing)")
     parser.add_argument("--rounds", type=int, default=1, help="processes per command")
     parser.add_argument("--only", action="append", choices=sorted(COMMANDS),
                         help="time this command (repeatable; default: all)")
@@ -93,7 +97,7 @@ def main() -> None:
                         help="also time fivdisc warmup, then each command after it")
     args = parser.parse_args()
     names = args.only or list(COMMANDS)
-    now = os.environ.get("PYTHONPATH", "")
+    now = str(source_tree(args.now)) if args.now else os.environ.get("PYTHONPATH", "")
     before = str(source_tree(args.baseline))
     load = os.getloadavg()[0]
     times: dict[str, tuple[list[float], list[float]]] = {n: ([], []) for n in names}
