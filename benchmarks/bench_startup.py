@@ -4,25 +4,31 @@ whole Fig. 10 command, side by side with the interpreter's own start in the same
 Run ``python benchmarks/bench_startup.py`` (``--repeat N`` processes per command, default
 15; ``--no-fig10`` leaves out the slow Fig. 10 command; it runs twice, the second time
 with the garbage collector's default thresholds, which the command line raises;
-``--reference`` also times the slow scipy reference on it, once, as a whole process). The
-fivdisc on ``sys.path`` is timed: set ``PYTHONPATH=src`` to time a clone. It prints, per
-command, the median wall time of its fresh processes [s], its ratio to the interpreter's
-start (``python -c pass``) and to ``python -c "import numpy"``, and the target of issue 11
-(item 3). The commands take turns, so that a change in the machine's load during the run
-falls on all of them alike; each runs once before the timing (compiled bytecode, the
-kernel's cache, the file cache).
+``--reference`` also times the slow scipy reference on it, once, as a whole process;
+``--baseline COMMIT`` also times each fivdisc command with the fivdisc of an earlier
+commit, ``previous.source_tree``, on the same interpreter and libraries). The fivdisc on
+``sys.path`` is timed: set ``PYTHONPATH=src`` to time a clone. It prints, per command, the
+median wall time of its fresh processes [s], its ratio to the interpreter's start
+(``python -c pass``), to ``python -c "import numpy"`` and to the baseline's, the median
+processor time (user and system, all threads) and its ratio to the baseline's, and its
+target (issue 11, item 3; issue 29, item 2 for the Fig. 10 command). The commands take
+turns, so that a change in the machine's load during the run falls on all of them alike;
+each runs once before the timing (compiled bytecode, the kernel's cache, the file cache).
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import resource
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+from previous import source_tree
 
 # The console script `fivdisc` runs exactly this; through the interpreter being timed, so
 # that no installed copy of fivdisc stands in for the one on sys.path.
@@ -38,7 +44,8 @@ _CLI_DEFAULT_GC = ("import gc, fivdisc.cli as c; c._GC_THRESHOLDS = gc.get_thres
 
 
 def _commands(workdir: Path, fig10: bool) -> list[tuple[str, list[str], float | None]]:
-    """(label, argv, target [s] or None) of each command timed."""
+    """(label, argv, target [s] or None) of each command timed; the first two are the
+    interpreter's alone."""
     python = sys.executable
     commands = [
         ('python -c "pass"', [python, "-c", "pass"], None),
@@ -51,17 +58,22 @@ def _commands(workdir: Path, fig10: bool) -> list[tuple[str, list[str], float | 
         out = str(workdir / "fig10.nc")
         commands.append((_FIG10,
                          [python, "-c", _CLI, "simulate", "fig10", "-o", out, "--no-progress"],
-                         2.0))
+                         1.0))
         commands.append(("  the same, default gc thresholds",
                          [python, "-c", _CLI_DEFAULT_GC, "simulate", "fig10", "-o", out,
                           "--no-progress"], None))
     return commands
 
 
-def _seconds(argv: list[str], workdir: Path) -> float:
+def _seconds(argv: list[str], workdir: Path, env: dict[str, str] | None = None
+             ) -> tuple[float, float]:
+    """Wall time and processor time (user and system, all threads) of one process [s]."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    subprocess.run(argv, check=True, stdout=subprocess.DEVNULL, cwd=workdir)
-    return time.perf_counter() - start
+    subprocess.run(argv, check=True, stdout=subprocess.DEVNULL, cwd=workdir, env=env)
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
 def main() -> None:
@@ -69,6 +81,8 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=15, help="processes per command")
     parser.add_argument("--no-fig10", dest="fig10", action="store_false",
                         help="leave out fivdisc simulate fig10 (about 2 s a process)")
+    parser.add_argument("--baseline", metavar="COMMIT",
+                        help="also time each fivdisc command at this earlier commit")
     parser.add_argument("--reference", action="store_true",
                         help="also time one process running the slow scipy reference on "
                              "the Fig. 10 case (about 2.5 min), against the command")
@@ -76,25 +90,44 @@ def main() -> None:
     # One core per process, as in the other benchmarks.
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    load = os.getloadavg()[0]
+    # Each run: (label, argv, target, environment or None for this one's).
+    baseline_env = None
+    if args.baseline:
+        baseline_env = {**os.environ, "PYTHONPATH": str(source_tree(args.baseline))}
     with tempfile.TemporaryDirectory() as tmp:
         workdir = Path(tmp)
         commands = _commands(workdir, args.fig10)
-        for _, argv, _ in commands:
-            _seconds(argv, workdir)
-        times: list[list[float]] = [[] for _ in commands]
+        runs = [(label, argv, target, None) for label, argv, target in commands]
+        if baseline_env is not None:
+            runs += [(f"{label} @{args.baseline}", argv, None, baseline_env)
+                     for label, argv, _ in commands[2:]]
+        for _, argv, _, env in runs:
+            _seconds(argv, workdir, env)
+        times: list[list[tuple[float, float]]] = [[] for _ in runs]
         for _ in range(args.repeat):
-            for (_, argv, _), samples in zip(commands, times, strict=True):
-                samples.append(_seconds(argv, workdir))
-        reference = _seconds([sys.executable, "-c", _REFERENCE], workdir) if (
+            for (_, argv, _, env), samples in zip(runs, times, strict=True):
+                samples.append(_seconds(argv, workdir, env))
+        reference = _seconds([sys.executable, "-c", _REFERENCE], workdir)[0] if (
             args.reference and args.fig10) else None
-    medians = [statistics.median(samples) for samples in times]
+    medians = [statistics.median(wall for wall, _ in samples) for samples in times]
+    cpus = [statistics.median(cpu for _, cpu in samples) for samples in times]
     interpreter, numpy = medians[0], medians[1]
-    print(f"fresh processes, median of {args.repeat} each ({sys.executable})")
-    print(f"{'command':<36} {'median [s]':>10} {'/ pass':>8} {'/ numpy':>8} {'target [s]':>11}")
-    for (label, _, target), median in zip(commands, medians, strict=True):
+    n = len(commands)
+    before = dict(zip(range(2, n), medians[n:], strict=True))
+    cpu_before = dict(zip(range(2, n), cpus[n:], strict=True))
+    print(f"fresh processes, median of {args.repeat} each ({sys.executable}); "
+          f"load average {load:.2f} before the run, {os.getloadavg()[0]:.2f} after")
+    # On a loaded machine the processor time (all threads) says more than the wall time.
+    print(f"{'command':<44} {'median [s]':>10} {'/ pass':>8} {'/ numpy':>8} "
+          f"{'/ before':>9} {'cpu [s]':>8} {'/ before':>9} {'target [s]':>11}")
+    for index, ((label, _, target, _), median, cpu) in enumerate(
+            zip(runs, medians, cpus, strict=True)):
         goal = f"{target:.1f}" if target is not None else ""
-        print(f"{label:<36} {median:>10.3f} {median / interpreter:>8.1f} "
-              f"{median / numpy:>8.2f} {goal:>11}")
+        ratio = f"{median / before[index]:.2f}" if index in before else ""
+        cpu_ratio = f"{cpu / cpu_before[index]:.2f}" if index in cpu_before else ""
+        print(f"{label:<44} {median:>10.3f} {median / interpreter:>8.1f} "
+              f"{median / numpy:>8.2f} {ratio:>9} {cpu:>8.3f} {cpu_ratio:>9} {goal:>11}")
     if reference is not None:
         command = medians[[label for label, _, _ in commands].index(_FIG10)]
         print(f"the slow scipy reference on the Fig. 10 case, one process: {reference:.1f} s, "

@@ -5,6 +5,11 @@ side by side with the working tree in one benchmark run.
 virtual environment with fivdisc installed from ``git archive COMMIT`` of this repository,
 then runs ``code`` with that environment's Python and returns its standard output. The
 first call takes a minute or two (install, then numba's compilation on first use).
+
+``source_tree(commit)`` only unpacks the commit's ``src`` (cached in the same place), for
+the benchmarks of whole processes (start-up, first use), which run it with the same
+interpreter and libraries as the working tree, on ``PYTHONPATH``: then only fivdisc's
+own code differs between the two.
 """
 
 from __future__ import annotations
@@ -38,16 +43,32 @@ def environment(commit: str) -> Path:
         return python
     home.mkdir(parents=True, exist_ok=True)
     src = home / "src"
-    with tempfile.TemporaryFile() as archive:
-        subprocess.run(["git", "archive", "--format=tar", full], cwd=REPO, check=True,
-                       stdout=archive)
-        archive.seek(0)
-        with tarfile.open(fileobj=archive) as tar:
-            tar.extractall(src, filter="data")
+    _unpack(full, src)
     subprocess.run([sys.executable, "-m", "venv", str(home / "venv")], check=True)
     subprocess.run([str(python), "-m", "pip", "install", "-q", str(src)], check=True)
     (home / "ready").touch()
     return python
+
+
+def _unpack(full: str, dest: Path, *paths: str) -> None:
+    with tempfile.TemporaryFile() as archive:
+        subprocess.run(["git", "archive", "--format=tar", full, *paths], cwd=REPO,
+                       check=True, stdout=archive)
+        archive.seek(0)
+        with tarfile.open(fileobj=archive) as tar:
+            tar.extractall(dest, filter="data")
+
+
+def source_tree(commit: str) -> Path:
+    """The directory holding the package ``fivdisc`` at ``commit`` (to put on
+    ``PYTHONPATH``), unpacked once."""
+    full = _resolve(commit)
+    home = CACHE / f"{full}-src"
+    if not (home / "ready").exists():
+        home.mkdir(parents=True, exist_ok=True)
+        _unpack(full, home, "src")
+        (home / "ready").touch()
+    return home / "src"
 
 
 def run_previous(commit: str, code: str) -> str:

@@ -52,17 +52,72 @@ def _integration() -> Integration:
     return Integration(model, initial_state(model), duration=0.01, output_rate=1000.0)
 
 
-def test_no_split_when_cached_on_one_core_or_with_tangents(monkeypatch):
+def test_no_split_when_cached_or_on_one_core(monkeypatch):
     simulate(Case(**_CASE))  # the kernel is in memory now
     run = _integration()
     assert not split_compile.compile_split(run)
+    run.set_tangents(np.eye(1, run.model.state_size))
+    run.run_to(1e-3)  # the kernel with tangents too
+    assert not split_compile.compile_split(run)
+    assert not split_compile.compile_split_tangents()
 
     monkeypatch.setattr("fivdisc.compilation.needs_compiling", lambda dispatcher: True)
     monkeypatch.setattr(split_compile, "_cores", lambda: 1)
     assert not split_compile.compile_split(run)
-    monkeypatch.setattr(split_compile, "_cores", lambda: 2)
-    run.set_tangents(np.eye(run.model.state_size)[:1])
-    assert not split_compile.compile_split(run)
+    assert not split_compile.compile_split_tangents()
+
+
+def test_each_function_of_a_share_is_typed_with_all_its_arguments():
+    """The predicted types name every parameter of each function the shares compile (a
+    kernel that gains a parameter must have its prediction extended)."""
+    import inspect
+
+    run = split_compile.default_run(tangents=True)
+    types = split_compile.callee_types(run)
+    dispatchers = split_compile._dispatchers()
+    shares = (split_compile.HELPER_KERNELS + split_compile.OWN_KERNELS
+              + split_compile.TANGENT_HELPER_KERNELS + split_compile.TANGENT_OWN_KERNELS)
+    assert set(types) == set(shares) == set(dispatchers)
+    for name in shares:
+        parameters = inspect.signature(dispatchers[name].py_func).parameters
+        assert len(types[name]) == len(parameters), name
+
+
+_COLD_TANGENTS = """
+import json
+from fivdisc import split_compile
+from fivdisc.analysis.lyapunov import lyapunov
+from fivdisc.case import Case
+spectrum = lyapunov(Case(**json.loads({case!r})), transient=0.0, duration=0.01,
+                    interval=0.005, seed=1)
+stats = {{name: [sum(d.stats.cache_hits.values()), sum(d.stats.cache_misses.values())]
+         for name, d in split_compile._dispatchers().items()}}
+print(json.dumps({{"stats": stats, "exponents": spectrum.exponents.tolist()}}))
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(split_compile._cores() < 2, reason="the split needs two cores")
+def test_a_cold_compile_with_tangents_loads_the_helpers_parts_from_the_cache(tmp_path):
+    """lyapunov from an empty cache: the plain kernel, then the one with tangents, each
+    shared with a helper whose part this process only loads; the exponents are this
+    process's own (a few minutes: two whole compilations)."""
+    from fivdisc.analysis.lyapunov import lyapunov
+
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    out = subprocess.run(
+        [sys.executable, "-c", _COLD_TANGENTS.format(case=json.dumps(_CASE))], env=env,
+        check=True, capture_output=True, text=True, timeout=1800)
+    cold = json.loads(out.stdout)
+    stages = {"_stages", "tangent_stages"}  # one function, a signature for each kernel
+    for name in set(split_compile.HELPER_KERNELS + split_compile.TANGENT_HELPER_KERNELS) - stages:
+        assert cold["stats"][name] == [1, 0], name
+    for name in set(split_compile.OWN_KERNELS + split_compile.TANGENT_OWN_KERNELS) - stages:
+        assert cold["stats"][name] == [0, 1], name
+    # The plain kernel's loaded from the helper's part, the tangent kernel's compiled here.
+    assert cold["stats"]["_stages"] == [1, 1]
+    here = lyapunov(Case(**_CASE), transient=0.0, duration=0.01, interval=0.005, seed=1)
+    assert np.array_equal(np.asarray(cold["exponents"]), here.exponents)
 
 
 def test_a_failing_helper_costs_time_only(monkeypatch):

@@ -99,3 +99,23 @@ def test_the_simulator_leaves_the_result_libraries_to_the_warm_up():
     out = _run(code)
     assert out.returncode == 0, out.stderr
     assert out.stdout.splitlines() == ["[]", "['netCDF4', 'xarray']"]
+
+
+def test_the_simulators_model_imports_no_root_finder():
+    """Building a model (the disc's modes: Bessel roots and the peaks of their shapes)
+    imports no scipy.optimize, a third of a second of every short run (issue 29, item 2):
+    fivdisc._brent takes scipy's steps itself (tests/test_plate.py checks it)."""
+    code = (
+        "import sys\n"
+        "from fivdisc import examples\n"
+        "from fivdisc.case import load_case\n"
+        "from fivdisc.model import build_model\n"
+        "from fivdisc.start import initial_state\n"
+        "model = build_model(load_case(examples.path('fig10')))\n"
+        "initial_state(model)\n"
+        "print(sorted(m for m in ('scipy.optimize', 'scipy.linalg', 'matplotlib', 'dask', "
+        "'xarray') if m in sys.modules))\n"
+    )
+    out = _run(code)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.splitlines()[-1] == "[]"

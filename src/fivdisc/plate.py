@@ -51,8 +51,9 @@ from functools import lru_cache
 from typing import Any
 
 import numpy as np
-from scipy import optimize, special
+from scipy import special
 
+from fivdisc._brent import brentq
 from fivdisc.errors import ModeError
 
 __all__ = ["AnnularPlate", "PlateMode", "clear_cache"]
@@ -212,7 +213,7 @@ def _roots(a: float, b: float, nu: float, order: int, count: int) -> tuple[float
             if not abs(value) > _DETERMINANT_NOISE:  # also skips NaN
                 continue
             if value * last_value < 0.0:
-                roots.append(optimize.brentq(det, last_beta, beta, xtol=1e-14, rtol=1e-15))
+                roots.append(brentq(det, last_beta, beta, xtol=1e-14, rtol=1e-15))
             last_beta, last_value = beta, value
         start = float(grid[-1]) + step
     return tuple(roots[:count])
@@ -269,7 +270,7 @@ def _radial_mode(
     )
     if d_lo > 0.0 > d_hi:  # |R| peaks strictly inside (lo, hi): refine on R' = 0
         candidates.append(
-            optimize.brentq(
+            brentq(
                 lambda s: float(_radial_values(order, beta, a, b, coefficients, np.array(s), 1)),
                 lo,
                 hi,

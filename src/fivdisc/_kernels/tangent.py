@@ -132,7 +132,7 @@ def step(t, hs, ph, sg, mdl, ys, wks, V, KV, vn, vs, cplx):
                 if a != 0.0:
                     for i in range(nd):
                         vs[i] += a * KV[r, j, i]
-            jvp(t + C[st] * hs, ys[st], vs, ph, sg, False, mdl, wks[st], cplx, KV[r, st])
+            jvp(t + C[st] * hs, ys[st], vs, ph, sg, LEFT, mdl, wks[st], cplx, KV[r, st])
         for i in range(nd):
             vn[r, i] = vs[i]
 
@@ -177,7 +177,7 @@ def prepare(t, y, ph, sg, mdl, V, KV):
     evaluate(t, y, ph, sg, RIGHT, mdl, wk, np.empty_like(y))
     for r in range(V.shape[0]):
         slave(ph, mdl, V[r])
-        jvp(t, y, V[r], ph, sg, True, mdl, wk, sc[0], KV[r, 0])
+        jvp(t, y, V[r], ph, sg, RIGHT, mdl, wk, sc[0], KV[r, 0])
 
 
 @njit(cache=True, _nrt=False)
@@ -242,7 +242,7 @@ def saltation(mode, e, t, ypre, ph_pre, sg_pre, ev_start, y, ph, sg, fplus, mdl,
     # The new phases' right-hand side at the new state, for the first stages.
     evaluate(t, y, ph, sg, RIGHT, mdl, wkr, np.empty_like(y))
     for r in range(V.shape[0]):
-        jvp(t, y, V[r], ph, sg, True, mdl, wkr, sc[0], KV[r, 0])
+        jvp(t, y, V[r], ph, sg, RIGHT, mdl, wkr, sc[0], KV[r, 0])
 
 
 # One vector's scratch; not a literal (see the package docstring).

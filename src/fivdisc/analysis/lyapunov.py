@@ -211,6 +211,7 @@ def lyapunov(
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise FivdiscError(f"n = {n!r} is invalid: must be an integer >= 1")
     from fivdisc.simulate import Deflection, initial_state
+    from fivdisc.split_compile import compile_split
 
     model = build_model(case)
     check_steps(model, transient + duration)
@@ -219,6 +220,7 @@ def lyapunov(
         cap = min(cap, sim.max_step)
     run = Integration(model, initial_state(model, initial), duration=transient + duration,
                       rtol=rtol, atol=atol, max_step=cap)
+    compile_split(run)  # the kernel's first compilation, if it is one, on two cores
     run.advance(0.0)
     # One bar in simulated time over the transient and the measurement: a long transient
     # is the first minutes of a run.
@@ -256,9 +258,11 @@ def _measure(run: Integration, model: Model, limit: Any, n: int, seed: int | Non
     logs = np.zeros((steps, n))
     times = np.zeros(steps)
     from fivdisc.compilation import tangent_notice
+    from fivdisc.split_compile import compile_split_tangents
 
     # The first interval compiles the kernel with tangents in a fresh installation.
     with tangent_notice(show=progress):
+        compile_split_tangents()
         run.set_tangents((q * sc[:, None]).T)
         _interval(run, limit, 0, logs, times, t0, interval, transient + duration, sc)
     for k in range(steps):
@@ -305,3 +309,20 @@ def _check(run: Integration, limit, what: str) -> None:
     if run.status_name not in ("running", "success"):
         raise FivdiscError(f"lyapunov: the run ended with {run.status_name} at "
                            f"t = {run.t:.9g} s during {what}")
+
+
+def warm_tangent_kernel(show: bool = False) -> None:
+    """Compile or load the kernel with tangent vectors now, with an exponent over 1 ms
+    of simulated time (a sweep computing exponents does it before its workers start,
+    ``fivdisc warmup`` with every kernel).
+
+    Parameters
+    ----------
+    show
+        Print the notice of :func:`fivdisc.compilation.tangent_notice` if it compiles.
+    """
+    from fivdisc.compilation import tangent_notice
+
+    with tangent_notice(show=show):
+        lyapunov(Case(simulation={"duration": 1e-3}), transient=0.0, duration=1e-3,
+                 interval=1e-3)

@@ -543,6 +543,7 @@ def periodic_orbit(
     if model.n_sliders == 0 or model.state_size == 0:
         raise FivdiscError("periodic_orbit needs a case with a slider")
     from fivdisc.simulate import initial_state
+    from fivdisc.split_compile import compile_split
 
     atol_run = atol if atol is not None else rtol * 1e-7
     if guess is None:
@@ -550,6 +551,7 @@ def periodic_orbit(
         duration = case.simulation.duration if transient is None else transient
         _positive("transient", duration, "s")
         run = Integration(model, y0, duration=duration, rtol=rtol, atol=atol_run)
+        compile_split(run)  # the kernel's first compilation, if it is one, on two cores
         run.run_to(duration)
         if run.status_name != "success":
             raise FivdiscError(f"periodic_orbit: the transient run ended with "
@@ -586,8 +588,10 @@ def periodic_orbit(
 
     from fivdisc.compilation import tangent_notice
     from fivdisc.progress import progress_bar
+    from fivdisc.split_compile import compile_split_tangents
 
     with tangent_notice(show=progress):
+        compile_split_tangents()
         shooting.shoot(x0, min(period, 1e-6), tangents=True)
     with progress_bar(max_iterations, "Newton shooting", "iteration", show=progress) as bar:
         sol = _newton(shooting, x0, period, tol, max_iterations, deadline, bar)

@@ -61,6 +61,7 @@ def _register() -> None:
         simulate,
         stability,
         sweep,
+        warmup,
     )
 
     cli.add_command(modes.modes)
@@ -75,6 +76,7 @@ def _register() -> None:
     cli.add_command(sweep.bifurcation)
     cli.add_command(reproduce.reproduce)
     cli.add_command(examples.examples)
+    cli.add_command(warmup.warmup)
 
 
 _register()

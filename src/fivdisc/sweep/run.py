@@ -26,6 +26,7 @@ from os import PathLike
 from pathlib import Path
 from typing import Any
 
+from fivdisc.analysis.lyapunov import warm_tangent_kernel
 from fivdisc.case import Case
 from fivdisc.errors import FivdiscError
 from fivdisc.simulate import warm_kernel
@@ -353,7 +354,7 @@ def run_sweep(
                     # Compiled here once (with a notice), the workers load it from the cache.
                     warm_kernel(show=progress)
                     if spec.lyapunov is not None:
-                        _warm_tangent_kernel(show=progress)
+                        warm_tangent_kernel(show=progress)
                     pool = _LocalPool(workers or os.cpu_count() or 1)
                 try:
                     _drive(pool, spec, target, todo, already, failed, progress)
@@ -377,18 +378,6 @@ def run_sweep(
         failed=failed,
         wall_time=time.perf_counter() - start,
     )
-
-
-def _warm_tangent_kernel(show: bool) -> None:
-    """Compile or load the kernel with tangent vectors (``largest_lyapunov`` needs it) now,
-    with an exponent over 1 ms of simulated time."""
-    from fivdisc.analysis.lyapunov import lyapunov
-    from fivdisc.case import Case
-    from fivdisc.compilation import tangent_notice
-
-    with tangent_notice(show=show):
-        lyapunov(Case(simulation={"duration": 1e-3}), transient=0.0, duration=1e-3,
-                 interval=1e-3)
 
 
 def _drive(

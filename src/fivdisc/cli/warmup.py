@@ -1,0 +1,32 @@
+"""``fivdisc warmup``: compile every kernel now, before any command needs it."""
+
+from __future__ import annotations
+
+import click
+
+
+@click.command("warmup")
+def warmup() -> None:
+    """Compile every kernel now, once per installation, so that no command waits for it.
+
+    numba compiles fivdisc's kernels at their first use and keeps them in its cache:
+    without this, the first simulation, the first orbit (Lyapunov exponents,
+    continuation) and the first stability analysis each wait for theirs. This compiles
+    them all in one go, the plain kernel and the one with tangent vectors each shared
+    between two processes on a machine with two cores or more, and says what it compiles.
+    Where they are compiled already it only loads them (a few seconds).
+    """
+    import time
+
+    from fivdisc.analysis.lyapunov import warm_tangent_kernel
+    from fivdisc.analysis.stability import linear_stability
+    from fivdisc.case import Case
+    from fivdisc.simulate import warm_kernel
+
+    start = time.perf_counter()
+    warm_kernel(show=True)
+    warm_tangent_kernel(show=True)
+    # The right-hand side's Jacobian at the sliding equilibrium (fivdisc stability).
+    linear_stability(Case())
+    click.echo(f"every kernel is compiled ({time.perf_counter() - start:.0f} s); "
+               "later runs load them")
