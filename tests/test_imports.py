@@ -26,13 +26,12 @@ SOURCE = Path(fivdisc.__file__).parent
 # package with its cache set-up belong to the model layer: the model fills that layout.
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("foundation", ("fivdisc.errors", "fivdisc.files", "fivdisc.extras", "fivdisc.warmup",
-                    "fivdisc._brent",
                     "fivdisc._lazy", "fivdisc._plot_kinds", "fivdisc.selection",
                     "fivdisc.examples")),
     # A case's keys and error messages, which its tables use: they import no table.
     ("case messages", ("fivdisc.case.tree", "fivdisc.case.messages")),
-    ("case", ("fivdisc.case", "fivdisc.plate", "fivdisc.speed", "fivdisc.limits",
-              "fivdisc.conventions")),
+    ("case", ("fivdisc.case", "fivdisc.plate", "fivdisc.plate_cache", "fivdisc.speed",
+              "fivdisc.limits", "fivdisc.conventions")),
     ("model", ("fivdisc.model", "fivdisc._kernels", "fivdisc._kernels.cache",
                "fivdisc._kernels.layout")),
     ("kernels", ("fivdisc._kernels.",)),

@@ -101,10 +101,12 @@ def test_the_simulator_leaves_the_result_libraries_to_the_warm_up():
     assert out.stdout.splitlines() == ["[]", "['netCDF4', 'xarray']"]
 
 
-def test_the_simulators_model_imports_no_root_finder():
+def test_the_simulators_model_imports_no_root_finder(tmp_path, monkeypatch):
     """Building a model (the disc's modes: Bessel roots and the peaks of their shapes)
-    imports no scipy.optimize, a third of a second of every short run (issue 29, item 2):
-    fivdisc._brent takes scipy's steps itself (tests/test_plate.py checks it)."""
+    imports no scipy.optimize, a third of a second of every short run, once an earlier
+    process stored the geometry's modes (fivdisc.plate_cache; tests/test_plate.py checks
+    they are the solved ones)."""
+    monkeypatch.setenv("FIVDISC_CACHE_DIR", str(tmp_path))
     code = (
         "import sys\n"
         "from fivdisc import examples\n"
@@ -116,6 +118,9 @@ def test_the_simulators_model_imports_no_root_finder():
         "print(sorted(m for m in ('scipy.optimize', 'scipy.linalg', 'matplotlib', 'dask', "
         "'xarray') if m in sys.modules))\n"
     )
+    first = _run(code)
+    assert first.returncode == 0, first.stderr
+    assert "scipy.optimize" in first.stdout  # solved, and stored
     out = _run(code)
     assert out.returncode == 0, out.stderr
     assert out.stdout.splitlines()[-1] == "[]"

@@ -53,7 +53,7 @@ from typing import Any
 import numpy as np
 from scipy import special
 
-from fivdisc._brent import brentq
+from fivdisc import plate_cache
 from fivdisc.errors import ModeError
 
 __all__ = ["AnnularPlate", "PlateMode", "clear_cache"]
@@ -193,6 +193,8 @@ def _roots(a: float, b: float, nu: float, order: int, count: int) -> tuple[float
     # offset below about l / b; missing it means the scan is broken, not that it is far away.
     beta_cap = 4.0 * ((count + 2) * spacing + (order + 2) / a)
 
+    from scipy.optimize import brentq
+
     def det(beta: float) -> float:
         return float(_determinant(order, nu, a, b, np.array([beta]))[0])
 
@@ -243,7 +245,23 @@ def _gauss_legendre(a: float, b: float, n: int) -> tuple[np.ndarray, np.ndarray]
 def _radial_mode(
     a: float, b: float, nu: float, k: int, order: int
 ) -> tuple[float, tuple[float, float, float, float], float]:
-    """beta [1/m], normalised coefficients and ``int_a^b R^2 r dr`` [m^2] of mode (k, l = order)."""
+    """beta [1/m], normalised coefficients and ``int_a^b R^2 r dr`` [m^2] of mode (k, l = order),
+    as stored by an earlier process (:mod:`fivdisc.plate_cache`) or solved."""
+    key = repr((a, b, nu, k, order))
+    stored = plate_cache.lookup(key)
+    if stored is not None:
+        beta, coefficients, norm = stored
+        return float(beta), tuple(float(c) for c in coefficients), float(norm)
+    mode = _solved_radial_mode(a, b, nu, k, order)
+    plate_cache.remember(key, [mode[0], list(mode[1]), mode[2]])
+    return mode
+
+
+def _solved_radial_mode(
+    a: float, b: float, nu: float, k: int, order: int
+) -> tuple[float, tuple[float, float, float, float], float]:
+    from scipy.optimize import brentq
+
     beta = _roots(a, b, nu, order, _count_bucket(k + 1))[k]
     matrix = _boundary_matrix(order, nu, a, b, np.array(beta))
     # Null vector of the unit-column matrix (as in _determinant), mapped back to the columns.

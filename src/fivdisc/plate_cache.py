@@ -5,9 +5,9 @@ Finding a mode's frequency parameter and the peak of its shape takes root search
 second of every short command. The modes of a geometry are therefore stored once, in
 ``fivdisc-plate-modes.json`` in ``$FIVDISC_CACHE_DIR`` (else ``$NUMBA_CACHE_DIR``, else
 ``~/.cache/fivdisc``), and read back exactly (JSON keeps every bit of a float). The file
-is stamped with a hash of :mod:`fivdisc.plate`'s source: when that changes, the stored
-modes are ignored and found again. A file that cannot be read, or a directory that
-cannot be written, only costs the root searches.
+is stamped with a hash of :mod:`fivdisc.plate`'s source and the numpy and scipy
+versions: when one changes, the stored modes are ignored and found again. A file that
+cannot be read, or a directory that cannot be written, only costs the root searches.
 """
 
 from __future__ import annotations
@@ -35,8 +35,14 @@ def _path() -> Path:
 
 @lru_cache(maxsize=1)
 def _stamp() -> str:
+    # The modes are what plate.py computes with these numpy and scipy (their Bessel
+    # functions may change in the last bits from one version to the next).
+    import numpy
+    import scipy
+
     source = Path(__file__).with_name("plate.py").read_bytes()
-    return hashlib.sha256(source).hexdigest()[:16]
+    versions = f"{numpy.__version__} {scipy.__version__}".encode()
+    return hashlib.sha256(source + versions).hexdigest()[:16]
 
 
 def _read() -> dict[str, Any]:
