@@ -354,13 +354,12 @@ class _Branch:
             x, period, p = self.unpack(z_new)
             try:
                 shot = self.shooter(p).shoot(x, period, tangents=False)
-                better = (np.array_equal(shot.free, self.free)
-                          and self.shooter(p).residual(shot, x, period) < residual)
+                polished = (self.shooter(p).residual(shot, x, period)
+                            if np.array_equal(shot.free, self.free) else np.inf)
             except FivdiscError:
-                better = False
-            if better:
-                point = self._linearised(z_new, phase,
-                                         self.shooter(p).residual(shot, x, period), it + 1)
+                polished = np.inf
+            if polished < residual:
+                point = self._linearised(z_new, phase, polished, it + 1)
         return point
 
     def _linearised(self, z: np.ndarray, phase: np.ndarray, residual: float,
