@@ -114,8 +114,9 @@ def main() -> None:
     cpus = [statistics.median(cpu for _, cpu in samples) for samples in times]
     interpreter, numpy = medians[0], medians[1]
     n = len(commands)
-    before = dict(zip(range(2, n), medians[n:], strict=True))
-    cpu_before = dict(zip(range(2, n), cpus[n:], strict=True))
+    # Without a baseline there is nothing after the commands' own runs.
+    before = dict(zip(range(2, n), medians[n:], strict=len(runs) > n))
+    cpu_before = dict(zip(range(2, n), cpus[n:], strict=len(runs) > n))
     print(f"fresh processes, median of {args.repeat} each ({sys.executable}); "
           f"load average {load:.2f} before the run, {os.getloadavg()[0]:.2f} after")
     # On a loaded machine the processor time (all threads) says more than the wall time.
