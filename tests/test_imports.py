@@ -26,6 +26,7 @@ SOURCE = Path(fivdisc.__file__).parent
 # package with its cache set-up belong to the model layer: the model fills that layout.
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("foundation", ("fivdisc.errors", "fivdisc.files", "fivdisc.extras", "fivdisc.warmup",
+                    "fivdisc.record",
                     "fivdisc._lazy", "fivdisc._plot_kinds", "fivdisc.selection",
                     "fivdisc.examples")),
     # A case's keys and error messages, which its tables use: they import no table.

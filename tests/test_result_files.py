@@ -184,12 +184,12 @@ def test_a_full_disk_keeps_the_run_in_the_temporary_directory(tmp_path: Path, mo
     import errno
     import tempfile
 
-    import xarray as xr
+    from fivdisc.record import Record
 
     full, spare = tmp_path / "full", tmp_path / "spare"
     full.mkdir()
     spare.mkdir()
-    original = xr.Dataset.to_netcdf
+    original = Record.to_netcdf  # what fivdisc simulate writes with
 
     def to_netcdf(self, path, *args, **kwargs):
         if Path(path).parent == full:
@@ -197,7 +197,7 @@ def test_a_full_disk_keeps_the_run_in_the_temporary_directory(tmp_path: Path, mo
             raise OSError(errno.ENOSPC, "No space left on device", str(path))
         return original(self, path, *args, **kwargs)
 
-    monkeypatch.setattr(xr.Dataset, "to_netcdf", to_netcdf)
+    monkeypatch.setattr(Record, "to_netcdf", to_netcdf)
     monkeypatch.setattr(tempfile, "tempdir", str(spare))
     case = tmp_path / "c.toml"
     SHORT.save(case)

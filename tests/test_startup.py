@@ -83,22 +83,37 @@ def test_simulate_stays_the_function_when_its_module_is_imported_first():
     assert out.returncode == 0, out.stderr
 
 
-def test_the_simulator_leaves_the_result_libraries_to_the_warm_up():
-    """Importing the simulator imports neither xarray nor the netCDF engine: a run imports
-    them in a thread while its kernel integrates (fivdisc.warmup), and the waiter it gets
-    returns only once they are imported."""
+def test_the_simulator_leaves_the_netcdf_library_to_the_warm_up():
+    """Importing the simulator imports no netCDF library: ``fivdisc simulate`` imports it in
+    a thread while its kernel integrates (fivdisc.warmup), and the waiter it gets returns
+    only once it is imported."""
     code = (
         "import sys\n"
         "import fivdisc.simulate\n"
         "print(sorted(m for m in ('xarray', 'netCDF4') if m in sys.modules))\n"
         "from fivdisc.warmup import warm_up\n"
-        "wait = warm_up('xarray', 'netcdf')\n"
+        "wait = warm_up('netcdf')\n"
         "wait()\n"
         "print(sorted(m for m in ('xarray', 'netCDF4') if m in sys.modules))\n"
     )
     out = _run(code)
     assert out.returncode == 0, out.stderr
-    assert out.stdout.splitlines() == ["[]", "['netCDF4', 'xarray']"]
+    assert out.stdout.splitlines() == ["[]", "['netCDF4']"]
+
+
+def test_simulate_writes_its_file_without_xarray(tmp_path):
+    """``fivdisc simulate`` writes its netCDF file from the run's record (fivdisc.record):
+    xarray, with pandas and the array libraries it probes for, was over a second of
+    processor time of a short run's process (issue 29, item 2)."""
+    case = tmp_path / "short.toml"
+    case.write_text("[simulation]\nduration = 0.01\n")
+    heavy = ("xarray", "pandas", "dask", "distributed", "matplotlib")
+    out = _run(_PROBE.format(code=_CLI, heavy=heavy), "simulate", str(case), "-o",
+               str(tmp_path / "short.nc"), "--no-progress")
+    assert out.returncode == 0, out.stderr
+    assert "wrote" in out.stdout
+    assert json.loads(out.stdout.splitlines()[-1]) == []
+    assert fivdisc.open_result(tmp_path / "short.nc").ok
 
 
 def test_the_simulators_model_imports_no_root_finder(tmp_path, monkeypatch):

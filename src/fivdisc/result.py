@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from fivdisc.errors import FivdiscError
+from fivdisc.record import Record
 from fivdisc.selection import select_slider  # noqa: F401 - its documented path
 
 if TYPE_CHECKING:
@@ -32,15 +33,14 @@ _ARRAY_ATTRS = ("final_phase", "final_state")
 EVENT_KINDS = ("stick", "slip", "reversal", "separation", "recontact")
 
 
-def _var(dims, data, units: str, long_name: str, **attrs) -> xr.Variable:
-    import xarray as xr
-
-    return xr.Variable(dims, data, attrs={"units": units, "long_name": long_name, **attrs})
+def _var(dims, data, units: str, long_name: str, **attrs) -> tuple:
+    return dims, data, {"units": units, "long_name": long_name, **attrs}
 
 
 def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarray,
-                  events: tuple[np.ndarray, np.ndarray], attrs: dict) -> xr.Dataset:
-    """Assemble the output dataset of one run.
+                  events: tuple[np.ndarray, np.ndarray], attrs: dict) -> Record:
+    """Assemble the output of one run, as the :class:`~fivdisc.record.Record` that
+    becomes the result's dataset.
 
     Parameters
     ----------
@@ -146,9 +146,7 @@ def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarr
 
     title = f"fivdisc simulation: {describe_run(model.case, model.speed)}"
     attrs = {**global_attrs(title, "fivdisc.simulate"), "case_name": "", **attrs}
-    import xarray as xr
-
-    return xr.Dataset(data, coords=coords, attrs=attrs)
+    return Record(data, coords, attrs)
 
 
 def describe_run(case: Case, speed: SpeedProfile | None = None) -> str:
@@ -315,20 +313,37 @@ class Summary:
         printer.text(str(self))
 
 
-@dataclass(frozen=True)
 class Result:
     """Outcome of :func:`fivdisc.simulate`, or of :func:`open_result` on a saved one.
 
     Results compare equal, pickle and round-trip through netCDF (:meth:`to_netcdf`,
     :func:`open_result`) unchanged.
 
-    Attributes
+    Parameters
     ----------
-    dataset : xarray.Dataset
-        Sampled time histories, the event table and run attributes.
+    dataset : xarray.Dataset or fivdisc.record.Record
+        Sampled time histories, the event table and run attributes; a simulation gives a
+        record, which becomes a dataset when :attr:`dataset` is first read (the summary
+        and :meth:`to_netcdf` do not need it).
     """
 
-    dataset: xr.Dataset
+    __slots__ = ("_data",)
+
+    def __init__(self, dataset: xr.Dataset | Record) -> None:
+        self._data = dataset
+
+    @property
+    def dataset(self) -> xr.Dataset:
+        """Sampled time histories, the event table and run attributes."""
+        if isinstance(self._data, Record):
+            self._data = self._data.to_xarray()
+        return self._data
+
+    def __getstate__(self) -> xr.Dataset | Record:
+        return self._data
+
+    def __setstate__(self, state: xr.Dataset | Record) -> None:
+        self._data = state
 
     def __eq__(self, other: object) -> bool:
         return isinstance(other, Result) and self.dataset.identical(other.dataset)
@@ -336,14 +351,14 @@ class Result:
     __hash__ = None  # type: ignore[assignment]  # mutable content
 
     def __repr__(self) -> str:
-        ds = self.dataset
+        ds = self._data
         name = ds.attrs.get("case_name") or "run"
         return (f"<fivdisc.Result {name}: {self.status}, {ds.attrs.get('end_time', np.nan):.6g}"
                 f" s simulated, {ds.sizes.get('slider', 1)} slider(s), {ds.sizes['time']} "
                 f"samples, {ds.sizes.get('event', 0)} events>")
 
     def __str__(self) -> str:
-        title = self.dataset.attrs.get("title", "fivdisc simulation")
+        title = self._data.attrs.get("title", "fivdisc simulation")
         return f"{self!r}\n{title}\n{self.summary()}"
 
     def _repr_pretty_(self, printer: Any, cycle: bool) -> None:  # IPython, Jupyter
@@ -352,7 +367,7 @@ class Result:
     @property
     def name(self) -> str:
         """Name of the case (its file or example), "" if not named (see :meth:`named`)."""
-        return str(self.dataset.attrs.get("case_name", ""))
+        return str(self._data.attrs.get("case_name", ""))
 
     def named(self, name: str) -> Result:
         """The same result with the case's name (e.g. its file's stem) in its title.
@@ -362,7 +377,7 @@ class Result:
         name
             The name, e.g. ``"fig10"``; plots and ``repr`` show it.
         """
-        ds = self.dataset.copy()
+        ds = self._data.copy()
         title = str(ds.attrs.get("title", "fivdisc simulation"))
         what = title.split(": ", 1)[-1]
         ds.attrs.update(case_name=name, title=f"fivdisc simulation of {name}: {what}")
@@ -371,12 +386,12 @@ class Result:
     @property
     def status(self) -> str:
         """``"success"``, ``"stopped"`` (early stop requested) or a failure name."""
-        return str(self.dataset.attrs["status"])
+        return str(self._data.attrs["status"])
 
     @property
     def message(self) -> str:
         """Human-readable account of how the run ended."""
-        return str(self.dataset.attrs["message"])
+        return str(self._data.attrs["message"])
 
     @property
     def ok(self) -> bool:
@@ -385,7 +400,7 @@ class Result:
 
     def events(self, kind: str | None = None) -> np.ndarray:
         """Times [s] of the switches, optionally only those of one ``kind``."""
-        ds = self.dataset
+        ds = self._data
         times = ds["event_time"].values
         if kind is None:
             return times
@@ -400,7 +415,7 @@ class Result:
         A result that lacks ``normal_force`` or ``w`` (a run of ``fivdisc reproduce`` keeps
         only what its figure draws) has nan for them.
         """
-        ds = self.dataset
+        ds = self._data
         dt = np.diff(ds["time"].values)
         kinds = ds["event_kind"].values
         owners = ds["event_slider"].values
@@ -468,7 +483,7 @@ class Result:
         """
         from fivdisc.files import write_netcdf
 
-        write_netcdf(path, self.dataset.to_netcdf)
+        write_netcdf(path, self._data.to_netcdf)
 
 
 def open_result(path: str | PathLike[str], run: str | None = None) -> Result:

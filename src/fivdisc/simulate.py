@@ -22,7 +22,6 @@ from fivdisc.result import EVENT_KINDS, PHASE_NAMES, Result, build_dataset
 from fivdisc.speed import SpeedProfile
 from fivdisc.split_compile import compile_split
 from fivdisc.start import initial_state
-from fivdisc.warmup import warm_up
 
 # Failures in which a state beyond the plate theory's range means the model diverged.
 _BLOW_UPS = ("nonfinite", "step_size_underflow")
@@ -107,7 +106,6 @@ def simulate(
     with compile_notice(kern.run, show=progress):
         compile_split(run)
         run.advance(0.0)
-    imported = warm_up("xarray")
     bar = progress_bar(sim.duration, "simulating", "s", show=progress,
                        bar_format=SIMULATED_TIME)
     start = _time.perf_counter()
@@ -168,7 +166,6 @@ def simulate(
         "final_phase": ph.copy(),
         "final_state": y.copy(),
     }
-    imported()
     ds = build_dataset(model, run.out_y[:n_done], run.out_aux[:n_done], times, run.events(),
                        attrs)
     ds.attrs["degenerate"] = degenerate(case, ds, limit.largest)

@@ -1,11 +1,9 @@
 """Imports a run will need next, done in a background thread while the kernel integrates.
 
 The integration kernel releases the GIL (``nogil``), so while it runs a second thread can
-import what the result needs afterwards: xarray (whose first variable imports the array
-libraries it finds installed, dask.array among them) and, for a command that writes
-netCDF, the netCDF engine (xarray's writer asks dask for its scheduler, which imports
-dask.distributed when installed). On a machine with two cores these imports then cost
-little wall time. In a process that already has them it does nothing.
+import what the result needs afterwards: for a command that writes netCDF, the netCDF
+library (a fifth of a second of processor time). On a machine with two cores the import
+then costs little wall time. In a process that already has it it does nothing.
 """
 
 from __future__ import annotations
@@ -15,26 +13,12 @@ import threading
 from collections.abc import Callable
 
 
-def _xarray() -> None:
-    import numpy as np
-    import xarray as xr
-
-    xr.Variable("x", np.zeros(1))
-
-
 def _netcdf() -> None:
     import netCDF4  # noqa: F401
-
-    try:
-        from dask.base import get_scheduler
-    except ImportError:
-        return
-    get_scheduler()
 
 
 _TASKS: dict[str, tuple[Callable[[], None], str]] = {
     # name: (what to do, the module whose presence means it is not needed)
-    "xarray": (_xarray, "xarray"),
     "netcdf": (_netcdf, "netCDF4"),
 }
 _threads: dict[str, threading.Thread] = {}
@@ -51,7 +35,7 @@ def _quietly(tasks: list[Callable[[], None]]) -> None:
 
 
 def warm_up(*names: str) -> Callable[[], None]:
-    """Start importing ``names`` (``"xarray"``, ``"netcdf"``) in a daemon thread.
+    """Start importing ``names`` (``"netcdf"``) in a daemon thread.
 
     Returns a function that waits until they are imported: call it before using the
     modules, so that the main thread never imports them while the thread is half-way

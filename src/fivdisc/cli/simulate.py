@@ -37,7 +37,7 @@ def simulate(case_file: Path, output: Path | None, progress: bool) -> None:
     case = load_case(case_file)
     out = check_output(output or default_output(case_file, ".nc"), "-o", NETCDF,
                        inputs=[case_file])
-    imported = warm_up("xarray", "netcdf")
+    imported = warm_up("netcdf")
     result = run(case, progress=progress).named(case_file.stem)
     imported()
     _save(result, out)
