@@ -294,6 +294,14 @@ def test_orbit_and_branch_files_round_trip(tmp_path):
     again = json.loads(res.stdout)
     assert again["points"][0]["parameter"] == pytest.approx(1.5)
     assert again["points"][-1]["parameter"] == pytest.approx(2.0)
+    # each point's multipliers: the disc mode's, by hand (as in the rigid-disc branch test)
+    for point in again["points"]:
+        mult = np.array([m["real"] + 1j * m["imag"] for m in point["multipliers"]])
+        assert [m["modulus"] for m in point["multipliers"]] == pytest.approx(np.abs(mult))
+        big = mult[np.abs(mult) > 0.5]
+        big = big[np.abs(big - 1.0) > 1e-6]
+        disc = _rigid_disc_closed_form(point["parameter"])[1]
+        assert np.sort_complex(big) == pytest.approx(np.sort_complex(disc), abs=1e-6)
     png = tmp_path / "branch.png"
     res = runner.invoke(cli, ["plot", str(branch_nc), "--var", "phi_dot", "-o", str(png)])
     assert res.exit_code == 0, res.output

@@ -251,9 +251,9 @@ class Branch:
                     for m in values]
 
         points = [{"parameter": float(p), "period": float(t), "stable": bool(s),
-                   "signature": list(self.signature(i))}
-                  for i, (p, t, s) in enumerate(zip(self.parameter, self.period, self.stable,
-                                                    strict=True))]
+                   "signature": list(self.signature(i)), "multipliers": cplx(m)}
+                  for i, (p, t, s, m) in enumerate(zip(self.parameter, self.period, self.stable,
+                                                       self.multipliers, strict=True))]
         bifs = []
         for b in self.bifurcations():
             entry = {k: v for k, v in b.items() if k not in ("state", "before", "after")}
