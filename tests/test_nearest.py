@@ -15,6 +15,9 @@ def test_nearest_compares_whole_keys_and_their_last_part():
     assert nearest("dcay", keys) == "; did you mean 'friction.decay'?"
     assert nearest("slider.mas", keys) == "; did you mean 'slider.mass'?"
     assert nearest("zzz", keys).startswith("; did you mean '")  # however far
+    # in capitals: the same key, not the one sharing most capital-blind letters
+    keys = ["disc.modes", "speed.value", "speed.profile", "slider.mass"]
+    assert nearest("SPEED.VALUE", keys) == "; did you mean 'speed.value'?"
     assert nearest("x", []) == ""
 
 

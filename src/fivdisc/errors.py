@@ -43,7 +43,7 @@ def nearest(name: str, names: Iterable[str]) -> str:
     'slider.mass'?"`` ("" if there are no names).
 
     Dotted names are compared whole and by their last part, so that ``dcay`` finds
-    ``friction.decay``; the closest is named however far it is.
+    ``friction.decay``, and regardless of case; the closest is named however far it is.
 
     Parameters
     ----------
@@ -56,9 +56,12 @@ def nearest(name: str, names: Iterable[str]) -> str:
     if not candidates:
         return ""
 
+    typed = name.lower()  # ``SPEED.VALUE`` is speed.value in capitals, not a misspelling
+
     def likeness(candidate: str) -> float:
-        whole = difflib.SequenceMatcher(None, name, candidate).ratio()
-        last = difflib.SequenceMatcher(None, name.rsplit(".", 1)[-1],
+        candidate = candidate.lower()
+        whole = difflib.SequenceMatcher(None, typed, candidate).ratio()
+        last = difflib.SequenceMatcher(None, typed.rsplit(".", 1)[-1],
                                        candidate.rsplit(".", 1)[-1]).ratio()
         return max(whole, last)
 
