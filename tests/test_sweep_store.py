@@ -363,3 +363,35 @@ def test_verify_of_something_else_is_one_line(tmp_path: Path) -> None:
         result = CliRunner().invoke(cli, ["sweep", "--verify", str(target)])
         assert result.exit_code == 2 and time.perf_counter() - start < 5.0
         assert result.stderr.count("\n") == 1 and words in result.stderr
+
+
+# --- chunks of many points -------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("shape", "max_points"), [
+    ((300, 300), []), ((5000,), []), ((1000, 10), []), ((2, 3, 4), []), ((7, 400, 3), []),
+    ((300, 300), [1000]), ((40,), [200_000]),
+])
+def test_a_chunk_is_a_run_of_at_most_1024_consecutive_points(shape, max_points) -> None:
+    from fivdisc.sweep.store import _point_chunks
+
+    chunks = _point_chunks(shape, max_points)
+    size = int(np.prod(chunks))
+    # as many points as fit, under both bounds (a section's values: 8 bytes each)
+    bound = min(1024, max(1, 2**20 // (8 * max([1, *max_points]))))
+    assert size <= bound and (size == int(np.prod(shape)) or size > bound // 2)
+    # consecutive in C order: whole axes after the last one cut, one point before it
+    cut = [k for k, (c, n) in enumerate(zip(chunks, shape, strict=True)) if c < n]
+    if cut:
+        assert all(c == 1 for c in chunks[:cut[-1]])
+
+
+def test_a_grid_of_300_by_300_is_stored_in_100_chunks_per_variable(tmp_path: Path) -> None:
+    import zarr
+
+    spec = Sweep(base=SPEC.base, axes={"slider.normal_damping": "0.1:1.0:300",
+                                       "speed.value": "1.0:30.0:300"}, keep=["separated"])
+    with store_lock(tmp_path / "big.zarr"):
+        SweepStore.open(tmp_path / "big.zarr", spec)
+    for name in ("separated", "error", "checksum", "done"):
+        assert zarr.open_array(tmp_path / "big.zarr" / name, mode="r").chunks == (3, 300)

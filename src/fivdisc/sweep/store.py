@@ -24,16 +24,24 @@ Layout (one Zarr v3 group, written through xarray, with consolidated metadata so
                 fivdisc_kind = "sweep", sweep_definition, sweep_hash (canonical JSON of the
                 sweep and its SHA-256), sweep_mode, sweep_axes, sweep_shape,
                 sweep_variables (the checksummed ones, in order), sweep_sections (JSON:
-                every section's settings), fivdisc_version, store_format (format 3 is
-                this layout without sections and sweep_sections; it is read as such)
+                every section's settings), fivdisc_version, store_format (5; formats 3
+                and 4 are read and verified, not resumed: see below)
 
 Points are numbered in C order over the axes (the first axis varies slowest). Every data
-variable has chunks of one point (a section's: all values of one point), so writing a
-point touches only its own chunk files (each replaced atomically by Zarr's local
-store). Values, ``error`` and ``checksum`` are written before ``done``. A point is
-complete only if its ``done`` chunk says so and its values read back to its checksum:
-Zarr reads a lost chunk file as the fill value, so without the checksum a deleted chunk
-would pass for data.
+variable has chunks of a block of consecutive points (see :func:`_point_chunks`: up to
+1024 points; a section's: all values of those points), so that a check opens one file
+per block and variable, not per point. Writing points rewrites the chunks that hold them
+(Zarr reads the rest of the chunk, and its local store replaces the file atomically), so
+an interrupted write leaves every chunk old or new. Values, ``error`` and ``checksum``
+are written before ``done``. A point is complete only if its ``done`` flag says so and
+its values read back to its checksum: Zarr reads a lost chunk file as the fill value, so
+without the checksum a deleted chunk would pass for data. A chunk that no longer decodes
+is removed when the sweep is resumed (:meth:`SweepStore.completed`): its points are
+recomputed, and Zarr could not write a point into it.
+
+Formats 3 and 4 held one point per chunk (3: without sections and ``sweep_sections``);
+they are read and verified, and refused by :meth:`SweepStore.open` (a sweep writing into
+them would mix two layouts).
 
 One coordinator writes a store at a time: :func:`store_lock` holds a lock file next
 to the store (``STORE.lock``, next to where a symbolic link leads, through ``filelock``)
@@ -164,10 +172,10 @@ def dims_of(sweep: Sweep) -> tuple[str, ...]:
     return tuple(sweep.axes) if sweep.mode == "grid" else (DIM,)
 
 
-def point_chunks(shape: Sequence[int], max_points: Sequence[int] = ()) -> tuple[int, ...]:
+def _point_chunks(shape: Sequence[int], max_points: Sequence[int] = ()) -> tuple[int, ...]:
     """The chunk shape over a sweep's points: whole trailing axes while they fit in
-    :data:`_BLOCK_POINTS` points (fewer if a section's values, `max_points` per point, would
-    exceed :data:`_BLOCK_BYTES`), then a slice of the next axis; so that a chunk is a run
+    ``_BLOCK_POINTS`` points (fewer if a section's values, `max_points` per point, would
+    exceed ``_BLOCK_BYTES``), then a slice of the next axis; so that a chunk is a run
     of consecutive points in C order, the order they are computed in."""
     room = min(_BLOCK_POINTS, max(1, _BLOCK_BYTES // (8 * max([1, *max_points]))))
     chunks = []
@@ -422,7 +430,7 @@ def _layout(attrs: dict[str, Any]) -> _Layout:
     shape = (tuple(len(v) for v in axes.values()) if mode == "grid"
              else (len(next(iter(axes.values()))),))
     names = {spec.partition(":")[2] or spec: spec for spec in stored(definition["keep"])}
-    block = (point_chunks(shape, [s["max_points"] for s in sections])
+    block = (_point_chunks(shape, [s["max_points"] for s in sections])
             if attrs.get("store_format") == STORE_FORMAT else (1,) * len(shape))
     arrays: dict[str, tuple[tuple[int, ...], tuple[int, ...] | None, np.dtype | None]] = {
         name: (shape, block, np.dtype(BUILTIN[spec].dtype if spec in BUILTIN else "float64"))
@@ -630,7 +638,7 @@ def _points(per_chunk: np.ndarray, grid: Sequence[int], block: Sequence[int]) ->
 def _readable(array: Any, grid: Sequence[int], points: np.ndarray | None = None,
               undecodable: list[str] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(values, readable) of a Zarr array over the sweep's `grid` (chunked by blocks of
-    points, see :func:`point_chunks`, or one point per chunk in formats 3 and 4), one row
+    points, see :func:`_point_chunks`, or one point per chunk in formats 3 and 4), one row
     per point in C order (the order of the sweep's points): values ``(n_points,)``, or
     ``(n_points, max_points)`` for a section's. Only the chunks holding a point flagged
     in `points` (default: all) are read; the other points get the fill value. The chunk
@@ -1051,10 +1059,10 @@ class SweepStore:
 
 
 def _encoding(sweep: Sweep, names: Sequence[str]) -> dict[str, dict[str, Any]]:
-    """Chunks of a block of points (see :func:`point_chunks`): their values, or a
+    """Chunks of a block of points (see :func:`_point_chunks`): their values, or a
     section's values of those points."""
     lengths = {s.name: s.max_points for s in sweep.sections}
-    block = point_chunks(sweep.shape, list(lengths.values()))
+    block = _point_chunks(sweep.shape, list(lengths.values()))
     return {name: {"chunks": block + ((lengths[name],) if name in lengths else ())}
             for name in names}
 
