@@ -105,7 +105,9 @@ def helper_dir(tmp_path_factory) -> Path:
 def _helper_on_path(helper_dir, monkeypatch) -> None:
     # spawned workers inherit sys.path; subprocesses get PYTHONPATH
     monkeypatch.syspath_prepend(str(helper_dir))
-    monkeypatch.setenv("PYTHONPATH", str(helper_dir))
+    # prepended: the fivdisc a PYTHONPATH names (a worktree's) stays the one imported
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(
+        [str(helper_dir), *filter(None, [os.environ.get("PYTHONPATH")])]))
 
 
 @pytest.fixture(scope="module")
