@@ -221,8 +221,8 @@ def _template(sweep: Sweep) -> xr.Dataset:
 
     dims, shape = dims_of(sweep), sweep.shape
     # One dask chunk per variable: only metadata is written (compute=False), and a graph
-    # of one task per point costs seconds per 10,000 points; Zarr's chunks of one point
-    # are set by _encoding.
+    # of one task per chunk costs seconds per 10,000 chunks; Zarr's chunks are set by
+    # _encoding.
     chunks = shape
     data = {
         r.name: (
@@ -559,7 +559,7 @@ def _chunk_files(directory: str, depth: int) -> list[tuple[tuple[int, ...], str]
     return level
 
 
-_READ = 1 << 16  # bytes per read: a chunk of one point is far smaller
+_READ = 1 << 16  # bytes per read: most chunks are smaller, larger ones are read on
 
 
 def _read(file: str) -> bytes | None:
@@ -586,8 +586,9 @@ def _read(file: str) -> bytes | None:
 
 def _decode_distinct(decode: Callable[[list[bytes]], np.ndarray], raws: list[bytes]
                      ) -> tuple[np.ndarray, np.ndarray]:
-    """(rows, index) of chunk files' bytes: every distinct content decoded once (a flag,
-    an empty error or a repeated value is the same few bytes at every point), and per
+    """(rows, index) of chunk files' bytes: every distinct content decoded once (in a
+    store of one point per chunk, a flag, an empty error or a repeated value is the same
+    few bytes at every point), and per
     chunk the row of its values in `rows`, -1 for a chunk that does not decode."""
     distinct = dict.fromkeys(raws)
     contents = list(distinct)
