@@ -356,9 +356,12 @@ def test_stores_of_format_3_are_read_not_resumed(tmp_path, monkeypatch) -> None:
     loaded = open_sweep(path)
     assert loaded["done"].values.tolist() == [True, True, False]
     np.testing.assert_array_equal(loaded["max_normal_force"].values[:2], [1.0, 2.0])
-    with store_lock(path), pytest.raises(SweepError, match=r"store format 3\); this version "
-                                                           r"reads it but resumes only"):
-        SweepStore.open(path, plain)
+    with store_lock(path):
+        store = SweepStore.open(path, plain)
+        np.testing.assert_array_equal(store.completed(), [True, True, False])
+        with pytest.raises(SweepError, match=r"store format 3\); this version reads it but "
+                                             r"resumes only"):
+            store.write([PointOutcome(2, {"max_normal_force": 3.0})])
 
 
 # --- sweep files ------------------------------------------------------------------------------

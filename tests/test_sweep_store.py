@@ -254,10 +254,17 @@ def test_a_store_of_one_point_per_chunk_is_read_and_verified_not_resumed(
     np.testing.assert_array_equal(verify_store(path).damaged, _mask(2))
     _tamper(path, "max_normal_force", 2, 102.0)
     xr.testing.assert_identical(open_sweep(path).drop_attrs(), reference.drop_attrs())
+    # complete: a rerun (as `fivdisc bifurcation` does before drawing) computes nothing
+    report = run_sweep(SPEC, path, workers=1, progress=False)
+    assert (report.already_done, report.computed) == (N, 0)
+    # a point missing: refused before any work, the store left as it was
+    _tamper(path, "done", 5, False)
+    files = sorted((f, f.read_bytes()) for f in path.rglob("*") if f.is_file())
     with pytest.raises(SweepError, match=r"old.zarr holds one point per chunk \(store format "
                                          r"4\); this version reads it but resumes only stores "
                                          r"of format 5: rerun the sweep into a new store$"):
         run_sweep(SPEC, path, workers=1, progress=False)
+    assert sorted((f, f.read_bytes()) for f in path.rglob("*") if f.is_file()) == files
 
 
 # --- one coordinator per store ---------------------------------------------------------------

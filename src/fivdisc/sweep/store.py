@@ -40,8 +40,10 @@ is removed when the sweep is resumed (:meth:`SweepStore.completed`): its points 
 recomputed, and Zarr could not write a point into it.
 
 Formats 3 and 4 held one point per chunk (3: without sections and ``sweep_sections``);
-they are read and verified, and refused by :meth:`SweepStore.open` (a sweep writing into
-them would mix two layouts).
+they are read and verified, never repaired or written (a sweep writing into them would
+mix two layouts): :meth:`SweepStore.open` opens them as they are, with a
+:attr:`~SweepStore.refusal` that :meth:`SweepStore.write` and :func:`~fivdisc.sweep.run_sweep` raise
+when a point is missing.
 
 One coordinator writes a store at a time: :func:`store_lock` holds a lock file next
 to the store (``STORE.lock``, next to where a symbolic link leads, through ``filelock``)
@@ -944,24 +946,29 @@ class SweepStore:
         The store's directory.
     sweep
         The sweep it holds.
+    refusal
+        Why points cannot be written into it, in one line ("" if they can): a store of
+        an earlier format is read, not written.
     """
 
-    def __init__(self, path: Path, sweep: Sweep) -> None:
+    def __init__(self, path: Path, sweep: Sweep, refusal: str = "") -> None:
         self.path = path
         self.sweep = sweep
+        self.refusal = refusal
 
     @classmethod
     def open(cls, path: str | PathLike[str], sweep: Sweep) -> SweepStore:
         """Create the store for `sweep`, or reopen it to resume; hold :func:`store_lock`.
 
         Variables whose metadata is lost or damaged are rebuilt empty (their points are
-        then incomplete and get recomputed).
+        then incomplete and get recomputed). A store of an earlier format (one point per
+        chunk) is opened as it is, to be read: its :attr:`refusal` says why it is not
+        written.
 
         Raises
         ------
         SweepError
-            `path` exists but is not a sweep store, holds a different sweep, or is of an
-            earlier format (one point per chunk: read, not resumed).
+            `path` exists but is not a sweep store, or holds a different sweep.
         """
         path = Path(path)
         _require_zarr()
@@ -979,21 +986,21 @@ class SweepStore:
                 "write to a new store, or delete this one to start over"
             )
         if attrs["store_format"] != STORE_FORMAT:
-            # Writing a point into a store of another format would mix two layouts.
-            raise SweepError(
+            # Repairing or writing it from this sweep's layout would mix two layouts.
+            return cls(path, sweep, (
                 f"{path} holds one point per chunk (store format {attrs['store_format']}); "
                 f"this version reads it but resumes only stores of format {STORE_FORMAT}: "
-                "rerun the sweep into a new store"
-            )
+                "rerun the sweep into a new store"))
         _repair(path, sweep, attrs)
         return cls(path, sweep)
 
     def completed(self) -> np.ndarray:
-        """Which points are complete (see :func:`read_mask`). Chunk files that do not
-        decode are removed: their points are not complete, and writing one of them again
-        would read the rest of its chunk first."""
+        """Which points are complete (see :func:`read_mask`). In a store that is written,
+        chunk files that do not decode are removed: their points are not complete, and
+        writing one of them again would read the rest of its chunk first."""
         undecodable: list[str] = []
-        complete = _inspect(self.path, _read_attrs(self.path), undecodable)[0]
+        complete = _inspect(self.path, _read_attrs(self.path),
+                            None if self.refusal else undecodable)[0]
         for file in undecodable:
             if os.path.isdir(file) and not os.path.islink(file):
                 shutil.rmtree(file, ignore_errors=True)
@@ -1012,7 +1019,14 @@ class SweepStore:
 
         Points with consecutive indices along the last axis are written by one region
         write each.
+
+        Raises
+        ------
+        SweepError
+            The store is not written (see :attr:`refusal`).
         """
+        if self.refusal:
+            raise SweepError(self.refusal)
         shape = self.sweep.shape
         outcomes = sorted(outcomes, key=lambda o: o.index)
         runs: list[list[PointOutcome]] = []
