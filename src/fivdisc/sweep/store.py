@@ -42,8 +42,8 @@ recomputed, and Zarr could not write a point into it.
 Formats 3 and 4 held one point per chunk (3: without sections and ``sweep_sections``);
 they are read and verified, never repaired or written (a sweep writing into them would
 mix two layouts): :meth:`SweepStore.open` opens them as they are, with a
-:attr:`~SweepStore.refusal` that :meth:`SweepStore.write` and :func:`~fivdisc.sweep.run_sweep` raise
-when a point is missing.
+:attr:`~SweepStore.refusal` that :meth:`SweepStore.write` and
+:func:`~fivdisc.sweep.run_sweep` raise when a point is missing.
 
 One coordinator writes a store at a time: :func:`store_lock` holds a lock file next
 to the store (``STORE.lock``, next to where a symbolic link leads, through ``filelock``)
