@@ -1,21 +1,26 @@
-"""Time the checks of a sweep store (issue 28): fivdisc's against reading it through Zarr.
+"""Time the checks of a sweep store (issue 28): fivdisc's against reading it through Zarr,
+and against the checks of earlier commits on the stores they wrote.
 
-Run ``python benchmarks/bench_store.py`` (about a minute) or with ``--empty N --full M
---previous COMMIT``.
-Every point's check needs one chunk of each stored variable; Zarr reads a chunk (or
-finds it missing) at about half a millisecond, so checking a 300 x 300 store through it
-took over a minute, before the sweep's first point and on every resume and ``--verify``.
-Printed, per store, the wall time of :func:`fivdisc.sweep.verify_store` and of reading
-the same variables through Zarr (the former method, the baseline), both per 100,000
-points, and their ratio:
+Run ``python benchmarks/bench_store.py`` (about two minutes) or with ``--empty N --full M
+--previous COMMIT ...``.
+A check reads every chunk file of every stored variable. Up to store format 4 a chunk
+held one point: Zarr reads a chunk (or finds it missing) at about half a millisecond, so
+checking a 300 x 300 store through it took over a minute, before the sweep's first point
+and on every resume and ``--verify``, and fivdisc's own reading of the files still cost
+some 12 s per 100,000 full points (file opens). Format 5 chunks blocks of up to 1024
+points. Printed, per store, wall times per 100,000 points and their ratios:
 
-1. an empty N x N store (a sweep's start: nothing to read but the ``done`` listing);
-2. a full M x M store (every point written, a seventh of them failed);
-3. the empty 300 x 300 store of the fault probe, fivdisc's check alone;
-4. the full M x M store checked by this fivdisc and by the store module of ``--previous``
-   (default ``278cbee``: one chunk file per point and variable tried through Python file
-   objects, hashing point by point), taken from this repository's history and imported
-   beside it; checked in turns, three times each, the medians and their ratio.
+1. an empty N x N store (a sweep's start: nothing to read but the ``done`` listing):
+   :func:`fivdisc.sweep.verify_store` against reading the same variables through Zarr;
+2. a full M x M store (every point written, a seventh of them failed), likewise;
+3. the full M x M store, written and checked by this fivdisc, against the same points
+   written and checked by the store module of each ``--previous`` commit (default
+   ``278cbee``, one chunk file per point and variable tried through Python file objects,
+   hashing point by point; and ``9d68a9a``, the last commit of format 4: only the chunk
+   files listed opened, through the operating system), taken from this repository's
+   history and imported beside it; checked in turns, three times each, the medians and
+   their ratio;
+4. the empty 300 x 300 store of the fault probe, fivdisc's check alone.
 """
 
 from __future__ import annotations
@@ -31,14 +36,14 @@ from types import ModuleType
 from typing import Any
 
 from fivdisc.case import Case
-from fivdisc.sweep import Sweep, SweepStore, store_lock, verify_store
+from fivdisc.sweep import Sweep, verify_store
 from fivdisc.sweep.store import PointOutcome, checksummed
 
 PER = 100_000  # points, the unit of the reported costs
 REPO = Path(__file__).resolve().parents[1]
 # The commit before the check read only the chunk files listed, each distinct content
-# decoded once, and hashed a column at a time.
-PREVIOUS = "278cbee"
+# decoded once, and hashed a column at a time; and the last commit of one point per chunk.
+PREVIOUS = ("278cbee", "9d68a9a")
 
 
 def _spec(n: int) -> Sweep:
@@ -47,11 +52,15 @@ def _spec(n: int) -> Sweep:
                  keep=["separated", "max_normal_force"])
 
 
-def make_store(path: Path, n: int, full: bool) -> Sweep:
-    """An n x n store, empty or with every point written (made-up outcomes)."""
+def make_store(path: Path, n: int, full: bool, module: Any = None) -> Sweep:
+    """An n x n store, empty or with every point written (made-up outcomes), by the store
+    module `module` (default: this fivdisc's)."""
+    from fivdisc.sweep import store as current
+
+    module = module or current
     spec = _spec(n)
-    with store_lock(path):
-        store = SweepStore.open(path, spec)
+    with module.store_lock(path):
+        store = module.SweepStore.open(path, spec)
         if full:
             store.write([PointOutcome(i, {"separated": i % 2 == 0, "max_normal_force": 1.0 * i})
                          if i % 7 else PointOutcome(i, None, "failed on purpose")
@@ -87,20 +96,19 @@ def previous_store_module(commit: str) -> ModuleType:
     return module
 
 
-def alternate(path: Path, previous: ModuleType, rounds: int = 3) -> tuple[float, float]:
-    """Median wall times [s] of this check and the previous one on the store at `path`,
-    run in turns (the file system's cache warm for both)."""
-    from fivdisc.sweep import store
-
-    times: dict[Any, list[float]] = {store: [], previous: []}
-    for module in times:
-        module.verify_store(path)
+def alternate(stores: dict[Any, Path], rounds: int = 3) -> dict[Any, float]:
+    """Median wall times [s] of each store module's check of its store (module -> store
+    path), run in turns (the file system's cache warm for all)."""
+    times: dict[Any, list[float]] = {module: [] for module in stores}
+    for module, path in stores.items():
+        if not module.verify_store(path).complete.any():
+            raise SystemExit(f"{module.__name__} finds no complete point in its store {path}")
     for _ in range(rounds):
         for module, spent in times.items():
             start = time.perf_counter()
-            module.verify_store(path)
+            module.verify_store(stores[module])
             spent.append(time.perf_counter() - start)
-    return statistics.median(times[store]), statistics.median(times[previous])
+    return {module: statistics.median(spent) for module, spent in times.items()}
 
 
 def compare(label: str, path: Path, spec: Sweep) -> None:
@@ -113,20 +121,30 @@ def compare(label: str, path: Path, spec: Sweep) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--empty", type=int, default=100, help="side of the empty store")
-    parser.add_argument("--full", type=int, default=40, help="side of the full store")
-    parser.add_argument("--previous", default=PREVIOUS, help="commit of the earlier check")
+    parser.add_argument("--full", type=int, default=100, help="side of the full store")
+    parser.add_argument("--previous", nargs="+", default=PREVIOUS,
+                        help="commits of the earlier checks")
     args = parser.parse_args()
+    from fivdisc.sweep import store as current
+
     with tempfile.TemporaryDirectory() as tmp:
         empty = Path(tmp) / "empty.zarr"
         compare("empty store", empty, make_store(empty, args.empty, full=False))
         full = Path(tmp) / "full.zarr"
         spec = make_store(full, args.full, full=True)
         compare("full store", full, spec)
-        ours, before = alternate(full, previous_store_module(args.previous))
+        stores = {current: full}
+        for commit in args.previous:
+            module = previous_store_module(commit)
+            stores[module] = Path(tmp) / f"full-{commit}.zarr"
+            make_store(stores[module], args.full, full=True, module=module)
+        times = alternate(stores)
         scale = PER / spec.n_points
-        print(f"full store ({spec.n_points} points): fivdisc {ours * scale:.3g} s, fivdisc at "
-              f"{args.previous} {before * scale:.3g} s per {PER:,} points; ratio "
-              f"{ours / before:.3g}")
+        ours = times.pop(current)
+        for commit, before in zip(args.previous, times.values(), strict=True):
+            print(f"full store ({spec.n_points} points): fivdisc {ours * scale:.3g} s, fivdisc "
+                  f"at {commit} {before * scale:.3g} s per {PER:,} points (each on the store "
+                  f"it writes); ratio {ours / before:.3g}")
         big = Path(tmp) / "big.zarr"
         make_store(big, 300, full=False)
         print(f"empty 300 x 300 store: fivdisc {fivdisc_check(big):.3g} s")

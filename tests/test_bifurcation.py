@@ -314,38 +314,54 @@ def _outcome(i: int) -> PointOutcome:
 
 
 def test_section_chunks_are_checksummed_and_recomputed(tmp_path) -> None:
+    import zarr
+
     path = tmp_path / "s.zarr"
     with store_lock(path):
         SweepStore.open(path, STORED).write([_outcome(i) for i in range(3)])
     reference = open_sweep(path)
     np.testing.assert_array_equal(reference["phi_dot_maxima_count"], [1, 2, 3])
     np.testing.assert_array_equal(reference["phi_dot_maxima"].values[2, :3], [20, 21, 22])
-    (path / "phi_dot_maxima" / "c" / "1" / "0").unlink()  # a lost chunk reads as NaN
-    (path / "phi_dot_maxima_count" / "c" / "2").write_bytes(b"garbage")
-    health = verify_store(path)
-    np.testing.assert_array_equal(health.complete, [True, False, False])
+    # point 1's values lost (read as NaN), its checksum left as it was
+    zarr.open_array(path / "phi_dot_maxima", mode="r+")[1] = np.full(5, np.nan)
+    np.testing.assert_array_equal(verify_store(path).complete, [True, False, True])
+    # the counts' chunk (all three points) damaged
+    (path / "phi_dot_maxima_count" / "c" / "0").write_bytes(b"garbage")
+    np.testing.assert_array_equal(verify_store(path).complete, [False, False, False])
     with store_lock(path):
-        SweepStore.open(path, STORED).write([_outcome(1), _outcome(2)])
+        store = SweepStore.open(path, STORED)
+        assert not store.completed().any()  # and the damaged chunk removed, to be rewritten
+        store.write([_outcome(i) for i in range(3)])
     xr.testing.assert_identical(open_sweep(path), reference)
 
 
-def test_stores_of_format_3_are_read_and_resumed(tmp_path) -> None:
-    """A store written before sections existed is this layout without them."""
+def test_stores_of_format_3_are_read_not_resumed(tmp_path, monkeypatch) -> None:
+    """A store written before sections existed is format 4 without them, one point per
+    chunk: read and verified, not resumed."""
+    from fivdisc.sweep import store as module
+
     plain = Sweep(base=STORED.base, axes=STORED.axes, keep=STORED.keep)
     path = tmp_path / "old.zarr"
+    monkeypatch.setattr(module, "_BLOCK_POINTS", 1)
     with store_lock(path):
         SweepStore.open(path, plain).write(
             [PointOutcome(i, {"max_normal_force": 1.0 + i}) for i in range(2)])
+    monkeypatch.undo()
     meta = path / "zarr.json"
     data = json.loads(meta.read_text())
     data["attributes"]["store_format"] = 3
     del data["attributes"]["sweep_sections"]
     meta.write_text(json.dumps(data))
     assert verify_store(path).healthy
-    assert open_sweep(path)["done"].values.tolist() == [True, True, False]
+    loaded = open_sweep(path)
+    assert loaded["done"].values.tolist() == [True, True, False]
+    np.testing.assert_array_equal(loaded["max_normal_force"].values[:2], [1.0, 2.0])
     with store_lock(path):
         store = SweepStore.open(path, plain)
         np.testing.assert_array_equal(store.completed(), [True, True, False])
+        with pytest.raises(SweepError, match=r"store format 3\); this version reads it but "
+                                             r"resumes only"):
+            store.write([PointOutcome(2, {"max_normal_force": 3.0})])
 
 
 # --- sweep files ------------------------------------------------------------------------------

@@ -105,7 +105,9 @@ def helper_dir(tmp_path_factory) -> Path:
 def _helper_on_path(helper_dir, monkeypatch) -> None:
     # spawned workers inherit sys.path; subprocesses get PYTHONPATH
     monkeypatch.syspath_prepend(str(helper_dir))
-    monkeypatch.setenv("PYTHONPATH", str(helper_dir))
+    # prepended: the fivdisc a PYTHONPATH names (a worktree's) stays the one imported
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(
+        [str(helper_dir), *filter(None, [os.environ.get("PYTHONPATH")])]))
 
 
 @pytest.fixture(scope="module")
@@ -464,18 +466,20 @@ def test_rerun_computes_nothing_and_other_sweeps_are_refused(reference, sweep_fi
     assert "3 points failed" in result.output and "too fast for this test" in result.output
 
 
-def test_damaged_chunks_count_as_not_done(reference, sweep_file, tmp_path) -> None:
+def test_damaged_points_count_as_not_done(reference, sweep_file, tmp_path) -> None:
+    import zarr
+
     store = tmp_path / "damaged.zarr"
     shutil.copytree(reference, store)
 
-    def chunk(name: str, point: int) -> Path:  # one chunk per point, on the 4 x 3 grid
-        return store.joinpath(name, "c", *map(str, np.unravel_index(point, (4, 3))))
+    def tamper(name: str, point: int, value) -> None:  # the checksum left as it was
+        zarr.open_array(store / name, mode="r+")[np.unravel_index(point, (4, 3))] = value
 
-    chunk("done", 1).write_bytes(b"\x28\xb5\x2f")  # cut short
-    chunk("max_normal_force", 2).write_bytes(b"garbage")
-    chunk("done", 3).unlink()  # values written, flag not yet
-    # lost: Zarr reads it as NaN, so only the point's checksum tells
-    chunk("max_normal_force", 4).unlink()
+    tamper("stick_fraction", 1, 0.5)
+    tamper("max_normal_force", 2, 1.0)
+    tamper("done", 3, False)  # values written, flag not yet
+    # lost: Zarr reads a lost chunk as NaN, so only the point's checksum tells
+    tamper("max_normal_force", 4, np.nan)
     expected = np.ones(12, dtype=bool)
     expected[[1, 2, 3, 4]] = False
     np.testing.assert_array_equal(read_mask(store), expected)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -151,7 +152,9 @@ def test_a_dying_cluster_ends_the_sweep_in_one_line_and_keeps_finished_points(
     stay stored and whole."""
     (tmp_path / "dask_helper.py").write_text(SLOW_HELPER, encoding="utf-8")
     (tmp_path / "sweep.toml").write_text(SLOW_SWEEP, encoding="utf-8")
-    monkeypatch.setenv("PYTHONPATH", str(tmp_path))
+    # prepended: the fivdisc a PYTHONPATH names (a worktree's) stays the one imported
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(
+        [str(tmp_path), *filter(None, [os.environ.get("PYTHONPATH")])]))
     store = tmp_path / "s.zarr"
     scheduler_file = tmp_path / "scheduler.json"
     scheduler = _python("-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",

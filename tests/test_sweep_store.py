@@ -68,7 +68,27 @@ def _mask(*indices: int) -> np.ndarray:
 
 
 def _chunk(store: Path, name: str, i: int) -> Path:
+    """Chunk file `i` of a variable (the N points fill one chunk, or N / BLOCK of them)."""
     return store / name / "c" / str(i)
+
+
+def _tamper(store: Path, name: str, i: int, value) -> None:
+    """Change one point's stored value through Zarr, its checksum left as it was."""
+    import zarr
+
+    zarr.open_array(store / name, mode="r+")[i] = value
+
+
+BLOCK = 4  # points per chunk where a test sets it: chunks of points 0-3 and 4-5
+
+
+@pytest.fixture
+def blocks(monkeypatch, tmp_path: Path) -> Path:
+    """A store of chunks of BLOCK points (every store of the test is laid out so)."""
+    from fivdisc.sweep import store
+
+    monkeypatch.setattr(store, "_BLOCK_POINTS", BLOCK)
+    return _store(tmp_path / "b.zarr")
 
 
 # --- checksums -------------------------------------------------------------------------------
@@ -84,14 +104,14 @@ def test_a_complete_store_verifies(store: Path) -> None:
     np.testing.assert_array_equal(data["max_normal_force"].values[[0, 5]], [100.0, 105.0])
 
 
-def test_lost_and_damaged_chunks_fail_their_checksum(store: Path) -> None:
+def test_changed_values_fail_their_checksum(store: Path) -> None:
     # Zarr reads a missing chunk as the fill value, so without checksums point 1 would
     # pass for done with max_normal_force = NaN.
-    _chunk(store, "max_normal_force", 1).unlink()
-    _chunk(store, "checksum", 2).unlink()
-    _chunk(store, "separated", 4).unlink()  # True, read back as the fill value False
-    _chunk(store, "error", FAILED).write_bytes(b"garbage")
-    _chunk(store, "done", 5).unlink()  # values written, flag not yet: incomplete, not damaged
+    _tamper(store, "max_normal_force", 1, np.nan)
+    _tamper(store, "checksum", 2, 0)
+    _tamper(store, "separated", 4, False)  # True, read back as the fill value False
+    _tamper(store, "error", FAILED, "")
+    _tamper(store, "done", 5, False)  # values written, flag not yet: incomplete, not damaged
     health = verify_store(store)
     np.testing.assert_array_equal(health.complete, _mask(0))
     np.testing.assert_array_equal(health.damaged, _mask(1, 2, FAILED, 4))
@@ -100,16 +120,48 @@ def test_lost_and_damaged_chunks_fail_their_checksum(store: Path) -> None:
     np.testing.assert_array_equal(open_sweep(store)["done"].values, _mask(0))
 
 
-def test_a_lost_chunk_equal_to_the_fill_value_loses_nothing(store: Path) -> None:
-    # Point 1 did not separate (False, the fill value): Zarr may not even write that chunk.
-    _chunk(store, "separated", 1).unlink(missing_ok=True)
-    assert verify_store(store).complete.all()
+def test_a_lost_chunk_equal_to_the_fill_value_loses_nothing(blocks: Path) -> None:
+    # Points 4 and 5 did not fail (their error "" is the fill value): Zarr does not even
+    # write their chunk.
+    assert _chunk(blocks, "error", 0).exists() and not _chunk(blocks, "error", 1).exists()
+    assert verify_store(blocks).complete.all()
 
 
-def test_a_chunk_copied_from_another_point_fails(store: Path) -> None:
-    for name in ("max_normal_force", "separated", "checksum"):
-        _chunk(store, name, 2).write_bytes(_chunk(store, name, 0).read_bytes())
-    np.testing.assert_array_equal(verify_store(store).damaged, _mask(2))
+def test_a_lost_or_damaged_chunk_loses_its_points_and_a_rerun_recomputes_them(
+        blocks: Path) -> None:
+    reference = open_sweep(blocks)
+    _chunk(blocks, "max_normal_force", 1).unlink()
+    _chunk(blocks, "error", 0).write_bytes(b"garbage")
+    health = verify_store(blocks)
+    np.testing.assert_array_equal(health.damaged, _mask(*range(N)))
+    # The damaged chunk is removed before the rerun writes into it (Zarr would read it
+    # first, to write a point's part); only its points are recomputed.
+    with store_lock(blocks):
+        target = SweepStore.open(blocks, SPEC)
+        assert not target.completed().any()
+        assert not _chunk(blocks, "error", 0).exists()
+        target.write([_outcome(i) for i in range(N)])
+    assert verify_store(blocks).healthy
+    xr.testing.assert_identical(open_sweep(blocks), reference)
+
+
+def test_a_chunk_copied_from_other_points_fails(blocks: Path) -> None:
+    # Zarr stores an edge chunk whole: chunk 0's copy decodes as points 4 and 5.
+    for name in ("max_normal_force", "separated", "checksum", "error", "done"):
+        if _chunk(blocks, name, 0).exists():
+            _chunk(blocks, name, 1).write_bytes(_chunk(blocks, name, 0).read_bytes())
+    np.testing.assert_array_equal(verify_store(blocks).damaged, _mask(4, 5))
+
+
+def test_points_written_a_few_at_a_time_fill_their_chunks(tmp_path: Path, blocks: Path
+                                                           ) -> None:
+    # A sweep writes the points that finished in the last second, each write into the
+    # chunks that hold them; the result is the store of one write.
+    path = tmp_path / "parts.zarr"
+    for part in ([5], [0, 2], [1, 3, 4]):
+        _store(path, part)
+    xr.testing.assert_identical(open_sweep(path).drop_attrs(), open_sweep(blocks).drop_attrs())
+    assert verify_store(path).complete.all()
 
 
 # --- damaged metadata ------------------------------------------------------------------------
@@ -177,8 +229,42 @@ def test_a_store_of_an_older_format_is_refused(store: Path) -> None:
     data = json.loads(meta.read_text())
     del data["attributes"]["store_format"]
     meta.write_text(json.dumps(data))
-    with pytest.raises(SweepError, match="store format 1, this version writes 4"):
+    with pytest.raises(SweepError, match="store format 1, this version writes 5"):
         verify_store(store)
+
+
+def test_a_store_of_one_point_per_chunk_is_read_and_verified_not_resumed(
+        tmp_path: Path, monkeypatch) -> None:
+    # Format 4, as earlier versions of fivdisc wrote it: one point per chunk.
+    from fivdisc.sweep import store as module
+
+    monkeypatch.setattr(module, "_BLOCK_POINTS", 1)
+    path = _store(tmp_path / "old.zarr")
+    monkeypatch.undo()
+    assert len(list((path / "max_normal_force" / "c").iterdir())) == N - 1  # FAILED's is NaN
+    meta = path / "zarr.json"
+    data = json.loads(meta.read_text())
+    data["attributes"]["store_format"] = 4
+    meta.write_text(json.dumps(data))
+    reference = open_sweep(_store(tmp_path / "new.zarr"))
+    health = verify_store(path)
+    assert health.healthy and health.complete.all()
+    np.testing.assert_array_equal(health.failed, _mask(FAILED))
+    _tamper(path, "max_normal_force", 2, 1.0)
+    np.testing.assert_array_equal(verify_store(path).damaged, _mask(2))
+    _tamper(path, "max_normal_force", 2, 102.0)
+    xr.testing.assert_identical(open_sweep(path).drop_attrs(), reference.drop_attrs())
+    # complete: a rerun (as `fivdisc bifurcation` does before drawing) computes nothing
+    report = run_sweep(SPEC, path, workers=1, progress=False)
+    assert (report.already_done, report.computed) == (N, 0)
+    # a point missing: refused before any work, the store left as it was
+    _tamper(path, "done", 5, False)
+    files = sorted((f, f.read_bytes()) for f in path.rglob("*") if f.is_file())
+    with pytest.raises(SweepError, match=r"old.zarr holds one point per chunk \(store format "
+                                         r"4\); this version reads it but resumes only stores "
+                                         r"of format 5: rerun the sweep into a new store$"):
+        run_sweep(SPEC, path, workers=1, progress=False)
+    assert sorted((f, f.read_bytes()) for f in path.rglob("*") if f.is_file()) == files
 
 
 # --- one coordinator per store ---------------------------------------------------------------
@@ -249,8 +335,8 @@ def test_verify_command(store: Path) -> None:
     assert result.exit_code == 0, result.output
     assert result.stdout == (f"{store}: 6 points: 6 complete and verified (1 of them failed "
                              "runs), 0 not computed, 0 damaged\n")
-    _chunk(store, "max_normal_force", 4).unlink()
-    _chunk(store, "done", 5).unlink()
+    _tamper(store, "max_normal_force", 4, np.nan)
+    _tamper(store, "done", 5, False)
     result = CliRunner().invoke(cli, ["sweep", "--verify", str(store)])
     assert result.exit_code == 1
     assert "4 complete and verified (1 of them failed runs), 1 not computed, 1 damaged" in \
@@ -284,3 +370,35 @@ def test_verify_of_something_else_is_one_line(tmp_path: Path) -> None:
         result = CliRunner().invoke(cli, ["sweep", "--verify", str(target)])
         assert result.exit_code == 2 and time.perf_counter() - start < 5.0
         assert result.stderr.count("\n") == 1 and words in result.stderr
+
+
+# --- chunks of many points -------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("shape", "max_points"), [
+    ((300, 300), []), ((5000,), []), ((1000, 10), []), ((2, 3, 4), []), ((7, 400, 3), []),
+    ((300, 300), [1000]), ((40,), [200_000]),
+])
+def test_a_chunk_is_a_run_of_at_most_1024_consecutive_points(shape, max_points) -> None:
+    from fivdisc.sweep.store import _point_chunks
+
+    chunks = _point_chunks(shape, max_points)
+    size = int(np.prod(chunks))
+    # as many points as fit, under both bounds (a section's values: 8 bytes each)
+    bound = min(1024, max(1, 2**20 // (8 * max([1, *max_points]))))
+    assert size <= bound and (size == int(np.prod(shape)) or size > bound // 2)
+    # consecutive in C order: whole axes after the last one cut, one point before it
+    cut = [k for k, (c, n) in enumerate(zip(chunks, shape, strict=True)) if c < n]
+    if cut:
+        assert all(c == 1 for c in chunks[:cut[-1]])
+
+
+def test_a_grid_of_300_by_300_is_stored_in_100_chunks_per_variable(tmp_path: Path) -> None:
+    import zarr
+
+    spec = Sweep(base=SPEC.base, axes={"slider.normal_damping": "0.1:1.0:300",
+                                       "speed.value": "1.0:30.0:300"}, keep=["separated"])
+    with store_lock(tmp_path / "big.zarr"):
+        SweepStore.open(tmp_path / "big.zarr", spec)
+    for name in ("separated", "error", "checksum", "done"):
+        assert zarr.open_array(tmp_path / "big.zarr" / name, mode="r").chunks == (3, 300)

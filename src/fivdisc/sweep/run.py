@@ -318,7 +318,8 @@ def run_sweep(
     Raises
     ------
     SweepError
-        Bad `workers`; a store holding another sweep or in use by another coordinator;
+        Bad `workers`; a store holding another sweep, in use by another coordinator or
+        of an earlier format with points missing (it is read, not written);
         no connection to `scheduler`, or the cluster lost during the sweep (finished
         points stay stored; rerunning resumes).
     KeyboardInterrupt
@@ -349,6 +350,8 @@ def run_sweep(
             todo = deque(int(i) for i in range(spec.n_points) if not done[i])
             already = spec.n_points - len(todo)
             failed = target.errors(done)
+            if todo and target.refusal:
+                raise SweepError(target.refusal)
             if todo:
                 if pool is None:
                     # Compiled here once (with a notice), the workers load it from the cache.

@@ -24,16 +24,26 @@ Layout (one Zarr v3 group, written through xarray, with consolidated metadata so
                 fivdisc_kind = "sweep", sweep_definition, sweep_hash (canonical JSON of the
                 sweep and its SHA-256), sweep_mode, sweep_axes, sweep_shape,
                 sweep_variables (the checksummed ones, in order), sweep_sections (JSON:
-                every section's settings), fivdisc_version, store_format (format 3 is
-                this layout without sections and sweep_sections; it is read as such)
+                every section's settings), fivdisc_version, store_format (5; formats 3
+                and 4 are read and verified, not resumed: see below)
 
 Points are numbered in C order over the axes (the first axis varies slowest). Every data
-variable has chunks of one point (a section's: all values of one point), so writing a
-point touches only its own chunk files (each replaced atomically by Zarr's local
-store). Values, ``error`` and ``checksum`` are written before ``done``. A point is
-complete only if its ``done`` chunk says so and its values read back to its checksum:
-Zarr reads a lost chunk file as the fill value, so without the checksum a deleted chunk
-would pass for data.
+variable has chunks of a block of consecutive points (see :func:`_point_chunks`: up to
+1024 points; a section's: all values of those points), so that a check opens one file
+per block and variable, not per point. Writing points rewrites the chunks that hold them
+(Zarr reads the rest of the chunk, and its local store replaces the file atomically), so
+an interrupted write leaves every chunk old or new. Values, ``error`` and ``checksum``
+are written before ``done``. A point is complete only if its ``done`` flag says so and
+its values read back to its checksum: Zarr reads a lost chunk file as the fill value, so
+without the checksum a deleted chunk would pass for data. A chunk that no longer decodes
+is removed when the sweep is resumed (:meth:`SweepStore.completed`): its points are
+recomputed, and Zarr could not write a point into it.
+
+Formats 3 and 4 held one point per chunk (3: without sections and ``sweep_sections``);
+they are read and verified, never repaired or written (a sweep writing into them would
+mix two layouts): :meth:`SweepStore.open` opens them as they are, with a
+:attr:`~SweepStore.refusal` that :meth:`SweepStore.write` and
+:func:`~fivdisc.sweep.run_sweep` raise when a point is missing.
 
 One coordinator writes a store at a time: :func:`store_lock` holds a lock file next
 to the store (``STORE.lock``, next to where a symbolic link leads, through ``filelock``)
@@ -55,6 +65,7 @@ is seen.
 
 from __future__ import annotations
 
+import contextlib
 import datetime
 import hashlib
 import json
@@ -92,9 +103,16 @@ __all__ = [
 
 DIM = "point"
 #: Version of the layout above; stores of another version are refused.
-STORE_FORMAT = 4
-# Format 3 is format 4 without sections (and without the sweep_sections attribute).
-_READABLE_FORMATS = (3, STORE_FORMAT)
+STORE_FORMAT = 5
+# Formats 3 and 4 kept one point per chunk (3: without sections and the sweep_sections
+# attribute); they are read and verified, not resumed.
+_READABLE_FORMATS = (3, 4, STORE_FORMAT)
+# A chunk holds up to this many points, and no more than _BLOCK_BYTES of a section's
+# values: a store's check opens one file per chunk (a file open costs about as much as
+# decoding a thousand values), a damaged chunk loses its points, and writing a point
+# rewrites its chunks whole.
+_BLOCK_POINTS = 1024
+_BLOCK_BYTES = 1 << 20
 _STRING = np.dtypes.StringDType()
 _BRIEF_CHARS = 160
 
@@ -156,6 +174,19 @@ def dims_of(sweep: Sweep) -> tuple[str, ...]:
     return tuple(sweep.axes) if sweep.mode == "grid" else (DIM,)
 
 
+def _point_chunks(shape: Sequence[int], max_points: Sequence[int] = ()) -> tuple[int, ...]:
+    """The chunk shape over a sweep's points: whole trailing axes while they fit in
+    ``_BLOCK_POINTS`` points (fewer if a section's values, `max_points` per point, would
+    exceed ``_BLOCK_BYTES``), then a slice of the next axis; so that a chunk is a run
+    of consecutive points in C order, the order they are computed in."""
+    room = min(_BLOCK_POINTS, max(1, _BLOCK_BYTES // (8 * max([1, *max_points]))))
+    chunks = []
+    for n in reversed(shape):
+        chunks.append(max(1, min(n, room)))
+        room = max(1, room // chunks[-1])
+    return tuple(reversed(chunks))
+
+
 def checksummed(sweep: Sweep) -> list[str]:
     """The variables a point's checksum covers, in order: the reductions, each section's
     values and count, then ``error``."""
@@ -192,8 +223,8 @@ def _template(sweep: Sweep) -> xr.Dataset:
 
     dims, shape = dims_of(sweep), sweep.shape
     # One dask chunk per variable: only metadata is written (compute=False), and a graph
-    # of one task per point costs seconds per 10,000 points; Zarr's chunks of one point
-    # are set by _encoding.
+    # of one task per chunk costs seconds per 10,000 chunks; Zarr's chunks are set by
+    # _encoding.
     chunks = shape
     data = {
         r.name: (
@@ -401,20 +432,21 @@ def _layout(attrs: dict[str, Any]) -> _Layout:
     shape = (tuple(len(v) for v in axes.values()) if mode == "grid"
              else (len(next(iter(axes.values()))),))
     names = {spec.partition(":")[2] or spec: spec for spec in stored(definition["keep"])}
-    ones = (1,) * len(shape)
+    block = (_point_chunks(shape, [s["max_points"] for s in sections])
+            if attrs.get("store_format") == STORE_FORMAT else (1,) * len(shape))
     arrays: dict[str, tuple[tuple[int, ...], tuple[int, ...] | None, np.dtype | None]] = {
-        name: (shape, ones, np.dtype(BUILTIN[spec].dtype if spec in BUILTIN else "float64"))
+        name: (shape, block, np.dtype(BUILTIN[spec].dtype if spec in BUILTIN else "float64"))
         for name, spec in names.items()
     }
     variables = list(names)
     for section in sections:
         name, points = section["name"], section["max_points"]
-        arrays[name] = ((*shape, points), (*ones, points), np.dtype("float64"))
-        arrays[f"{name}_count"] = (shape, ones, np.dtype("int32"))
+        arrays[name] = ((*shape, points), (*block, points), np.dtype("float64"))
+        arrays[f"{name}_count"] = (shape, block, np.dtype("int32"))
         variables += [name, f"{name}_count"]
     variables.append("error")
-    arrays |= {"error": (shape, ones, _STRING), "checksum": (shape, ones, np.dtype("uint64")),
-               "done": (shape, ones, np.dtype(bool))}
+    arrays |= {"error": (shape, block, _STRING), "checksum": (shape, block, np.dtype("uint64")),
+               "done": (shape, block, np.dtype(bool))}
     if mode == "grid":
         coords = {key: _coordinate(values) for key, values in axes.items()}
     else:
@@ -529,7 +561,7 @@ def _chunk_files(directory: str, depth: int) -> list[tuple[tuple[int, ...], str]
     return level
 
 
-_READ = 1 << 16  # bytes per read: a chunk of one point is far smaller
+_READ = 1 << 16  # bytes per read: most chunks are smaller, larger ones are read on
 
 
 def _read(file: str) -> bytes | None:
@@ -556,8 +588,9 @@ def _read(file: str) -> bytes | None:
 
 def _decode_distinct(decode: Callable[[list[bytes]], np.ndarray], raws: list[bytes]
                      ) -> tuple[np.ndarray, np.ndarray]:
-    """(rows, index) of chunk files' bytes: every distinct content decoded once (a flag,
-    an empty error or a repeated value is the same few bytes at every point), and per
+    """(rows, index) of chunk files' bytes: every distinct content decoded once (in a
+    store of one point per chunk, a flag, an empty error or a repeated value is the same
+    few bytes at every point), and per
     chunk the row of its values in `rows`, -1 for a chunk that does not decode."""
     distinct = dict.fromkeys(raws)
     contents = list(distinct)
@@ -580,20 +613,47 @@ def _decode_distinct(decode: Callable[[list[bytes]], np.ndarray], raws: list[byt
     return rows, np.array([distinct[raw] for raw in raws], dtype=np.intp)
 
 
-def _readable(array: Any, grid: Sequence[int], points: np.ndarray | None = None
-              ) -> tuple[np.ndarray, np.ndarray]:
-    """(values, readable) of a Zarr array of one-point chunks over the sweep's `grid`,
-    one row per point in C order (the order of the sweep's points): values
-    ``(n_points,)``, or ``(n_points, max_points)`` for a section's. Only the points
-    flagged in `points` (default: all) are read; the others get the fill value.
+def _blocks(mask: np.ndarray, grid: Sequence[int], block: Sequence[int]) -> np.ndarray:
+    """Per chunk of shape `block` over `grid` (C order), whether any point of `mask` (flat,
+    one entry per point) lies in it."""
+    counts = [-(-n // b) for n, b in zip(grid, block, strict=True)]
+    padded = np.zeros([c * b for c, b in zip(counts, block, strict=True)], dtype=bool)
+    padded[tuple(slice(0, n) for n in grid)] = mask.reshape(grid)
+    split = padded.reshape([x for cb in zip(counts, block, strict=True) for x in cb])
+    return split.any(axis=tuple(range(1, 2 * len(grid), 2))).ravel()
+
+
+def _points(per_chunk: np.ndarray, grid: Sequence[int], block: Sequence[int]) -> np.ndarray:
+    """Per point (flat, C order), the entry of its chunk: `per_chunk` has one row per
+    chunk of shape `block` over `grid` (C order), the chunk's values in that row's
+    leading ``block`` axes (anything after them is kept)."""
+    counts = [-(-n // b) for n, b in zip(grid, block, strict=True)]
+    k = len(grid)
+    tail = per_chunk.shape[1 + k:]
+    spread = per_chunk.reshape(*counts, *block, *tail)
+    # (c0, ..., b0, ...) -> (c0, b0, c1, b1, ...): the padded grid in C order
+    order = [x for pair in zip(range(k), range(k, 2 * k), strict=True) for x in pair]
+    padded = spread.transpose(*order, *range(2 * k, 2 * k + len(tail)))
+    padded = padded.reshape(*[c * b for c, b in zip(counts, block, strict=True)], *tail)
+    return padded[tuple(slice(0, n) for n in grid)].reshape(math.prod(grid), *tail)
+
+
+def _readable(array: Any, grid: Sequence[int], points: np.ndarray | None = None,
+              undecodable: list[str] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(values, readable) of a Zarr array over the sweep's `grid` (chunked by blocks of
+    points, see :func:`_point_chunks`, or one point per chunk in formats 3 and 4), one row
+    per point in C order (the order of the sweep's points): values ``(n_points,)``, or
+    ``(n_points, max_points)`` for a section's. Only the chunks holding a point flagged
+    in `points` (default: all) are read; the other points get the fill value. The chunk
+    files that do not decode are appended to `undecodable`.
 
     Chunk files are listed and decoded here rather than read through Zarr, which costs
     about half a millisecond per chunk (its store reads one file per asynchronous task,
-    and a chunk never written costs as much): the checks of a 300 x 300 sweep took over
-    a minute (see ``benchmarks/bench_store.py``). Only the chunk files listed are opened,
-    and each distinct content is decoded once. Arrays of other codecs are read through
-    Zarr. A chunk cut short or damaged fails to decode (the error type varies with the
-    codec, hence the broad excepts); such points are unreadable.
+    and a chunk never written costs as much): the checks of a 300 x 300 sweep of one
+    point per chunk took over a minute (see ``benchmarks/bench_store.py``). Only the
+    chunk files listed are opened, and each distinct content is decoded once. Arrays of
+    other codecs are read through Zarr. A chunk cut short or damaged fails to decode (the
+    error type varies with the codec, hence the broad excepts); its points are unreadable.
     """
     n = math.prod(grid)
     tail = array.shape[len(grid):]
@@ -608,25 +668,40 @@ def _readable(array: Any, grid: Sequence[int], points: np.ndarray | None = None
             except Exception:
                 ok[i] = False
         return values, ok
+    chunk = tuple(array.chunks)
+    block = chunk[:len(grid)]
+    counts = tuple(-(-g // b) for g, b in zip(grid, block, strict=True))
     directory = os.path.join(str(array.store_path.store.root), array.path, "c")
     listed = _chunk_files(directory, array.ndim)
-    chunks = np.array([chunk for chunk, _ in listed], dtype=np.int64).reshape(-1, array.ndim)
-    # Chunks of this array's shape only (a section's values: one chunk per point).
-    own = (chunks[:, len(grid):] == 0).all(axis=1) & (chunks[:, :len(grid)] < grid).all(axis=1)
+    chunks = np.array([c for c, _ in listed], dtype=np.int64).reshape(-1, array.ndim)
+    # Chunks of this array's shape only (a section's values: one chunk along its own axis).
+    own = (chunks[:, len(grid):] == 0).all(axis=1) & (chunks[:, :len(grid)] < counts).all(axis=1)
     at = np.flatnonzero(own)
-    index = np.ravel_multi_index(tuple(chunks[at, :len(grid)].T), tuple(grid))
-    keep = wanted[index]
-    found, raws = [], []
+    index = np.ravel_multi_index(tuple(chunks[at, :len(grid)].T), counts)
+    # Every chunk is read when the undecodable ones are sought (they are removed before
+    # a resumed sweep writes into them).
+    keep = (np.ones(len(index), dtype=bool) if undecodable is not None
+            else _blocks(wanted, grid, block)[index])
+    found, files, raws = [], [], []
     for i, k in zip(index[keep].tolist(), at[keep].tolist(), strict=True):
         raw = _read(listed[k][1])
         if raw is not None:  # None: removed since listed, read as the fill value
             found.append(i)
+            files.append(listed[k][1])
             raws.append(raw)
     rows, row = _decode_distinct(decode, raws)
     found = np.array(found, dtype=np.intp)
     good = row >= 0
-    values[found[good]] = rows[row[good]].reshape(-1, *tail)
-    ok[found[~good]] = False
+    if undecodable is not None:
+        undecodable += [file for file, g in zip(files, good.tolist(), strict=True) if not g]
+    per_chunk = np.full((math.prod(counts), *chunk), array.fill_value, dtype=array.dtype)
+    if good.any():
+        per_chunk[found[good]] = rows[row[good]]
+    readable = np.ones(math.prod(counts), dtype=bool)
+    readable[found[~good]] = False
+    values[wanted] = _points(per_chunk, grid, block)[wanted]
+    ok = _points(np.broadcast_to(readable.reshape(-1, *(1,) * len(block)),
+                                 (len(readable), *block)), grid, block).copy()
     return values, ok
 
 
@@ -665,17 +740,18 @@ class StoreHealth:
         return not self.damaged.any() and not self.broken
 
 
-def _inspect(path: Path, attrs: dict[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray,
-                                                          list[str]]:
+def _inspect(path: Path, attrs: dict[str, Any], undecodable: list[str] | None = None
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
     """(complete, damaged, failed, broken variables) of a store; see :class:`StoreHealth`.
-    The masks are flat, one entry per point."""
+    The masks are flat, one entry per point. The chunk files that do not decode are
+    appended to `undecodable`."""
     layout = _layout(attrs)
     arrays, broken = _arrays(path, layout)
     broken += _attribute_damage(attrs, layout)
     grid = layout.grid
     n = math.prod(grid)
     if "done" in arrays:
-        done, done_readable = _readable(arrays["done"], grid)
+        done, done_readable = _readable(arrays["done"], grid, None, undecodable)
         done = np.asarray(done, dtype=bool)
     else:
         done, done_readable = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
@@ -684,7 +760,8 @@ def _inspect(path: Path, attrs: dict[str, Any]) -> tuple[np.ndarray, np.ndarray,
     columns = {}
     for name in [*layout.variables, "checksum"]:
         if name in arrays:
-            columns[name], ok = _readable(arrays[name], grid, done & done_readable)
+            columns[name], ok = _readable(arrays[name], grid, done & done_readable,
+                                          undecodable)
             readable &= ok
         else:
             readable[:] = False
@@ -869,18 +946,24 @@ class SweepStore:
         The store's directory.
     sweep
         The sweep it holds.
+    refusal
+        Why points cannot be written into it, in one line ("" if they can): a store of
+        an earlier format is read, not written.
     """
 
-    def __init__(self, path: Path, sweep: Sweep) -> None:
+    def __init__(self, path: Path, sweep: Sweep, refusal: str = "") -> None:
         self.path = path
         self.sweep = sweep
+        self.refusal = refusal
 
     @classmethod
     def open(cls, path: str | PathLike[str], sweep: Sweep) -> SweepStore:
         """Create the store for `sweep`, or reopen it to resume; hold :func:`store_lock`.
 
         Variables whose metadata is lost or damaged are rebuilt empty (their points are
-        then incomplete and get recomputed).
+        then incomplete and get recomputed). A store of an earlier format (one point per
+        chunk) is opened as it is, to be read: its :attr:`refusal` says why it is not
+        written.
 
         Raises
         ------
@@ -902,12 +985,29 @@ class SweepStore:
                 f"{path} holds a different sweep (its definition differs in: {fields}); "
                 "write to a new store, or delete this one to start over"
             )
+        if attrs["store_format"] != STORE_FORMAT:
+            # Repairing or writing it from this sweep's layout would mix two layouts.
+            return cls(path, sweep, (
+                f"{path} holds one point per chunk (store format {attrs['store_format']}); "
+                f"this version reads it but resumes only stores of format {STORE_FORMAT}: "
+                "rerun the sweep into a new store"))
         _repair(path, sweep, attrs)
         return cls(path, sweep)
 
     def completed(self) -> np.ndarray:
-        """Which points are complete (see :func:`read_mask`)."""
-        return read_mask(self.path)
+        """Which points are complete (see :func:`read_mask`). In a store that is written,
+        chunk files that do not decode are removed: their points are not complete, and
+        writing one of them again would read the rest of its chunk first."""
+        undecodable: list[str] = []
+        complete = _inspect(self.path, _read_attrs(self.path),
+                            None if self.refusal else undecodable)[0]
+        for file in undecodable:
+            if os.path.isdir(file) and not os.path.islink(file):
+                shutil.rmtree(file, ignore_errors=True)
+            else:
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(file)
+        return complete
 
     def errors(self, points: np.ndarray) -> dict[int, str]:
         """Point index -> error message of the failed ones among `points`."""
@@ -919,7 +1019,14 @@ class SweepStore:
 
         Points with consecutive indices along the last axis are written by one region
         write each.
+
+        Raises
+        ------
+        SweepError
+            The store is not written (see :attr:`refusal`).
         """
+        if self.refusal:
+            raise SweepError(self.refusal)
         shape = self.sweep.shape
         outcomes = sorted(outcomes, key=lambda o: o.index)
         runs: list[list[PointOutcome]] = []
@@ -967,10 +1074,11 @@ class SweepStore:
 
 
 def _encoding(sweep: Sweep, names: Sequence[str]) -> dict[str, dict[str, Any]]:
-    """Chunks of one point: one value, or a section's values of one point."""
-    ndim = len(sweep.shape)
+    """Chunks of a block of points (see :func:`_point_chunks`): their values, or a
+    section's values of those points."""
     lengths = {s.name: s.max_points for s in sweep.sections}
-    return {name: {"chunks": (1,) * ndim + ((lengths[name],) if name in lengths else ())}
+    block = _point_chunks(sweep.shape, list(lengths.values()))
+    return {name: {"chunks": block + ((lengths[name],) if name in lengths else ())}
             for name in names}
 
 
