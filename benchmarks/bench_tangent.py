@@ -127,6 +127,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--processes", type=int, default=0,
                         help="also repeat the one-vector figure in N fresh processes")
+    parser.add_argument("--rounds", type=int, default=7,
+                        help="rounds of the per-step figures (default 7)")
+    parser.add_argument("--no-exponent", action="store_true",
+                        help="leave out the largest exponent's figure")
     parser.add_argument("--one", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     case = load_case(DIRECTORY / "fig08.toml")
@@ -134,8 +138,9 @@ def main() -> None:
         per_step(case, repeat=3, counts=(1,))
         return
     print(f"machine: {platform.machine()}, {os.cpu_count()} cores, {platform.python_version()}")
-    per_step(case)
-    exponent(case)
+    per_step(case, repeat=args.rounds)
+    if not args.no_exponent:
+        exponent(case)
     if args.processes:
         processes(args.processes)
 

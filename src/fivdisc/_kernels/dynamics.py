@@ -684,13 +684,15 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
         fi = wk[r_fq, i]
         l2 = li * li
         dwc += gi * v[i]
-        dwcd0 += gi * v[half + i] + gpi * y[half + i] * dpsi
+        dwcd0 += gi * v[half + i]
         dgpq += gpi * v[i]
         dgpqd += gpi * v[half + i] - l2 * gi * y[half + i] * dpsi
         dl2gq += l2 * (gi * v[i] + gpi * y[i] * dpsi)
         ds_gf += (gpi * dpsi * fi + gi * dfi) * minv
         ds_ggp += (gpi * gpi - l2 * gi * gi) * minv
     dwc += gpq * dpsi
+    # g'.qdot dpsi, the rest of dwcd0, is known from the state's evaluation.
+    dwcd0 += gpqd * dpsi
     dgpq -= l2gq * dpsi
     ds_gg = 2.0 * s_ggp * dpsi
     ds_ggp *= dpsi
@@ -737,10 +739,11 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
         a = shh * f
         da = shh * df
         out[half + n] = 0.0
+    # da g' + a dg' - dsn g - sn dg with dg = g' dpsi, dg' = -l^2 g dpsi, by the
+    # coefficients of g' and g.
+    cgp = da - sn * dpsi
+    adpsi = a * dpsi
     for i in range(n):
-        gi = wk[0, i]
-        gpi = wk[r_gp, i]
-        dgi = gpi * dpsi
-        dgpi = -disc[D_L, i] * disc[D_L, i] * gi * dpsi
-        out[half + i] = (out[half + i] + da * gpi + a * dgpi - dsn * gi - sn * dgi) * (
-            disc[D_MINV, i])
+        li = disc[D_L, i]
+        out[half + i] = (out[half + i] + cgp * wk[r_gp, i]
+                         - (dsn + adpsi * (li * li)) * wk[0, i]) * disc[D_MINV, i]
