@@ -62,7 +62,7 @@ def _figure(walls, bases) -> str:
     return f"{min(walls) / min(bases):5.2f} x (median of the rounds {_median(ratios):.2f})"
 
 
-def per_step(case, repeat=7, counts=(1, 2, 4)) -> None:
+def per_step(case, repeat=7, counts=(1, 2, 4), span=SPAN) -> None:
     """Runs with 0 and ``counts`` vectors interleaved, ``repeat`` rounds."""
     model = build_model(case)
     y0 = initial_state(model)
@@ -73,14 +73,14 @@ def per_step(case, repeat=7, counts=(1, 2, 4)) -> None:
     bases = []
     steps = None
     for _ in range(repeat):
-        base, steps = _run(model, y0, SPAN, 0, cap)
+        base, steps = _run(model, y0, span, 0, cap)
         bases.append(base)
         for n in walls:
-            wall, steps_n = _run(model, y0, SPAN, n, cap)
+            wall, steps_n = _run(model, y0, span, n, cap)
             assert steps_n == steps
             walls[n].append(wall)
     base = min(bases)
-    print(f"plain run, {SPAN:g} s, step cap {cap:.2e} s: {base:.3f} s, {steps} steps, "
+    print(f"plain run, {span:g} s, step cap {cap:.2e} s: {base:.3f} s, {steps} steps, "
           f"{1e6 * base / steps:.2f} us/step (fastest of {repeat})")
     for n, values in walls.items():
         print(f"  {n} tangent vector(s): {_figure(values, bases)} the plain run per step "
@@ -127,6 +127,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--processes", type=int, default=0,
                         help="also repeat the one-vector figure in N fresh processes")
+    parser.add_argument("--span", type=float, default=SPAN,
+                        help=f"simulated time of each timed run [s] (default {SPAN:g})")
     parser.add_argument("--rounds", type=int, default=7,
                         help="rounds of the per-step figures (default 7)")
     parser.add_argument("--no-exponent", action="store_true",
@@ -138,7 +140,7 @@ def main() -> None:
         per_step(case, repeat=3, counts=(1,))
         return
     print(f"machine: {platform.machine()}, {os.cpu_count()} cores, {platform.python_version()}")
-    per_step(case, repeat=args.rounds)
+    per_step(case, repeat=args.rounds, span=args.span)
     if not args.no_exponent:
         exponent(case)
     if args.processes:

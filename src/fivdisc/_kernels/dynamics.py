@@ -210,6 +210,11 @@ def solve_small(a, r0, m):
         a[r0 + c, m] = acc / a[r0 + c, c]
 
 
+# The small system's solve inlined where it runs every evaluation (several sliders'
+# normal forces, ``_contacts``): a call passes the work array field by field.
+_solve_inline = njit(cache=True, inline="always")(solve_small.py_func)
+
+
 @njit(cache=True, inline="always")
 def _disc_force(i, x, om, om2, omd, eps, damped, disc, half):
     """Force on modal coordinate ``i`` from its stiffness, the spin and the damping at
@@ -500,7 +505,7 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
                            + sm * gpq * wk[aux + A_FPHI, j] / sl[S_INERTIA, j])
         else:
             wk[row, ns] = wk[aux + A_KNOWN, j] + sm * gf + sm * gpq * omd
-    solve_small(wk, r_sys, ns)
+    _solve_inline(wk, r_sys, ns)
 
     for k in range(ns):
         if ph[k] == SEPARATION:
