@@ -18,8 +18,9 @@ floors of the same sliders (each as a ratio to one slider's), each with its
 least-squares slope and the largest deviation from that line. Each slider count's cost
 is also given as a ratio to its own structured floor, and that ratio relative to one
 slider's (the growth of the kernel over the growth of its floor). The sliders' runs are
-timed in turns with their floors, the fastest of ``--rounds`` rounds; ``--only PART``
-prints one part.
+timed in turns with their floors (runs without output), the fastest of ``--rounds``
+rounds, by the wall time or with ``--cpu-time`` by the CPU time; ``--only PART`` prints
+one part.
 """
 
 from __future__ import annotations
@@ -179,6 +180,9 @@ def main() -> None:
                         help="print only this part")
     parser.add_argument("--rounds", type=int, default=25,
                         help="rounds of the sliders' part (default 25)")
+    parser.add_argument("--cpu-time", action="store_true",
+                        help="time the sliders' part by this thread's CPU time, which a "
+                        "machine busy with other work disturbs far less than the wall time")
     args = parser.parse_args()
     only = args.only
     if only in (None, "fig10"):
@@ -186,7 +190,7 @@ def main() -> None:
     if only in (None, "coordinates"):
         coordinates()
     if only in (None, "sliders"):
-        sliders(args.rounds)
+        sliders(args.rounds, time.thread_time if args.cpu_time else time.perf_counter)
 
 
 def fig10_case() -> None:
@@ -230,14 +234,24 @@ def coordinates() -> None:
     _slope("coordinate", coords, costs)
 
 
-def _floor_once(op, start, duration: float) -> tuple[float, int]:
-    """Wall time per accepted step [s] of one run of a linear floor, and its steps."""
-    t0 = time.perf_counter()
+def _floor_once(op, start, duration: float, clock) -> float:
+    """Time per accepted step [s] of one run of a linear floor by ``clock``."""
+    t0 = clock()
     steps = _dopri_linear(op, start.copy(), duration, 1e-6, 1e-9)
-    return (time.perf_counter() - t0) / steps, steps
+    return (clock() - t0) / steps
 
 
-def sliders(rounds: int) -> None:
+def _kernel_once(model, y0, duration: float, clock) -> float:
+    """Time per accepted step [s] of the kernel's run without output by ``clock``."""
+    from fivdisc.integration import Integration
+
+    run = Integration(model, y0, duration=duration)
+    t0 = clock()
+    run.run_to(duration)
+    return (clock() - t0) / int(run.ist[1])
+
+
+def sliders(rounds: int, clock) -> None:
     """Per step, 1 to 8 sliders against the floors of the same sliders.
 
     On a shared machine the kernel and its floors are timed in turns, ``rounds`` times
@@ -247,7 +261,8 @@ def sliders(rounds: int) -> None:
     import tomllib
 
     from bench_family import _spread
-    from fivdisc import Case, build_model, examples, simulate
+    from fivdisc import Case, build_model, examples
+    from fivdisc.simulate import initial_state
 
     # Short runs, many rounds: the more of them, the likelier some ran undisturbed.
     span = 1.0
@@ -259,24 +274,25 @@ def sliders(rounds: int) -> None:
     counts = [1, 2, 4, 8]
     cases = {s: Case(**_spread(fig04, s)) for s in counts}
     ops = {}
+    models = {}
     for s, case in cases.items():
         model = build_model(case)
+        models[s] = (model, initial_state(model))
         start = np.zeros(model.state_size)
         start[: model.n] = 1e-5
         start[model.n + 2 * s : 2 * model.n + 2 * s] = 1e-2
         ops[s] = (start, _operators(model))
-        simulate(case.replace({"simulation.duration": 0.01}))
+        _kernel_once(*models[s], 0.01, clock)
         for op in ops[s][1].values():
             _dopri_linear(op, start.copy(), 1e-3, 1e-6, 1e-9)
     kernel = {s: [] for s in counts}
     floors = {s: {name: [] for name in ops[s][1]} for s in counts}
     for _ in range(rounds):
         for s in counts:
-            attrs = simulate(cases[s]).dataset.attrs
-            kernel[s].append(attrs["wall_time"] / attrs["n_steps"])
+            kernel[s].append(_kernel_once(*models[s], span, clock))
             start, named = ops[s]
             for name, op in named.items():
-                floors[s][name].append(_floor_once(op, start, span)[0])
+                floors[s][name].append(_floor_once(op, start, span, clock))
     cost = {s: min(kernel[s]) for s in counts}
     floor = {s: {name: min(c) for name, c in floors[s].items()} for s in counts}
     for s in counts:

@@ -182,8 +182,8 @@ def new_work(mdl, like):
 def solve_small(a, r0, m):
     """Solve the ``m x m`` system in rows ``r0 .. r0 + m`` of ``a`` (matrix in columns
     ``0 .. m``, right-hand side in column m) in place, the solution left in column m, by
-    Gaussian elimination with partial pivoting on the real parts. For m = 1 it is one
-    division."""
+    Gaussian elimination with partial pivoting on the real parts (what it leaves below
+    the diagonal is scratch). For m = 1 it is one division."""
     for c in range(m):
         piv = c
         best = abs(a[r0 + c, c].real)
@@ -689,15 +689,13 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
         fi = wk[r_fq, i]
         l2 = li * li
         dwc += gi * v[i]
-        dwcd0 += gi * v[half + i]
+        dwcd0 += gi * v[half + i] + gpi * y[half + i] * dpsi
         dgpq += gpi * v[i]
         dgpqd += gpi * v[half + i] - l2 * gi * y[half + i] * dpsi
         dl2gq += l2 * (gi * v[i] + gpi * y[i] * dpsi)
         ds_gf += (gpi * dpsi * fi + gi * dfi) * minv
         ds_ggp += (gpi * gpi - l2 * gi * gi) * minv
     dwc += gpq * dpsi
-    # g'.qdot dpsi, the rest of dwcd0, is known from the state's evaluation.
-    dwcd0 += gpqd * dpsi
     dgpq -= l2gq * dpsi
     ds_gg = 2.0 * s_ggp * dpsi
     ds_ggp *= dpsi
@@ -744,11 +742,10 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
         a = shh * f
         da = shh * df
         out[half + n] = 0.0
-    # da g' + a dg' - dsn g - sn dg with dg = g' dpsi, dg' = -l^2 g dpsi, by the
-    # coefficients of g' and g.
-    cgp = da - sn * dpsi
-    adpsi = a * dpsi
     for i in range(n):
-        li = disc[D_L, i]
-        out[half + i] = (out[half + i] + cgp * wk[r_gp, i]
-                         - (dsn + adpsi * (li * li)) * wk[0, i]) * disc[D_MINV, i]
+        gi = wk[0, i]
+        gpi = wk[r_gp, i]
+        dgi = gpi * dpsi
+        dgpi = -disc[D_L, i] * disc[D_L, i] * gi * dpsi
+        out[half + i] = (out[half + i] + da * gpi + a * dgpi - dsn * gi - sn * dgi) * (
+            disc[D_MINV, i])
