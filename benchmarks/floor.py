@@ -15,7 +15,12 @@ Run ``python benchmarks/floor.py``: it prints, for the paper's Fig. 10 case (one
 10 kHz output, each as a ratio to both floors measured in the same run; then the cost per
 step at 7 to 23 modal coordinates against the floors, and at 1 to 8 sliders beside the
 floors of the same sliders (each as a ratio to one slider's), each with its
-least-squares slope and the largest deviation from that line.
+least-squares slope and the largest deviation from that line. Each slider count's cost
+is also given as a ratio to its own structured floor, and that ratio relative to one
+slider's (the growth of the kernel over the growth of its floor). The sliders' runs are
+timed in turns with their floors (runs without output), the fastest of ``--rounds``
+rounds, by the wall time or with ``--cpu-time`` by the CPU time; ``--only PART`` prints
+one part.
 """
 
 from __future__ import annotations
@@ -168,7 +173,28 @@ def _slope(label: str, x: list[int], cost: list[float]) -> None:
 
 
 def main() -> None:
-    from bench_family import CASES, _spread, per_step
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--only", choices=("fig10", "coordinates", "sliders"),
+                        help="print only this part")
+    parser.add_argument("--rounds", type=int, default=25,
+                        help="rounds of the sliders' part (default 25)")
+    parser.add_argument("--cpu-time", action="store_true",
+                        help="time the sliders' part by this thread's CPU time, which a "
+                        "machine busy with other work disturbs far less than the wall time")
+    args = parser.parse_args()
+    only = args.only
+    if only in (None, "fig10"):
+        fig10_case()
+    if only in (None, "coordinates"):
+        coordinates()
+    if only in (None, "sliders"):
+        sliders(args.rounds, time.thread_time if args.cpu_time else time.perf_counter)
+
+
+def fig10_case() -> None:
+    from bench_family import CASES, per_step
     from fivdisc import Case, build_model
 
     fig10 = CASES["fig10"]
@@ -186,6 +212,13 @@ def main() -> None:
     print(f"cost of the 10 kHz output: "
           f"{100 * (kernel['10 kHz output']['cost'] / kernel['no output']['cost'] - 1):+.0f} %")
 
+
+def coordinates() -> None:
+    from bench_family import CASES, per_step
+    from fivdisc import Case, build_model
+
+    fig10 = CASES["fig10"]
+    quiet = {**fig10, "simulation": {**fig10["simulation"], "output_rate": 0.1}}
     print("== modal coordinates (modes (0, l), l <= L; Fig. 10 case, 5 s, no output)")
     coords, costs = [], []
     for top in (3, 5, 7, 9, 11):
@@ -200,24 +233,79 @@ def main() -> None:
               f"{c / f['structured'][0]:.2f} x structured, {c / f['dense'][0]:.2f} x dense floor")
     _slope("coordinate", coords, costs)
 
-    print("== sliders (Fig. 4 parameters, steady sliding, 5 s)")
+
+def _floor_once(op, start, duration: float, clock) -> float:
+    """Time per accepted step [s] of one run of a linear floor by ``clock``."""
+    t0 = clock()
+    steps = _dopri_linear(op, start.copy(), duration, 1e-6, 1e-9)
+    return (clock() - t0) / steps
+
+
+def _kernel_once(model, y0, duration: float, clock) -> float:
+    """Time per accepted step [s] of the kernel's run without output by ``clock``."""
+    from fivdisc.integration import Integration
+
+    run = Integration(model, y0, duration=duration)
+    t0 = clock()
+    run.run_to(duration)
+    return (clock() - t0) / int(run.ist[1])
+
+
+def sliders(rounds: int, clock) -> None:
+    """Per step, 1 to 8 sliders against the floors of the same sliders.
+
+    On a shared machine the kernel and its floors are timed in turns, ``rounds`` times
+    (each round: every slider count's run, then its floors' runs), and each figure is
+    the fastest of the rounds: the work is deterministic, so the fastest run is the one
+    least disturbed by the rest of the machine (the advice of :mod:`timeit`)."""
     import tomllib
 
-    from fivdisc import examples
+    from bench_family import _spread
+    from fivdisc import Case, build_model, examples
+    from fivdisc.simulate import initial_state
 
+    # Short runs, many rounds: the more of them, the likelier some ran undisturbed.
+    span = 1.0
+    print(f"== sliders (Fig. 4 parameters, steady sliding, {span:g} s; fastest of {rounds} "
+          "rounds)")
     fig04 = tomllib.loads(examples.path("fig04").read_text())
-    fig04["simulation"] = {**fig04.get("simulation", {}), "duration": 5.0, "output_rate": 100.0}
+    fig04["simulation"] = {**fig04.get("simulation", {}), "duration": span,
+                           "output_rate": 100.0}
     counts = [1, 2, 4, 8]
-    per = per_step({str(s): _spread(fig04, s) for s in counts})
-    # The floors grow with the sliders too: what the kernel's growth compares with.
-    floors = {s: floor_cost(build_model(Case(**_spread(fig04, s))), 5.0) for s in counts}
+    cases = {s: Case(**_spread(fig04, s)) for s in counts}
+    ops = {}
+    models = {}
+    for s, case in cases.items():
+        model = build_model(case)
+        models[s] = (model, initial_state(model))
+        start = np.zeros(model.state_size)
+        start[: model.n] = 1e-5
+        start[model.n + 2 * s : 2 * model.n + 2 * s] = 1e-2
+        ops[s] = (start, _operators(model))
+        _kernel_once(*models[s], 0.01, clock)
+        for op in ops[s][1].values():
+            _dopri_linear(op, start.copy(), 1e-3, 1e-6, 1e-9)
+    kernel = {s: [] for s in counts}
+    floors = {s: {name: [] for name in ops[s][1]} for s in counts}
+    for _ in range(rounds):
+        for s in counts:
+            kernel[s].append(_kernel_once(*models[s], span, clock))
+            start, named = ops[s]
+            for name, op in named.items():
+                floors[s][name].append(_floor_once(op, start, span, clock))
+    cost = {s: min(kernel[s]) for s in counts}
+    floor = {s: {name: min(c) for name, c in floors[s].items()} for s in counts}
     for s in counts:
-        cost = per[str(s)]["cost"]
-        grows = ", ".join(f"{name} floor {f[0] * 1e6:.2f} us ({f[0] / floors[1][name][0]:.2f} x)"
-                          for name, f in floors[s].items())
-        print(f"{s} slider(s): {cost * 1e6:.2f} us per step "
-              f"({cost / per['1']['cost']:.2f} x one slider); {grows}")
-    _slope("slider", counts, [per[str(s)]["cost"] for s in counts])
+        grows = ", ".join(f"{name} floor {f * 1e6:.2f} us ({f / floor[1][name]:.2f} x)"
+                          for name, f in floor[s].items())
+        own = cost[s] / floor[s]["structured"]
+        rounds_own = sorted(k / f for k, f in zip(kernel[s], floors[s]["structured"],
+                                                  strict=True))
+        print(f"{s} slider(s): {cost[s] * 1e6:.2f} us per step ({cost[s] / cost[1]:.2f} x one "
+              f"slider); {grows}; {own:.2f} x its structured floor (median of the rounds "
+              f"{rounds_own[len(rounds_own) // 2]:.2f}), "
+              f"{own * floor[1]['structured'] / cost[1]:.2f} x relative to one slider's")
+    _slope("slider", counts, [cost[s] for s in counts])
 
 
 if __name__ == "__main__":
