@@ -76,7 +76,8 @@ def test_each_function_of_a_share_is_typed_with_all_its_arguments():
     types = split_compile.callee_types(run)
     dispatchers = split_compile._dispatchers()
     shares = (split_compile.HELPER_KERNELS + split_compile.OWN_KERNELS
-              + split_compile.TANGENT_HELPER_KERNELS + split_compile.TANGENT_OWN_KERNELS)
+              + split_compile.TANGENT_HELPER_KERNELS + split_compile.TANGENT_OWN_KERNELS
+              + split_compile.RHS_HELPER_KERNELS + split_compile.RHS_OWN_KERNELS)
     assert set(types) == set(shares) == set(dispatchers)
     for name in shares:
         parameters = inspect.signature(dispatchers[name].py_func).parameters
@@ -109,15 +110,56 @@ def test_a_cold_compile_with_tangents_loads_the_helpers_parts_from_the_cache(tmp
         [sys.executable, "-c", _COLD_TANGENTS.format(case=json.dumps(_CASE))], env=env,
         check=True, capture_output=True, text=True, timeout=1800)
     cold = json.loads(out.stdout)
-    stages = {"_stages", "tangent_stages"}  # one function, a signature for each kernel
-    for name in set(split_compile.HELPER_KERNELS + split_compile.TANGENT_HELPER_KERNELS) - stages:
+    # One function, a signature for each kernel: the plain kernel's loaded from the
+    # helper's part, the tangent kernel's compiled here.
+    stages = {"_stages", "tangent_stages"}
+    switch = {"_switch", "complex_switch"}
+    # The saltation's callees come with it, never called here on their own.
+    for name in set(split_compile.HELPER_KERNELS) - stages:
         assert cold["stats"][name] == [1, 0], name
+    assert cold["stats"]["saltation"] == [1, 0]
+    assert cold["stats"]["_event_rate"] == [0, 0]
     for name in set(split_compile.OWN_KERNELS + split_compile.TANGENT_OWN_KERNELS) - stages:
         assert cold["stats"][name] == [0, 1], name
-    # The plain kernel's loaded from the helper's part, the tangent kernel's compiled here.
     assert cold["stats"]["_stages"] == [1, 1]
+    for name in switch:  # the plain kernel's compiled here, the complex one's not at all
+        assert cold["stats"][name] == [0, 1], name
     here = lyapunov(Case(**_CASE), transient=0.0, duration=0.01, interval=0.005, seed=1)
     assert np.array_equal(np.asarray(cold["exponents"]), here.exponents)
+
+
+_COLD_RHS = """
+import json
+from fivdisc import split_compile
+from fivdisc.analysis.stability import linear_stability
+from fivdisc.case import Case
+result = linear_stability(Case())
+stats = {name: [sum(d.stats.cache_hits.values()), sum(d.stats.cache_misses.values())]
+         for name, d in split_compile._dispatchers().items()}
+print(json.dumps({"stats": stats, "eigenvalues": [[z.real, z.imag] for z in
+                                                  result.eigenvalues.tolist()]}))
+"""
+
+
+@pytest.mark.skipif(split_compile._cores() < 2, reason="the split needs two cores")
+def test_a_cold_stability_loads_the_helper_s_jacobian_from_the_cache(tmp_path):
+    """fivdisc stability from an empty cache: the right-hand side compiled here, its
+    complex-step Jacobian by the helper, for the types the equilibrium then calls them
+    with; the eigenvalues are this process's own."""
+    from fivdisc.analysis.stability import linear_stability
+    from fivdisc.case import Case
+
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    out = subprocess.run([sys.executable, "-c", _COLD_RHS], env=env, check=True,
+                         capture_output=True, text=True, timeout=900)
+    cold = json.loads(out.stdout)
+    for name in split_compile.RHS_HELPER_KERNELS:
+        assert cold["stats"][name] == [1, 0], name
+    for name in split_compile.RHS_OWN_KERNELS:
+        assert cold["stats"][name] == [0, 1], name
+    here = linear_stability(Case()).eigenvalues
+    assert np.array_equal(np.array(cold["eigenvalues"]),
+                          np.column_stack([here.real, here.imag]))
 
 
 def test_a_failing_helper_costs_time_only(monkeypatch):
