@@ -11,9 +11,9 @@ which loads the helper's part from the cache instead of compiling it
 
 The kernel with tangent vectors (``run`` given ``tan``) is a second compilation of
 ``run``, longer still, which adds the tangent code. It is shared out the same way: the
-helper compiles the saltation at a switch (:func:`fivdisc._kernels.tangent.saltation`),
-the event's rate and the switch on the complex state first, which the saltation calls;
-this process the tangent step and the stages that feed it. A command that will need the
+helper compiles the saltation at a switch (:func:`fivdisc._kernels.tangent.saltation`,
+with the switch on the complex state), this process the tangent step and the stages that
+feed it. A command that will need the
 tangent kernel after a plain run (``orbit``, ``lyapunov``, ``continue``, ``warmup``)
 says so to :func:`compile_split` (``tangents=True``): the helper then goes on with the
 tangent kernel's share as soon as it has done the plain one's, while this process still
@@ -53,13 +53,11 @@ __all__ = ["HELPER_KERNELS", "OWN_KERNELS", "RHS_HELPER_KERNELS", "RHS_OWN_KERNE
 HELPER_KERNELS = ("_stages", "_complete_rows", "locate", "_event_at", "_sample_states",
                   "dense_coefficients")
 OWN_KERNELS = ("_switch",)
-#: The same for the kernel with tangent vectors, in the order compiled: the saltation's
-#: callees on the complex state (``complex_switch`` is ``_switch`` for it) before the
-#: saltation, so that their common callees compile once. ``tangent_stages`` is
-#: ``_stages`` for the stage states that the tangent step reads; ``step`` last, so that
-#: the right-hand side on a complex state at a real time that both shares call may be in
-#: the cache by then, from whichever process needed it first.
-TANGENT_HELPER_KERNELS = ("_event_rate", "complex_switch", "saltation")
+#: The same for the kernel with tangent vectors, in the order compiled: ``tangent_stages``
+#: is ``_stages`` for the stage states that the tangent step reads; ``step`` last, so that
+#: the right-hand side on a complex state at a real time, which the saltation calls too,
+#: may be in the cache by then when the helper began first.
+TANGENT_HELPER_KERNELS = ("saltation",)
 TANGENT_OWN_KERNELS = ("tangent_stages", "interpolate", "accept", "step")
 #: The same for the right-hand side that the sliding equilibrium (``fivdisc stability``)
 #: calls from Python, and its Jacobian by the complex step: two compilations of the
@@ -83,7 +81,6 @@ def _dispatchers() -> dict[str, Any]:
             "locate": integrate.locate, "_event_at": integrate._event_at,
             "_sample_states": integrate._sample_states,
             "dense_coefficients": dopri5.dense_coefficients, "_switch": switch._switch,
-            "_event_rate": tangent._event_rate, "complex_switch": switch._switch,
             "saltation": tangent.saltation, "tangent_stages": integrate._stages,
             "step": tangent.step, "interpolate": tangent.interpolate,
             "accept": tangent.accept}
@@ -140,15 +137,8 @@ def callee_types(run: Integration) -> dict[str, tuple]:
     tangent.scratch.compile(scratch_args)
     tsc = tangent.scratch.overloads[scratch_args].signature.return_type
     tcx, tvn, tvs, ypre, sgpre, tys, twk = (tsc[i] for i in (0, 3, 4, 9, 10, 11, 12))
-    ycx, dycx, wkcx = tcx
-    kcx, evcx = tsc[1], tsc[2]
     row = typeof(run.k[0])
-    c16 = types.complex128
-    # The saltation's own arrays (ev_t, ev_i, ist, fst) are new, C-contiguous.
     found.update({
-        "_event_rate": (i8, f8, ypre, ph, sgpre, mdl, tsc, vec, f8),
-        "complex_switch": (i8, i8, c16, ycx, ph, sgpre, ph, ev_prev, mdl, wkcx, dycx, kcx,
-                           evcx, vec, typeof(np.empty((1, 1), np.int64)), ivec, vec),
         "saltation": (i8, i8, f8, ypre, ph, sgpre, ev_prev, y, ph, sg, row, mdl, tv, tk, tsc),
         "tangent_stages": (f8, f8, y, ph, sg, mdl, mat, k, vec, vec, vec, tys, twk),
         "step": (f8, f8, ph, sg, mdl, tys, twk, tv, tk, tvn, tvs, tcx),
