@@ -29,8 +29,10 @@ def warmup() -> None:
     start = time.perf_counter()
     with compile_notice(integrate.run, what="simulation kernel"):
         # The helper goes on with the tangent kernel's share while this process
-        # finishes the plain kernel.
-        compile_split(default_run(), tangents=True)
+        # finishes the plain kernel (compiled by the run's first call).
+        run = default_run()
+        compile_split(run, tangents=True)
+        run.advance(0.0)
         warm_kernel()
     warm_tangent_kernel(show=True)
     # The right-hand side's Jacobian at the sliding equilibrium (fivdisc stability).
