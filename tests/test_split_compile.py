@@ -167,3 +167,9 @@ def test_a_failing_helper_costs_time_only(monkeypatch):
     plain.run_to(0.01)
     assert run.t == plain.t == pytest.approx(0.01)
     assert np.array_equal(run.y, plain.y)
+    # A helper asked to go on with the tangent kernel's share that ended in the plain one
+    # is not waited for (the kernel with tangents then compiles in this process).
+    assert split_compile.compile_split(_integration(), tangents=True)
+    assert split_compile._pending is not None
+    assert split_compile.compile_split_tangents()
+    assert split_compile._pending is None

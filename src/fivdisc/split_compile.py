@@ -203,6 +203,7 @@ class _Helper:
             env=env, text=True)
         self.deadline = time.monotonic() + _HELPER_TIMEOUT
         self._lines: queue.Queue[str] = queue.Queue()
+        self._ended = False
         self._reader = threading.Thread(target=self._read, daemon=True)
         self._reader.start()
 
@@ -213,13 +214,14 @@ class _Helper:
 
     def wait_for(self, share: str) -> None:
         """Until the helper has compiled `share`, has ended, or has had its time."""
-        while True:
+        while not self._ended:
             try:
                 line = self._lines.get(timeout=max(0.0, self.deadline - time.monotonic()))
             except queue.Empty:
                 self.stop()
                 return
-            if line in (share, ""):
+            self._ended = line == ""
+            if line == share:
                 return
 
     def stop(self) -> None:
@@ -228,6 +230,7 @@ class _Helper:
         self.process.wait()
         self._reader.join()  # at the pipe's end, now that the helper has ended
         self.process.stdout.close()
+        self._ended = True
 
 
 # A helper that compiles the tangent kernel's share for a later compile_split_tangents;
