@@ -77,6 +77,7 @@ def test_each_function_of_a_share_is_typed_with_all_its_arguments():
     dispatchers = split_compile._dispatchers()
     shares = (split_compile.HELPER_KERNELS + split_compile.OWN_KERNELS
               + split_compile.TANGENT_HELPER_KERNELS + split_compile.TANGENT_OWN_KERNELS
+              + split_compile.TANGENT_HELPER_AHEAD
               + split_compile.RHS_HELPER_KERNELS + split_compile.RHS_OWN_KERNELS)
     assert set(types) == set(shares) == set(dispatchers)
     for name in shares:
@@ -117,6 +118,9 @@ def test_a_cold_compile_with_tangents_loads_the_helpers_parts_from_the_cache(tmp
         assert cold["stats"][name] == [0, 1], name
     # The plain kernel's loaded from the helper's part, the tangent kernel's compiled here.
     assert cold["stats"]["_stages"] == [1, 1]
+    # The right-hand side on a real state compiled here (for the plain kernel's switch),
+    # on a complex one at a real time loaded: the helper compiled it first.
+    assert cold["stats"]["jvp_rhs"] == [1, 1]
     here = lyapunov(Case(**_CASE), transient=0.0, duration=0.01, interval=0.005, seed=1)
     assert np.array_equal(np.asarray(cold["exponents"]), here.exponents)
 

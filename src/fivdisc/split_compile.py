@@ -45,8 +45,9 @@ if TYPE_CHECKING:
     from fivdisc.integration import Integration
 
 __all__ = ["HELPER_KERNELS", "OWN_KERNELS", "RHS_HELPER_KERNELS", "RHS_OWN_KERNELS",
-           "TANGENT_HELPER_KERNELS", "TANGENT_OWN_KERNELS", "callee_types", "compile_split",
-           "compile_split_rhs", "compile_split_tangents", "default_run"]
+           "TANGENT_HELPER_AHEAD", "TANGENT_HELPER_KERNELS", "TANGENT_OWN_KERNELS",
+           "callee_types", "compile_split", "compile_split_rhs", "compile_split_tangents",
+           "default_run"]
 
 #: What the helper process compiles, and what this process compiles before ``run``: two
 #: shares of about the same compile time.
@@ -59,6 +60,12 @@ OWN_KERNELS = ("_switch",)
 #: may be in the cache by then when the helper began first.
 TANGENT_HELPER_KERNELS = ("saltation",)
 TANGENT_OWN_KERNELS = ("tangent_stages", "interpolate", "accept", "step")
+#: What the helper compiles first of the tangent kernel's share when it did the plain
+#: kernel's share before, while this process still compiles the plain kernel: the
+#: right-hand side on a complex state at a real time (``jvp_rhs``, ``evaluate`` for it),
+#: which the saltation and this process's ``step`` both call; ``step`` then finds it in
+#: the cache instead of compiling it a second time.
+TANGENT_HELPER_AHEAD = ("jvp_rhs",)
 #: The same for the right-hand side that the sliding equilibrium (``fivdisc stability``)
 #: calls from Python, and its Jacobian by the complex step: two compilations of the
 #: right-hand side, on a real and on a complex state.
@@ -81,7 +88,8 @@ def _dispatchers() -> dict[str, Any]:
             "locate": integrate.locate, "_event_at": integrate._event_at,
             "_sample_states": integrate._sample_states,
             "dense_coefficients": dopri5.dense_coefficients, "_switch": switch._switch,
-            "saltation": tangent.saltation, "tangent_stages": integrate._stages,
+            "jvp_rhs": dynamics.evaluate, "saltation": tangent.saltation,
+            "tangent_stages": integrate._stages,
             "step": tangent.step, "interpolate": tangent.interpolate,
             "accept": tangent.accept}
 
@@ -139,6 +147,8 @@ def callee_types(run: Integration) -> dict[str, tuple]:
     tcx, tvn, tvs, ypre, sgpre, tys, twk = (tsc[i] for i in (0, 3, 4, 9, 10, 11, 12))
     row = typeof(run.k[0])
     found.update({
+        # tangent.jvp: the side a numpy bool, the complex-step arrays of the scratch
+        "jvp_rhs": (f8, tcx[0], ph, sg, types.boolean, mdl, tcx[2], tcx[1]),
         "saltation": (i8, i8, f8, ypre, ph, sgpre, ev_prev, y, ph, sg, row, mdl, tv, tk, tsc),
         "tangent_stages": (f8, f8, y, ph, sg, mdl, mat, k, vec, vec, vec, tys, twk),
         "step": (f8, f8, ph, sg, mdl, tys, twk, tv, tk, tvn, tvs, tcx),
@@ -184,7 +194,8 @@ def helper_main(*shares: str) -> None:
     the default case's types into the cache, printing its name after it."""
     types = callee_types(default_run("tangents" in shares))
     for name in shares:
-        _compile(_SHARES[name], types)
+        ahead = TANGENT_HELPER_AHEAD if name == "tangents" and "plain" in shares else ()
+        _compile(ahead + _SHARES[name], types)
         print(name, flush=True)
 
 
