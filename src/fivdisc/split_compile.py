@@ -13,11 +13,11 @@ The kernel with tangent vectors (``run`` given ``tan``) is a second compilation 
 ``run``, longer still, which adds the tangent code. It is shared out the same way: the
 helper compiles the saltation at a switch (:func:`fivdisc._kernels.tangent.saltation`,
 with the switch on the complex state), this process the tangent step and the stages that
-feed it. A command that will need the
-tangent kernel after a plain run (``orbit``, ``lyapunov``, ``continue``, ``warmup``)
-says so to :func:`compile_split` (``tangents=True``): the helper then goes on with the
-tangent kernel's share as soon as it has done the plain one's, while this process still
-compiles the plain kernel, and :func:`compile_split_tangents` later finds it under way
+feed it. A command that will need the tangent kernel after a plain run (``orbit``,
+``lyapunov``, ``continue``, ``warmup``) says so to :func:`compile_split`
+(``tangents=True``): the helper then goes on with the tangent kernel's share as soon as
+it has done the plain one's, while this process still compiles the plain kernel, and
+:func:`compile_split_tangents` later finds it under way
 (``benchmarks/bench_first_use.py`` times the commands). :func:`compile_split_rhs` does
 the same for the right-hand side on a real state and its complex-step Jacobian, which the
 sliding equilibrium (``fivdisc stability``) calls from Python.
