@@ -76,7 +76,9 @@ def test_each_function_of_a_share_is_typed_with_all_its_arguments():
     types = split_compile.callee_types(run)
     dispatchers = split_compile._dispatchers()
     shares = (split_compile.HELPER_KERNELS + split_compile.OWN_KERNELS
-              + split_compile.TANGENT_HELPER_KERNELS + split_compile.TANGENT_OWN_KERNELS)
+              + split_compile.TANGENT_HELPER_KERNELS + split_compile.TANGENT_OWN_KERNELS
+              + split_compile.TANGENT_HELPER_AHEAD
+              + split_compile.RHS_HELPER_KERNELS + split_compile.RHS_OWN_KERNELS)
     assert set(types) == set(shares) == set(dispatchers)
     for name in shares:
         parameters = inspect.signature(dispatchers[name].py_func).parameters
@@ -116,8 +118,45 @@ def test_a_cold_compile_with_tangents_loads_the_helpers_parts_from_the_cache(tmp
         assert cold["stats"][name] == [0, 1], name
     # The plain kernel's loaded from the helper's part, the tangent kernel's compiled here.
     assert cold["stats"]["_stages"] == [1, 1]
+    # The right-hand side on a real state compiled here (for the plain kernel's switch),
+    # on a complex one at a real time loaded: the helper compiled it first.
+    assert cold["stats"]["jvp_rhs"] == [1, 1]
     here = lyapunov(Case(**_CASE), transient=0.0, duration=0.01, interval=0.005, seed=1)
     assert np.array_equal(np.asarray(cold["exponents"]), here.exponents)
+
+
+_COLD_RHS = """
+import json
+from fivdisc import split_compile
+from fivdisc.analysis.stability import linear_stability
+from fivdisc.case import Case
+result = linear_stability(Case())
+stats = {name: [sum(d.stats.cache_hits.values()), sum(d.stats.cache_misses.values())]
+         for name, d in split_compile._dispatchers().items()}
+print(json.dumps({"stats": stats, "eigenvalues": [[z.real, z.imag] for z in
+                                                  result.eigenvalues.tolist()]}))
+"""
+
+
+@pytest.mark.skipif(split_compile._cores() < 2, reason="the split needs two cores")
+def test_a_cold_stability_loads_the_helper_s_jacobian_from_the_cache(tmp_path):
+    """fivdisc stability from an empty cache: the right-hand side compiled here, its
+    complex-step Jacobian by the helper, for the types the equilibrium then calls them
+    with; the eigenvalues are this process's own."""
+    from fivdisc.analysis.stability import linear_stability
+    from fivdisc.case import Case
+
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    out = subprocess.run([sys.executable, "-c", _COLD_RHS], env=env, check=True,
+                         capture_output=True, text=True, timeout=900)
+    cold = json.loads(out.stdout)
+    for name in split_compile.RHS_HELPER_KERNELS:
+        assert cold["stats"][name] == [1, 0], name
+    for name in split_compile.RHS_OWN_KERNELS:
+        assert cold["stats"][name] == [0, 1], name
+    here = linear_stability(Case()).eigenvalues
+    assert np.array_equal(np.array(cold["eigenvalues"]),
+                          np.column_stack([here.real, here.imag]))
 
 
 def test_a_failing_helper_costs_time_only(monkeypatch):
@@ -132,3 +171,9 @@ def test_a_failing_helper_costs_time_only(monkeypatch):
     plain.run_to(0.01)
     assert run.t == plain.t == pytest.approx(0.01)
     assert np.array_equal(run.y, plain.y)
+    # A helper asked to go on with the tangent kernel's share that ended in the plain one
+    # is not waited for (the kernel with tangents then compiles in this process).
+    assert split_compile.compile_split(_integration(), tangents=True)
+    assert split_compile._pending is not None
+    assert split_compile.compile_split_tangents()
+    assert split_compile._pending is None

@@ -10,11 +10,17 @@ which loads the helper's part from the cache instead of compiling it
 (``benchmarks/bench_compile.py`` measures the whole).
 
 The kernel with tangent vectors (``run`` given ``tan``) is a second compilation of
-``run``, about as long again, which adds the tangent code. It is shared out the same
-way: the helper compiles the saltation at a switch (:func:`fivdisc._kernels.tangent.
-saltation`, with the switch on the complex state), this process the tangent step and the
-stages that feed it; the plain kernel's parts, when they are not in the cache either,
-first, as above (``benchmarks/bench_first_use.py`` times the commands).
+``run``, longer still, which adds the tangent code. It is shared out the same way: the
+helper compiles the saltation at a switch (:func:`fivdisc._kernels.tangent.saltation`,
+with the switch on the complex state), this process the tangent step and the stages that
+feed it. A command that will need the tangent kernel after a plain run (``orbit``,
+``lyapunov``, ``continue``, ``warmup``) says so to :func:`compile_split`
+(``tangents=True``): the helper then goes on with the tangent kernel's share as soon as
+it has done the plain one's, while this process still compiles the plain kernel, and
+:func:`compile_split_tangents` later finds it under way
+(``benchmarks/bench_first_use.py`` times the commands). :func:`compile_split_rhs` does
+the same for the right-hand side on a real state and its complex-step Jacobian, which the
+sliding equilibrium (``fivdisc stability``) calls from Python.
 
 A cache entry holds one signature, so each function is compiled for the argument types
 ``run`` passes it, :func:`callee_types`. Every case's arrays have the same types, so the
@@ -25,27 +31,48 @@ that it does not happen).
 
 from __future__ import annotations
 
+import atexit
 import os
+import queue
 import subprocess
 import sys
+import threading
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from fivdisc.integration import Integration
 
-__all__ = ["HELPER_KERNELS", "OWN_KERNELS", "TANGENT_HELPER_KERNELS", "TANGENT_OWN_KERNELS",
-           "callee_types", "compile_split", "compile_split_tangents", "default_run"]
+__all__ = ["HELPER_KERNELS", "OWN_KERNELS", "RHS_HELPER_KERNELS", "RHS_OWN_KERNELS",
+           "TANGENT_HELPER_AHEAD", "TANGENT_HELPER_KERNELS", "TANGENT_OWN_KERNELS",
+           "callee_types", "compile_split", "compile_split_rhs", "compile_split_tangents",
+           "default_run"]
 
 #: What the helper process compiles, and what this process compiles before ``run``: two
 #: shares of about the same compile time.
 HELPER_KERNELS = ("_stages", "_complete_rows", "locate", "_event_at", "_sample_states",
                   "dense_coefficients")
 OWN_KERNELS = ("_switch",)
-#: The same for the kernel with tangent vectors (``tangent_stages`` is ``_stages`` for
-#: the stage states that the tangent step reads).
+#: The same for the kernel with tangent vectors, in the order compiled: ``tangent_stages``
+#: is ``_stages`` for the stage states that the tangent step reads; ``step`` last, so that
+#: the right-hand side on a complex state at a real time, which the saltation calls too,
+#: may be in the cache by then when the helper began first.
 TANGENT_HELPER_KERNELS = ("saltation",)
-TANGENT_OWN_KERNELS = ("tangent_stages", "step", "interpolate", "accept")
+TANGENT_OWN_KERNELS = ("tangent_stages", "interpolate", "accept", "step")
+#: What the helper compiles first of the tangent kernel's share when it did the plain
+#: kernel's share before, while this process still compiles the plain kernel: the
+#: right-hand side on a complex state at a real time (``jvp_rhs``, ``evaluate`` for it),
+#: which the saltation and this process's ``step`` both call; ``step`` then finds it in
+#: the cache instead of compiling it a second time.
+TANGENT_HELPER_AHEAD = ("jvp_rhs",)
+#: The same for the right-hand side that the sliding equilibrium (``fivdisc stability``)
+#: calls from Python, and its Jacobian by the complex step: two compilations of the
+#: right-hand side, on a real and on a complex state.
+RHS_HELPER_KERNELS = ("complex_step_jacobian",)
+RHS_OWN_KERNELS = ("new_work", "evaluate")
+_SHARES = {"plain": HELPER_KERNELS, "tangents": TANGENT_HELPER_KERNELS,
+           "rhs": RHS_HELPER_KERNELS}
 
 # The helper is given this long [s] before this process gives up on it and compiles its
 # part itself: only so that a hung helper cannot hang the first simulation.
@@ -53,13 +80,16 @@ _HELPER_TIMEOUT = 600.0
 
 
 def _dispatchers() -> dict[str, Any]:
-    from fivdisc._kernels import dopri5, integrate, switch, tangent
+    from fivdisc._kernels import dopri5, dynamics, integrate, switch, tangent
 
-    return {"_stages": integrate._stages, "_complete_rows": integrate._complete_rows,
+    return {"new_work": dynamics.new_work, "evaluate": dynamics.evaluate,
+            "complex_step_jacobian": dynamics.complex_step_jacobian,
+            "_stages": integrate._stages, "_complete_rows": integrate._complete_rows,
             "locate": integrate.locate, "_event_at": integrate._event_at,
             "_sample_states": integrate._sample_states,
             "dense_coefficients": dopri5.dense_coefficients, "_switch": switch._switch,
-            "saltation": tangent.saltation, "tangent_stages": integrate._stages,
+            "jvp_rhs": dynamics.evaluate, "saltation": tangent.saltation,
+            "tangent_stages": integrate._stages,
             "step": tangent.step, "interpolate": tangent.interpolate,
             "accept": tangent.accept}
 
@@ -68,7 +98,8 @@ def callee_types(run: Integration) -> dict[str, tuple]:
     """The numba argument types with which ``integrate.run``, called on ``run``'s arrays,
     calls each function of :data:`HELPER_KERNELS` and :data:`OWN_KERNELS`, and, if
     ``run`` carries tangent vectors, of :data:`TANGENT_HELPER_KERNELS` and
-    :data:`TANGENT_OWN_KERNELS`.
+    :data:`TANGENT_OWN_KERNELS`; with those of :data:`RHS_HELPER_KERNELS` and
+    :data:`RHS_OWN_KERNELS` as ``fivdisc.start`` calls them on arrays of ``run``'s types.
 
     Arrays that ``run`` passes on are typed from ``run`` itself; those it makes (work
     rows, stage scratch, copies of the phases) are C-contiguous and writable, as
@@ -92,6 +123,10 @@ def callee_types(run: Integration) -> dict[str, tuple]:
     out_y, out_aux = typeof(run.out_y), typeof(run.out_aux)
     none = typeof(None)
     found = {
+        # fivdisc.start: a Python bool for the side, a new work array
+        "new_work": (mdl, y),
+        "evaluate": (f8, y, ph, sg, types.boolean, mdl, mat, vec),
+        "complex_step_jacobian": (f8, y, ph, sg, mdl),
         "_stages": (f8, f8, y, ph, sg, mdl, mat, k, vec, vec, vec, none, none),
         "_complete_rows": (i8, i8, ctl, mdl, mat, vec, vec, ivec, ivec, out_y, out_aux, fst),
         "locate": (i8, f8, f8, f8, f8, f8, f8, mat, ph, sg, mdl, mat, vec, vec, vec, ist),
@@ -112,6 +147,8 @@ def callee_types(run: Integration) -> dict[str, tuple]:
     tcx, tvn, tvs, ypre, sgpre, tys, twk = (tsc[i] for i in (0, 3, 4, 9, 10, 11, 12))
     row = typeof(run.k[0])
     found.update({
+        # tangent.jvp: the side a numpy bool, the complex-step arrays of the scratch
+        "jvp_rhs": (f8, tcx[0], ph, sg, types.boolean, mdl, tcx[2], tcx[1]),
         "saltation": (i8, i8, f8, ypre, ph, sgpre, ev_prev, y, ph, sg, row, mdl, tv, tk, tsc),
         "tangent_stages": (f8, f8, y, ph, sg, mdl, mat, k, vec, vec, vec, tys, twk),
         "step": (f8, f8, ph, sg, mdl, tys, twk, tv, tk, tvn, tvs, tcx),
@@ -151,71 +188,148 @@ def default_run(tangents: bool = False) -> Integration:
     return run
 
 
-def helper_main(tangents: bool = False) -> None:
-    """What the helper process runs: compile :data:`HELPER_KERNELS` (with `tangents`:
-    :data:`TANGENT_HELPER_KERNELS`) for the default case's types into the cache."""
-    run = default_run(tangents)
-    _compile(TANGENT_HELPER_KERNELS if tangents else HELPER_KERNELS, callee_types(run))
+def helper_main(*shares: str) -> None:
+    """What the helper process runs: compile each share (``plain``: :data:`HELPER_KERNELS`,
+    ``tangents``: :data:`TANGENT_HELPER_KERNELS`, ``rhs``: :data:`RHS_HELPER_KERNELS`) for
+    the default case's types into the cache, printing its name after it."""
+    types = callee_types(default_run("tangents" in shares))
+    for name in shares:
+        ahead = TANGENT_HELPER_AHEAD if name == "tangents" and "plain" in shares else ()
+        _compile(ahead + _SHARES[name], types)
+        print(name, flush=True)
 
 
-def _shares(run: Integration) -> list[tuple[bool, tuple[str, ...]]]:
-    """(whether the tangent kernel's, this process's functions) of each share that
-    ``run``'s first call would compile, in the order to compile them."""
-    from fivdisc._kernels import integrate, tangent
-    from fivdisc.compilation import needs_compiling
+class _Helper:
+    """A helper process compiling shares into the cache; it prints a line after each."""
 
-    shares = []
-    if needs_compiling(integrate.run):
-        shares.append((False, OWN_KERNELS))
-    # The saltation is compiled for the kernel with tangents alone.
-    if run.tan is not None and needs_compiling(tangent.saltation):
-        shares.append((True, TANGENT_OWN_KERNELS))
-    return shares
+    def __init__(self, *shares: str) -> None:
+        package_parent = str(Path(__file__).resolve().parents[1])
+        path = os.environ.get("PYTHONPATH")
+        env = {**os.environ,
+               "PYTHONPATH": package_parent + (os.pathsep + path if path else "")}
+        self.process = subprocess.Popen(
+            [sys.executable, "-c", "from fivdisc.split_compile import helper_main; "
+             f"helper_main(*{shares!r})"],
+            stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+            env=env, text=True)
+        self.deadline = time.monotonic() + _HELPER_TIMEOUT
+        self._lines: queue.Queue[str] = queue.Queue()
+        self._ended = False
+        self._reader = threading.Thread(target=self._read, daemon=True)
+        self._reader.start()
+
+    def _read(self) -> None:
+        for line in self.process.stdout:
+            self._lines.put(line.strip())
+        self._lines.put("")  # the helper has ended
+
+    def wait_for(self, share: str) -> None:
+        """Until the helper has compiled `share`, has ended, or has had its time."""
+        while not self._ended:
+            try:
+                line = self._lines.get(timeout=max(0.0, self.deadline - time.monotonic()))
+            except queue.Empty:
+                self.stop()
+                return
+            self._ended = line == ""
+            if line == share:
+                return
+
+    def stop(self) -> None:
+        if self.process.poll() is None:
+            self.process.kill()
+        self.process.wait()
+        self._reader.join()  # at the pipe's end, now that the helper has ended
+        self.process.stdout.close()
+        self._ended = True
 
 
-def compile_split(run: Integration) -> bool:
+# A helper that compiles the tangent kernel's share for a later compile_split_tangents;
+# one that is still at it when the process ends is stopped then.
+_pending: _Helper | None = None
+
+
+@atexit.register
+def _stop_pending() -> None:
+    global _pending
+    if _pending is not None:
+        _pending.stop()
+        _pending = None
+
+
+def compile_split(run: Integration, tangents: bool = False) -> bool:
     """Compile the kernel's parts on two processes before ``run``'s first step, if the
     machine has two cores and the kernel (with tangents, if ``run`` carries them) is not
     in numba's cache; returns whether it did.
 
     ``run.advance`` then compiles ``integrate.run`` itself, taking the parts from memory
     and from the cache. A helper that fails or hangs costs time only: ``run`` compiles
-    what is missing.
+    what is missing. With `tangents` (the caller will need the kernel with tangent
+    vectors next) the helper goes on with that kernel's share meanwhile, for
+    :func:`compile_split_tangents`.
     """
+    global _pending
+    from fivdisc._kernels import integrate, tangent
+    from fivdisc.compilation import needs_compiling
+
     if _cores() < 2:
         return False
-    shares = _shares(run)
-    if not shares:
+    plain = needs_compiling(integrate.run)
+    # The saltation is compiled for the kernel with tangents alone.
+    with_tangents = ((run.tan is not None or tangents) and _pending is None
+                     and needs_compiling(tangent.saltation))
+    if not (plain or with_tangents):
         return False
-    types = callee_types(run)
-    package_parent = str(Path(__file__).resolve().parents[1])
-    path = os.environ.get("PYTHONPATH")
-    env = {**os.environ,
-           "PYTHONPATH": package_parent + (os.pathsep + path if path else "")}
-    for tangents, own in shares:
-        helper = subprocess.Popen(
-            [sys.executable, "-c",
-             f"from fivdisc.split_compile import helper_main; helper_main({tangents})"],
-            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-            env=env)
-        try:
-            _compile(own, types)
-            helper.wait(timeout=_HELPER_TIMEOUT)
-        except subprocess.TimeoutExpired:
-            pass
-        finally:
-            if helper.poll() is None:
-                helper.kill()
-                helper.wait()
+    helper = _Helper(*(["plain"] if plain else []) + (["tangents"] if with_tangents else []))
+    try:
+        if plain:
+            _compile(OWN_KERNELS, callee_types(run))
+            helper.wait_for("plain")
+        if with_tangents and run.tan is None:
+            _pending, helper = helper, None
+        elif with_tangents:
+            _compile(TANGENT_OWN_KERNELS, callee_types(run))
+            helper.wait_for("tangents")
+    finally:
+        if helper is not None:
+            helper.stop()
     return True
 
 
 def compile_split_tangents() -> bool:
     """:func:`compile_split` for the kernel with tangent vectors, for a caller that has no
     run at hand yet (the types are every case's); returns whether it compiled."""
+    global _pending
     from fivdisc._kernels import tangent
     from fivdisc.compilation import needs_compiling
 
+    if _pending is not None:
+        # Started by compile_split(tangents=True): this process's share, then the helper's.
+        helper, _pending = _pending, None
+        try:
+            _compile(TANGENT_OWN_KERNELS, callee_types(default_run(tangents=True)))
+            helper.wait_for("tangents")
+        finally:
+            helper.stop()
+        return True
     if _cores() < 2 or not needs_compiling(tangent.saltation):
         return False
     return compile_split(default_run(tangents=True))
+
+
+def compile_split_rhs() -> bool:
+    """Compile the right-hand side that the sliding equilibrium calls and its complex-step
+    Jacobian on two processes, if the machine has two cores and the Jacobian is not in
+    numba's cache; returns whether it did."""
+    from fivdisc._kernels import dynamics
+    from fivdisc.compilation import needs_compiling
+
+    if _cores() < 2 or not needs_compiling(dynamics.complex_step_jacobian):
+        return False
+    helper = _Helper("rhs")
+    try:
+        _compile(RHS_OWN_KERNELS, callee_types(default_run()))
+        helper.wait_for("rhs")
+    finally:
+        helper.stop()
+    return True

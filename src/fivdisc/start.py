@@ -122,6 +122,9 @@ def sliding_equilibrium(
     # the friction law and its complex-step Jacobian) that everything here calls.
     with compile_notice((dyn.evaluate, dyn.complex_step_jacobian), show=None,
                         what="right-hand side and its Jacobian"):
+        from fivdisc.split_compile import compile_split_rhs
+
+        compile_split_rhs()  # on two cores, if they compile
         n, ns = model.n, model.n_sliders
         kern = model.kernel_args
         unknowns = _unknowns(model)

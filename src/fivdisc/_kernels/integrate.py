@@ -417,8 +417,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
     if ist[I_STARTED] == 0:
         if tan is not None:
             ph_start = ph.copy()
-            ypre[:] = y[:nd]
-            sgpre[:] = sg
+            tangent.before_switch(y, sg, tsc)
         _switch(MODE_START, NO_EVENT, t, y, ph, sg, ph, ev_prev, mdl, wk, dy, k, ev_prev, ev_t,
                 ev_i, ist, fst)
         _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
@@ -579,8 +578,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
             ev_start = ev_prev.copy()
             if tan is not None:
                 tangent.interpolate(theta, hs, tv, tk, tsc)
-                ypre[:] = y[:nd]
-                sgpre[:] = sg
+                tangent.before_switch(y, sg, tsc)
             _switch(MODE_EVENT, which, t_e, y, ph, sg, ph_start, ev_start, mdl, wk, dy, k,
                     ev_prev, ev_t, ev_i, ist, fst)
             t = t_e
@@ -638,8 +636,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
         if land and t < t_final:
             if tan is not None:
                 ph_start = ph.copy()
-                ypre[:] = y[:nd]
-                sgpre[:] = sg
+                tangent.before_switch(y, sg, tsc)
             _switch(MODE_KINK, NO_EVENT, t, y, ph, sg, ph, ev_prev, mdl, wk, dy, k, ev_prev, ev_t,
                     ev_i, ist, fst)
             _restart(t, y, ph, sg, mdl, wk, k, ev_prev)

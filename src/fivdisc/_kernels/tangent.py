@@ -156,6 +156,20 @@ def interpolate(theta, hs, V, KV, sc):
         dense_eval(rc, theta, V[r])
 
 
+# Element by element: a slice assignment (``ypre[:] = y[:nd]``) compiles numba's
+# shape-mismatch error with its message formatting into the kernel, a few seconds of the
+# kernel's first compilation for a check that cannot fail here.
+@njit(cache=True, inline="always")
+def before_switch(y, sg, sc):
+    """Keep the dynamic state and the slip signs before a switch in scratch slots 9 and
+    10, for :func:`saltation`."""
+    ypre, sgpre = sc[9], sc[10]
+    for i in range(ypre.shape[0]):
+        ypre[i] = y[i]
+    for j in range(sgpre.shape[0]):
+        sgpre[j] = sg[j]
+
+
 @njit(cache=True, _nrt=False)
 def slave(ph, mdl, v):
     """Zero the rows of coordinates that are not free in phases ``ph``."""

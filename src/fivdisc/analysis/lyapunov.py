@@ -220,7 +220,9 @@ def lyapunov(
         cap = min(cap, sim.max_step)
     run = Integration(model, initial_state(model, initial), duration=transient + duration,
                       rtol=rtol, atol=atol, max_step=cap)
-    compile_split(run)  # the kernel's first compilation, if it is one, on two cores
+    # The kernel's first compilation, if it is one, on two cores; the one with tangents,
+    # needed next, begins meanwhile.
+    compile_split(run, tangents=True)
     run.advance(0.0)
     # One bar in simulated time over the transient and the measurement: a long transient
     # is the first minutes of a run.

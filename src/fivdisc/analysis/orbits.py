@@ -551,7 +551,9 @@ def periodic_orbit(
         duration = case.simulation.duration if transient is None else transient
         _positive("transient", duration, "s")
         run = Integration(model, y0, duration=duration, rtol=rtol, atol=atol_run)
-        compile_split(run)  # the kernel's first compilation, if it is one, on two cores
+        # The kernel's first compilation, if it is one, on two cores; the one with
+        # tangents, needed next, begins meanwhile.
+        compile_split(run, tangents=True)
         run.run_to(duration)
         if run.status_name != "success":
             raise FivdiscError(f"periodic_orbit: the transient run ended with "

@@ -18,13 +18,22 @@ def warmup() -> None:
     """
     import time
 
+    from fivdisc._kernels import integrate
     from fivdisc.analysis.lyapunov import warm_tangent_kernel
     from fivdisc.analysis.stability import linear_stability
     from fivdisc.case import Case
+    from fivdisc.compilation import compile_notice
     from fivdisc.simulate import warm_kernel
+    from fivdisc.split_compile import compile_split, default_run
 
     start = time.perf_counter()
-    warm_kernel(show=True)
+    with compile_notice(integrate.run, what="simulation kernel"):
+        # The helper goes on with the tangent kernel's share while this process
+        # finishes the plain kernel (compiled by the run's first call).
+        run = default_run()
+        compile_split(run, tangents=True)
+        run.advance(0.0)
+        warm_kernel()
     warm_tangent_kernel(show=True)
     # The right-hand side's Jacobian at the sliding equilibrium (fivdisc stability).
     linear_stability(Case())
