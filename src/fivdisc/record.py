@@ -106,8 +106,9 @@ class Record:
         Notes
         -----
         xarray's default encoding, which this follows (the tests compare the two files):
-        floating-point variables get ``_FillValue = NaN``; text (object arrays) is stored
-        as variable-length strings (an empty one as doubles); a data variable's
+        floating-point variables get ``_FillValue = NaN``; text is stored as
+        variable-length strings (an empty object array as doubles: fivdisc keeps its text in
+        numpy string arrays, whose type xarray knows even when empty); a data variable's
         ``coordinates`` attribute names, sorted, the non-dimension coordinates whose
         dimensions it has, and any such coordinate no variable names goes in the global
         ``coordinates`` attribute.
@@ -128,7 +129,7 @@ class Record:
                 root.createDimension(dim, size)
             for name, column in (*self.data_vars.items(), *self.coords.items()):
                 values = column.values
-                if values.dtype.kind in "OU" and values.size == 0:
+                if values.dtype.kind == "O" and values.size == 0:
                     # Without a value to infer text from, xarray stores doubles.
                     var = root.createVariable(name, np.float64, column.dims)
                 elif values.dtype.kind in "OU":

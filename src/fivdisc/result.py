@@ -103,7 +103,7 @@ def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarr
         "event_time": _var("event", ev_t, "s", "time of the phase switch"),
         "event_kind": _var(
             "event",
-            np.array([EVENT_KINDS[k] for k in ev_i[:, 0]], dtype=object),
+            np.array([EVENT_KINDS[k] for k in ev_i[:, 0]], dtype=str),
             "1",
             "kind of switch (" + ", ".join(EVENT_KINDS) + ")",
         ),
@@ -131,7 +131,7 @@ def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarr
         "slider": ("slider", np.arange(ns), {"units": "1", "long_name": "slider index"}),
         "angle": _var("slider", np.array([s.angle for s in sliders]), "rad",
                       "space-fixed angle of the slider's base"),
-        "face": ("slider", np.array([s.face for s in sliders], dtype=object),
+        "face": ("slider", np.array([s.face for s in sliders], dtype=str),
                  {"units": "1", "long_name": "face of the disc the slider presses on"}),
         "track_radius": _var("slider", np.array([s.track_radius for s in sliders]), "m",
                              "radius of the slider's track"),

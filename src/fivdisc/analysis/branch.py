@@ -154,7 +154,7 @@ class Branch:
             "state": (("point", "coordinate"), np.array([p.x for p in pts]),
                       {"long_name": "point on the orbit (state layout)"}),
             "signature": (("point", "slider"),
-                          np.array([list(p.cycle.signature) for p in pts], dtype=object),
+                          np.array([list(p.cycle.signature) for p in pts], dtype=str),
                           {"long_name": "event signature over one period"}),
             "multiplier_real": (("point", "multiplier"), mults.real,
                                 {"long_name": "Floquet multiplier, real part", "units": "1"}),
@@ -183,7 +183,7 @@ class Branch:
             return np.array(values) if values else np.zeros(shape)
 
         data.update({
-            "kind": ("bifurcation", np.array([b.kind for b in bif], dtype=object),
+            "kind": ("bifurcation", np.array([b.kind for b in bif], dtype=str),
                      {"long_name": "kind of bifurcation"}),
             "bifurcation_parameter": ("bifurcation", table([b.parameter for b in bif], 0),
                                       {"long_name": f"{info.long_name} at the bifurcation",
@@ -199,15 +199,15 @@ class Branch:
             "rotation": ("bifurcation", table([b.rotation for b in bif], 0),
                          {"long_name": "rotation number of a torus bifurcation",
                           "units": "1"}),
-            "note": ("bifurcation", np.array([b.note for b in bif], dtype=object),
+            "note": ("bifurcation", np.array([b.note for b in bif], dtype=str),
                      {"long_name": "what happens there"}),
             "signature_before": (("bifurcation", "slider"),
                                  np.array([list(b.signature_before) for b in bif],
-                                          dtype=object).reshape(-1, ns),
+                                          dtype=str).reshape(-1, ns),
                                  {"long_name": "event signature before"}),
             "signature_after": (("bifurcation", "slider"),
                                 np.array([list(b.signature_after) for b in bif],
-                                         dtype=object).reshape(-1, ns),
+                                         dtype=str).reshape(-1, ns),
                                 {"long_name": "event signature after"}),
         })
         for side in ("before", "after"):
