@@ -14,12 +14,16 @@ processor time (user and system, all threads) and its ratio to the baseline's, a
 target (issue 11, item 3; issue 29, item 2 for the Fig. 10 command). The commands take
 turns, so that a change in the machine's load during the run falls on all of them alike;
 each runs once before the timing (compiled bytecode, the kernel's cache, the file cache).
+A process that only imports numba and loads one trivial function from numba's cache is
+timed beside them: with the integration the Fig. 10 command prints (its median), it
+makes the floor of any command that runs a cached numba kernel, printed last.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import re
 import resource
 import statistics
 import subprocess
@@ -43,13 +47,34 @@ _CLI_DEFAULT_GC = ("import gc, fivdisc.cli as c; c._GC_THRESHOLDS = gc.get_thres
                    "c.main()")
 
 
+# A process that does only what any numba program does before its first cached kernel
+# runs: import numba and load one trivial function from numba's on-disk cache (numba then
+# registers its typing and lowering tables once, whatever the function).
+_NUMBA_FLOOR = """\
+from numba import njit
+
+
+@njit(cache=True)
+def one(x):
+    return x + 1.0
+
+
+one(1.0)
+"""
+_NUMBA_LABEL = "numba: load one cached function"
+# What fivdisc simulate prints of the integration alone.
+_INTEGRATION = re.compile(r"wall time: ([0-9.]+) s \(integration only")
+
+
 def _commands(workdir: Path, fig10: bool) -> list[tuple[str, list[str], float | None]]:
-    """(label, argv, target [s] or None) of each command timed; the first two are the
-    interpreter's alone."""
+    """(label, argv, target [s] or None) of each command timed; the first three are the
+    interpreter's and numba's alone."""
     python = sys.executable
+    (workdir / "numba_floor.py").write_text(_NUMBA_FLOOR)
     commands = [
         ('python -c "pass"', [python, "-c", "pass"], None),
         ('python -c "import numpy"', [python, "-c", "import numpy"], None),
+        (_NUMBA_LABEL, [python, "-c", "import numba_floor"], None),
         ('python -c "import fivdisc"', [python, "-c", "import fivdisc"], 0.4),
         ("fivdisc --help", [python, "-c", _CLI, "--help"], 0.3),
         ("fivdisc simulate --help", [python, "-c", _CLI, "simulate", "--help"], 0.3),
@@ -66,14 +91,18 @@ def _commands(workdir: Path, fig10: bool) -> list[tuple[str, list[str], float | 
 
 
 def _seconds(argv: list[str], workdir: Path, env: dict[str, str] | None = None
-             ) -> tuple[float, float]:
-    """Wall time and processor time (user and system, all threads) of one process [s]."""
+             ) -> tuple[float, float, float | None]:
+    """Wall time and processor time (user and system, all threads) of one process [s],
+    and the integration's wall time it printed [s] (None if it printed none)."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    subprocess.run(argv, check=True, stdout=subprocess.DEVNULL, cwd=workdir, env=env)
+    out = subprocess.run(argv, check=True, stdout=subprocess.PIPE, cwd=workdir, env=env,
+                         text=True).stdout
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    found = _INTEGRATION.search(out)
+    return (wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime),
+            float(found.group(1)) if found else None)
 
 
 def main() -> None:
@@ -101,7 +130,7 @@ def main() -> None:
         runs = [(label, argv, target, None) for label, argv, target in commands]
         if baseline_env is not None:
             runs += [(f"{label} @{args.baseline}", argv, None, baseline_env)
-                     for label, argv, _ in commands[2:]]
+                     for label, argv, _ in commands[3:]]
         for _, argv, _, env in runs:
             _seconds(argv, workdir, env)
         times: list[list[tuple[float, float]]] = [[] for _ in runs]
@@ -110,13 +139,13 @@ def main() -> None:
                 samples.append(_seconds(argv, workdir, env))
         reference = _seconds([sys.executable, "-c", _REFERENCE], workdir)[0] if (
             args.reference and args.fig10) else None
-    medians = [statistics.median(wall for wall, _ in samples) for samples in times]
-    cpus = [statistics.median(cpu for _, cpu in samples) for samples in times]
+    medians = [statistics.median(wall for wall, _, _ in samples) for samples in times]
+    cpus = [statistics.median(cpu for _, cpu, _ in samples) for samples in times]
     interpreter, numpy = medians[0], medians[1]
     n = len(commands)
     # Without a baseline there is nothing after the commands' own runs.
-    before = dict(zip(range(2, n), medians[n:], strict=len(runs) > n))
-    cpu_before = dict(zip(range(2, n), cpus[n:], strict=len(runs) > n))
+    before = dict(zip(range(3, n), medians[n:], strict=len(runs) > n))
+    cpu_before = dict(zip(range(3, n), cpus[n:], strict=len(runs) > n))
     print(f"fresh processes, median of {args.repeat} each ({sys.executable}); "
           f"load average {load:.2f} before the run, {os.getloadavg()[0]:.2f} after")
     # On a loaded machine the processor time (all threads) says more than the wall time.
@@ -129,8 +158,18 @@ def main() -> None:
         cpu_ratio = f"{cpu / cpu_before[index]:.2f}" if index in cpu_before else ""
         print(f"{label:<44} {median:>10.3f} {median / interpreter:>8.1f} "
               f"{median / numpy:>8.2f} {ratio:>9} {cpu:>8.3f} {cpu_ratio:>9} {goal:>11}")
+    labels = [label for label, _, _ in commands]
+    if args.fig10:
+        # No fivdisc that loads its kernel with numba and integrates this run can start
+        # faster than numba's own start plus the integration, whatever else it does.
+        integration = statistics.median(
+            seconds for _, _, seconds in times[labels.index(_FIG10)] if seconds is not None)
+        floor = medians[labels.index(_NUMBA_LABEL)] + integration
+        print(f"of the Fig. 10 command: the integration {integration:.3f} s (as it prints "
+              f"it); with numba's start, {floor:.3f} s, a floor for any numba kernel; the "
+              f"command is {medians[labels.index(_FIG10)] / floor:.2f} x that")
     if reference is not None:
-        command = medians[[label for label, _, _ in commands].index(_FIG10)]
+        command = medians[labels.index(_FIG10)]
         print(f"the slow scipy reference on the Fig. 10 case, one process: {reference:.1f} s, "
               f"{reference / command:.0f} x the command (target of issue 11, item 3: >= 200)")
 
