@@ -340,6 +340,8 @@ def test_a_branch_rewritten_through_xarray_keeps_its_checksum(rigid_branch, tmp_
     (["--key", "speed.value", "--to", "-1"], "must be >= 0"),
     (["--key", "speed.value", "--to", "inf"], "finite"),
     (["--key", "slider.mass", "--to", "0"], "slider.mass"),
+    (["--key", "speed.value", "--to", "0.5", "--back-to", "0.8"], "--back-to = 0.8 is invalid"),
+    (["--key", "speed.value", "--to", "3", "--back-to", "nan"], "--back-to = nan is invalid"),
 ])
 def test_continue_refuses_bad_input_before_any_work(tmp_path, args, message):
     case = tmp_path / "rigid.toml"

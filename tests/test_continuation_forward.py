@@ -171,11 +171,13 @@ def test_stability_changes_only_at_the_folds():
 
 def test_a_closed_branch_stops_where_it_came_round():
     """In the friction law's decay the 12.3 rad/s orbit lies on a closed curve of orbits
-    (an isola between folds at 0.8343 and 2.3194 s/m). The walk goes round once and
+    (an isola between folds at 0.8343 and 2.3194 s/m). In a window that holds it
+    (``back_to`` beyond its far fold) the walk goes round once and
     stops at the first fold met a second time, instead of drawing the curve again; the
     verdict changes only at the folds (one multiplier passes +1 at each)."""
     start = periodic_orbit(CASE, transient=5.0)
-    br = continue_orbit(CASE, "friction.decay", 0.0, orbit=start, max_points=400)
+    br = continue_orbit(CASE, "friction.decay", 0.0, orbit=start, back_to=3.0,
+                        max_points=400)
     assert "closed on itself" in br.stop_reason
     kinds = [b["kind"] for b in br.bifurcations()]
     assert kinds == ["fold", "fold", "fold"]
@@ -183,3 +185,21 @@ def test_a_closed_branch_stops_where_it_came_round():
     assert last["parameter"] == pytest.approx(first["parameter"], rel=1e-6)
     # one change at each fold passed, the first one twice
     assert np.count_nonzero(np.diff(br.stable.astype(int))) == len(kinds)
+
+
+def test_a_branch_that_turns_at_a_fold_stops_where_it_began():
+    # Continued towards 12.8 rad/s from just below the fold, the branch turns there and
+    # comes back; it stops at its starting speed (AUTO's window from the start to the
+    # target), on the saddle orbit beside the stable one it began on, instead of
+    # walking away from the target until its points run out.
+    case = CASE.replace({"speed.value": 12.45})
+    branch = continue_orbit(case, "speed.value", 12.8,
+                            orbit=periodic_orbit(case, transient=5.0), max_points=60)
+    assert "came back to speed.value = 12.45" in branch.stop_reason
+    assert [b["kind"] for b in branch.bifurcations()] == ["fold"]
+    assert len(branch) < 60
+    assert branch.parameter[-1] == pytest.approx(12.45, abs=1e-12)
+    assert np.all(branch.parameter[1:-1] > 12.45)
+    # two orbits at one speed: the first stable, the last a saddle of another period
+    assert branch.stable[0] and not branch.stable[-1]
+    assert abs(branch.period[-1] / branch.period[0] - 1.0) > 1e-4

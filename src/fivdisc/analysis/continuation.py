@@ -58,7 +58,7 @@ from fivdisc.errors import CaseError, ConvergenceError, FivdiscError
 from fivdisc.integration import Integration
 from fivdisc.model import Model, build_model, model_at
 
-__all__ = ["Bifurcation", "check_key", "continue_orbit", "doubled_start"]
+__all__ = ["Bifurcation", "check_key", "check_window", "continue_orbit", "doubled_start"]
 
 # A corrector may move the point at most this many step lengths from the predictor.
 _MAX_CORRECTION = 0.5
@@ -696,6 +696,7 @@ def continue_orbit(
     *,
     orbit: PeriodicOrbit | None = None,
     along: np.ndarray | None = None,
+    back_to: float | None = None,
     max_points: int = 200,
     step: float = 0.02,
     max_step: float = 0.1,
@@ -719,7 +720,8 @@ def continue_orbit(
         ``sliders.1.preload``, ``friction.decay``, ``disc.damping_ratio``, ...).
     to : float
         Where the continuation stops [the key's unit]; its side of the case's value sets
-        the direction.
+        the direction. A branch that turns at a fold stops where the key comes back past
+        ``back_to`` (the walk's window runs from there to ``to``).
     orbit : PeriodicOrbit, optional
         The orbit to start from (at the case's value of ``key``). Default: found as
         :func:`~fivdisc.analysis.orbits.periodic_orbit` finds it, with ``search`` as its
@@ -727,6 +729,12 @@ def continue_orbit(
     along : ndarray, optional
         Branch switching: the first step leaves ``orbit``'s point in this state
         direction instead of along the branch through it (see :func:`doubled_start`).
+    back_to : float, optional
+        The window's other end [the key's unit]: once the branch has turned at a fold, it
+        stops where the key comes back past this value, on a point corrected to it.
+        Default: the case's value. On the case's value or on its side away from ``to``;
+        give a value beyond the range the orbits span to follow a closed branch (an
+        isola) round.
     max_points : int
         Most points on the branch (the first included).
     step, max_step, min_step : float
@@ -763,6 +771,9 @@ def continue_orbit(
     """
     p0 = _check_options(case, key, to, max_points, step, max_step, min_step, tol,
                         time_budget)
+    if back_to is None:
+        back_to = p0
+    check_window(key, p0, to, back_to)
     atol_run = atol if atol is not None else rtol * 1e-7
     if orbit is None:
         orbit = periodic_orbit(case, rtol=rtol, atol=atol_run, tol=tol, progress=progress,
@@ -774,7 +785,17 @@ def continue_orbit(
     branch = _Branch(case, key, orbit.phases, orbit.period, rtol, atol_run, tol)
     return _run(branch, lambda deadline: _start_point(branch, orbit, direction, along,
                                                       deadline), to,
-                max_points, step, max_step, min_step, time_budget, progress, orbit.start)
+                max_points, step, max_step, min_step, time_budget, progress, orbit.start,
+                back_to)
+
+
+def check_window(key: str, p0: float, to: float, back_to: float, option: str = "back_to"
+                 ) -> None:
+    """A one-line refusal of a window's far end ``back_to`` that is not finite or lies
+    between the start's value ``p0`` and ``to``."""
+    if not (np.isfinite(back_to) and (back_to - p0) * (to - p0) <= 0):
+        raise CaseError(f"{option} = {back_to!r} is invalid: must be a finite value of {key} "
+                        f"at the start's value {p0:g} or on its side away from {to:g}")
 
 
 def _check_options(case: Case, key: str, to: float, max_points: int, step: float,
@@ -804,8 +825,10 @@ def _check_options(case: Case, key: str, to: float, max_points: int, step: float
 
 
 def _run(branch: _Branch, first, to: float, max_points: int, step: float, max_step: float,
-         min_step: float, time_budget: float, progress: bool, start: str):
-    """The first point (``first(deadline)``), then the walk to ``to``: the branch."""
+         min_step: float, time_budget: float, progress: bool, start: str,
+         back_to: float | None = None):
+    """The first point (``first(deadline)``), then the walk to ``to`` (and, after a fold,
+    back to ``back_to``, default the first point's value): the branch."""
     from fivdisc.analysis.branch import Branch
     from fivdisc.progress import progress_bar
 
@@ -816,7 +839,8 @@ def _run(branch: _Branch, first, to: float, max_points: int, step: float, max_st
         walk.points.append(first(deadline))
         bar.update()
         try:
-            _walk(branch, walk, to, max_points, step, max_step, min_step, deadline, bar)
+            _walk(branch, walk, to, back_to, max_points, step, max_step, min_step,
+                  deadline, bar)
         except KeyboardInterrupt:
             # The points and bifurcations so far are a branch: kept, as a time budget
             # running out keeps them.
@@ -838,10 +862,14 @@ def _without_fold_echoes(found: list[Bifurcation]) -> list[Bifurcation]:
             if not (b.kind == "branch point" and any(abs(b.point - f) <= 1 for f in folds))]
 
 
-def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
-          max_step: float, min_step: float, deadline: float, bar) -> None:
+def _walk(branch: _Branch, walk: _Walk, to: float, back_to: float | None, max_points: int,
+          ds: float, max_step: float, min_step: float, deadline: float, bar) -> None:
     target = to / branch.ps
     side = np.sign(target - walk.points[0].z[-1])
+    # Once the branch has turned at a fold, it stops where the key comes back past
+    # `began` away from `to`, as AUTO stops at the far end of its window; the walk
+    # covers the range from there to `to` and no more.
+    began = branch.unpack(walk.points[0].z)[2] if back_to is None else back_to
     lo_period, hi_period = branch.period0 / 100.0, branch.period0 * 100.0
     while len(walk.points) < max_points:
         a = walk.points[-1]
@@ -881,15 +909,24 @@ def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
                               "(a period growing without bound: a homoclinic orbit?)")
             return
         passed = landing or np.sign(target - b.z[-1]) != side
-        if passed and not landing:
+        turned = any(f.kind == "fold" for f in walk.bifurcations)
+        back = turned and _away(branch, b, began, to) and not _away(branch, a, began, to)
+        if (passed and not landing) or back:
             try:
-                b = branch.at_value(a, to, deadline)
+                b = branch.at_value(a, began if back else to, deadline)
             except ConvergenceError:
                 ds *= 0.5
                 continue
         found = len(walk.bifurcations)
         _record(branch, walk, a, b, float(np.linalg.norm(b.z - a.z)), deadline)
         walk.points.append(b)
+        folds = [f for f in walk.bifurcations if f.kind == "fold"]
+        if back or (not turned and folds and _away(branch, b, began, to)):
+            walk.stop = _Stop(f"the branch turned at the fold at {branch.key} = "
+                              f"{folds[-1].parameter:.9g} and came back to {branch.key} = "
+                              f"{began:.9g}, the other end of its window")
+            bar.update()
+            return
         again = _closed(walk.bifurcations, found)
         if again is not None:
             walk.stop = _Stop(f"the branch closed on itself (an isola): it passed the fold at "
@@ -906,6 +943,11 @@ def _walk(branch: _Branch, walk: _Walk, to: float, max_points: int, ds: float,
         elif b.iterations >= 7:
             ds = max(ds * 0.5, min_step)
     walk.stop = _Stop(f"the largest number of points ({max_points}) is reached")
+
+
+def _away(branch: _Branch, point: _Point, began: float, to: float) -> bool:
+    """Whether ``point``'s key lies past ``began`` on the side away from ``to``."""
+    return (branch.unpack(point.z)[2] - began) * (to - began) < 0
 
 
 def _closed(found: list[Bifurcation], new: int) -> Bifurcation | None:

@@ -19,6 +19,10 @@ from fivdisc.cli._case import CASE
 @click.option("--to", "target", type=float, required=True,
               help="The key's value where the continuation stops [the key's unit]; its side "
               "of the case's value sets the direction.")
+@click.option("--back-to", "back_to", type=float,
+              help="The other end of the window [the key's unit]: a branch that turns at a "
+              "fold stops where the key comes back past it (default: the start's value). "
+              "Give a value beyond the orbits' range to follow a closed branch round.")
 @click.option("--from", "from_file", type=click.Path(dir_okay=False, exists=True,
                                                      path_type=Path),
               help="Start from a file instead of the case's orbit: an orbit (fivdisc orbit "
@@ -51,9 +55,9 @@ from fivdisc.cli._case import CASE
               help="Write the branch to a netCDF file (.nc), for fivdisc plot.")
 @click.option("--progress/--no-progress", default=True, show_default=True,
               help="Show the Newton iterations and the points on a terminal.")
-def continuation(case_file: Path | None, key: str, target: float, from_file: Path | None,
-                 which: int | None, hopf_spec: str | None, points: int, step: float,
-                 max_step: float,
+def continuation(case_file: Path | None, key: str, target: float, back_to: float | None,
+                 from_file: Path | None, which: int | None, hopf_spec: str | None,
+                 points: int, step: float, max_step: float,
                  transient: float | None, period: float | None, rtol: float, as_json: bool,
                  output: Path | None, progress: bool) -> None:
     """Follow a periodic orbit of CASE_FILE (constant speed) as --key goes --to a value.
@@ -64,7 +68,12 @@ def continuation(case_file: Path | None, key: str, target: float, from_file: Pat
     event signature (stick phases appearing, grazing, ...) located to 1e-6 in the key.
     CASE_FILE is a TOML file or a packaged example.
     """
-    from fivdisc.analysis.continuation import INTERRUPTED, continue_orbit
+    from fivdisc.analysis.continuation import (
+        INTERRUPTED,
+        check_key,
+        check_window,
+        continue_orbit,
+    )
     from fivdisc.errors import ConvergenceError, FivdiscError
     from fivdisc.files import check_output
 
@@ -76,9 +85,10 @@ def continuation(case_file: Path | None, key: str, target: float, from_file: Pat
         if value < 1:
             raise FivdiscError(f"{name} = {value} is invalid: must be >= 1")
     if hopf_spec is not None:
-        if from_file is not None or transient is not None or period is not None:
+        if (from_file is not None or transient is not None or period is not None
+                or back_to is not None):
             raise FivdiscError("--from-hopf starts at a Hopf point: leave out --from, "
-                               "--transient and --period")
+                               "--transient, --period and --back-to")
         branch = _from_hopf(case_file, key, target, hopf_spec, points, step, max_step, rtol,
                             progress)
         if out is not None:
@@ -88,8 +98,11 @@ def continuation(case_file: Path | None, key: str, target: float, from_file: Pat
     try:
         case, orbit, along, search = _start(case_file, from_file, which, key, target, rtol,
                                             transient, period)
+        if back_to is not None:
+            check_window(key, check_key(case, key), target, back_to, "--back-to")
         branch = continue_orbit(case, key, target, orbit=orbit, along=along,
-                                max_points=points, step=step, max_step=max_step, rtol=rtol,
+                                back_to=back_to, max_points=points, step=step,
+                                max_step=max_step, rtol=rtol,
                                 progress=progress, **search)
     except ConvergenceError as exc:
         click.echo(f"error: no periodic orbit to start from: {exc}", err=True)
