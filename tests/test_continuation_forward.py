@@ -202,4 +202,5 @@ def test_a_branch_that_turns_at_a_fold_stops_where_it_began():
     assert np.all(branch.parameter[1:-1] > 12.45)
     # two orbits at one speed: the first stable, the last a saddle of another period
     assert branch.stable[0] and not branch.stable[-1]
+    assert f"(over 12.45 to {branch.parameter.max():.9g} rad/s)" in str(branch)
     assert abs(branch.period[-1] / branch.period[0] - 1.0) > 1e-4

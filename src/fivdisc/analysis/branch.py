@@ -280,9 +280,12 @@ class Branch:
         unit = self.dataset["parameter"].attrs.get("units", "")
         unit = f" {unit}" if unit else ""
         p, t = self.parameter, self.period
+        # A branch that turned at a fold reaches past its ends.
+        span = ("" if p.min() == min(p[0], p[-1]) and p.max() == max(p[0], p[-1])
+                else f" (over {p.min():.9g} to {p.max():.9g}{unit})")
         lines = [f"branch of periodic orbits in {self.key}: {len(self)} points from "
-                 f"{p[0]:.9g} to {p[-1]:.9g}{unit}, period {t[0]:.9g} to {t[-1]:.9g} s; "
-                 f"{int(self.stable.sum())} stable",
+                 f"{p[0]:.9g} to {p[-1]:.9g}{unit}{span}, period {t[0]:.9g} to {t[-1]:.9g} "
+                 f"s; {int(self.stable.sum())} stable",
                  f"stopped: {self.stop_reason}"]
         hopf = self.hopf()
         if hopf:
