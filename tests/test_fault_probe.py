@@ -43,8 +43,15 @@ def cli_run(args: list[str]):
     return result, time.perf_counter() - start
 
 
+def messages(stderr: str) -> list[str]:
+    """The lines of `stderr` but the notices of a kernel's first compilation, which every
+    command prints when it compiles one (with or without --progress)."""
+    return [line for line in stderr.strip().splitlines()
+            if not line.startswith(("compiling the ", "compiled the "))]
+
+
 def one_line_error(result) -> str:
-    lines = result.stderr.strip().splitlines()
+    lines = messages(result.stderr)
     assert len(lines) == 1 and lines[0].startswith("error: "), result.output
     return lines[0]
 

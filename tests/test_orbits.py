@@ -161,7 +161,7 @@ def test_orbit_command_json_and_netcdf(tmp_path):
     out = tmp_path / "orbit.nc"
     res = CliRunner().invoke(cli, ["orbit", str(path), "--json", "--no-progress", "-o", str(out)])
     assert res.exit_code == 0, res.output
-    data = json.loads(res.output)
+    data = json.loads(res.stdout)
     period, _ = _rigid_disc_closed_form()
     assert data["period"] == pytest.approx(period, rel=1e-9)
     assert data["verdict"] == "stable"

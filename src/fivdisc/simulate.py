@@ -103,7 +103,8 @@ def simulate(
     # A first call with target 0 only sets up the start: it compiles or loads the kernel
     # before the progress bar starts, so the bar's rate and estimate are the integrator's
     # (and the wall time excludes the compilation, announced with the bar).
-    with compile_notice(kern.run, show=progress):
+    # Without a bar the notice is still the command line's (a library call says nothing).
+    with compile_notice(kern.run, show=progress or None):
         compile_split(run)
         run.advance(0.0)
     bar = progress_bar(sim.duration, "simulating", "s", show=progress,

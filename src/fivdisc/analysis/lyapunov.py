@@ -263,7 +263,7 @@ def _measure(run: Integration, model: Model, limit: Any, n: int, seed: int | Non
     from fivdisc.split_compile import compile_split_tangents
 
     # The first interval compiles the kernel with tangents in a fresh installation.
-    with tangent_notice(show=progress):
+    with tangent_notice(show=progress or None):
         compile_split_tangents()
         run.set_tangents((q * sc[:, None]).T)
         _interval(run, limit, 0, logs, times, t0, interval, transient + duration, sc)

@@ -592,7 +592,7 @@ def periodic_orbit(
     from fivdisc.progress import progress_bar
     from fivdisc.split_compile import compile_split_tangents
 
-    with tangent_notice(show=progress):
+    with tangent_notice(show=progress or None):
         compile_split_tangents()
         shooting.shoot(x0, min(period, 1e-6), tangents=True)
     with progress_bar(max_iterations, "Newton shooting", "iteration", show=progress) as bar:
