@@ -406,6 +406,9 @@ API_MISUSE = [
      "disc.thickness = 1e+308 is invalid: must be < disc.outer_radius"),
     ("plate stiffness underflows", lambda: Case(disc={"youngs_modulus": 1e-300}),
      "is out of floating-point range"),
+    # found by the long generated-case test: Python's power raised OverflowError
+    ("outer radius 1e300", lambda: Case(disc={"outer_radius": 1e300}),
+     "disc.outer_radius = 1e+300 is invalid: gives the plate a frequency scale"),
     ("duration 1e308", lambda: simulate(Case(simulation={"duration": 1e308})),
      "simulation.duration = 1e+308 s at simulation.output_rate"),
 ]

@@ -30,6 +30,7 @@ from fivdisc.cli import cli
 from fivdisc.cli.plot import KINDS
 from fivdisc.sweep import SweepStore, load_sweep, store_lock
 from fivdisc.sweep.store import PointOutcome
+from test_fault_probe import messages
 
 # --- the property ----------------------------------------------------------------------------
 
@@ -41,7 +42,7 @@ def check_outcome(result: Result, args: list[str]) -> None:
         f"{shown}\n{type(result.exception).__name__}: {result.exception}"
     )
     assert "Traceback" not in result.output, shown
-    err = result.stderr.strip()
+    err = "\n".join(messages(result.stderr))
     if result.exit_code == 0:
         return
     if result.exit_code == 2 and err.splitlines()[-1].startswith("Error: "):

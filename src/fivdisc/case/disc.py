@@ -116,14 +116,20 @@ class Disc(Table):
         with np.errstate(all="ignore"):
             rigidity = np.float64(self.youngs_modulus) * np.float64(h) ** 3
             per_area = np.float64(self.density) * h
-            scale = np.sqrt(rigidity / per_area) / self.outer_radius**2
-        if not (np.isfinite(scale) and scale > 0 and np.isfinite(rigidity)
-                and rigidity >= _TINY and per_area >= _TINY and np.isfinite(per_area)):
+            # numpy's power: Python's raises OverflowError for a radius like 1e300.
+            scale = np.sqrt(rigidity / per_area) / np.float64(self.outer_radius) ** 2
+        if not (np.isfinite(rigidity) and rigidity >= _TINY and per_area >= _TINY
+                and np.isfinite(per_area)):
             raise rule(
                 "with disc.youngs_modulus and disc.density gives a plate whose stiffness "
                 f"E h^3 = {rigidity:.3g} N m or mass per area rho h = {per_area:.3g} kg/m^2 "
                 "is out of floating-point range",
                 "thickness", h)
+        if not (np.isfinite(scale) and scale > 0):
+            raise rule(
+                "gives the plate a frequency scale sqrt(E h^3 / (rho h)) / b^2 = "
+                f"{scale:.3g} rad/s out of floating-point range",
+                "outer_radius", self.outer_radius)
         return self
 
     @model_validator(mode="after")
