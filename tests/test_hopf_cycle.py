@@ -96,6 +96,29 @@ def test_stribeck_hopf_points_supercritical_below_subcritical_above(stribeck_hop
     assert (first.hopf()["criticality"], bool(first.stable[0])) == expected
 
 
+def test_a_subcritical_branch_stopped_before_grazing_leaves_bistability_open(
+        hopf, stribeck_hopf):
+    """A subcritical Hopf point's first orbits are unstable on the side where sliding is
+    stable: they bound the equilibrium's basin, and what lies outside them (stick-slip, in
+    test_simulations_agree_with_the_subcritical_verdict) may coexist with stable sliding.
+    A branch stopped before its orbits fold or graze (here after its first point) has not
+    decided the bistable range, so it must not print "none found" (read: no
+    bistability); a supercritical point's stable orbits on the unstable side do decide
+    that there is none near it."""
+    first = hopf_cycles(hopf, 30.0, max_points=1)
+    info = first.hopf()
+    assert info["criticality"] == "subcritical"
+    assert np.isnan(info["bistable"][0]) and info["bistable_undetermined"]
+    text = str(first)
+    assert "none found" not in text
+    assert "not determined" in text
+    super_first = hopf_cycles(stribeck_hopf[0], 30.0, max_points=1)
+    assert super_first.hopf()["criticality"] == "supercritical"
+    assert not super_first.hopf()["bistable_undetermined"]
+    assert "bistable range (stable sliding and a stable vibration): none found" in str(
+        super_first)
+
+
 def test_branch_grazes_and_gives_the_bistable_range(hopf, cycles):
     """The unstable slipping orbits grow with the speed until the slip speed touches
     zero; the branch ends there, and the bistable range runs from the Hopf speed to it

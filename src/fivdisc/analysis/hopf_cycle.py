@@ -101,7 +101,10 @@ def hopf_cycles(
     stick-slip orbits themselves are not continued here and may coexist with the
     equilibrium beyond the grazing value, so that end of the range is then a bound
     only (``bistable_open``; continue a stick-slip orbit there with
-    :func:`~fivdisc.analysis.continuation.continue_orbit` to find where it ends). The
+    :func:`~fivdisc.analysis.continuation.continue_orbit` to find where it ends). A
+    subcritical branch that stops before its orbits fold or graze leaves the range
+    undetermined (``bistable_undetermined``): its unstable orbits bound the equilibrium's
+    basin, and the motion beyond them may be a stable vibration coexisting with it. The
     equilibrium's stability beyond other Hopf points of the key is not checked.
     """
     if not (np.isfinite(amplitude) and 0 < amplitude <= 0.5):
@@ -148,7 +151,12 @@ def _judge(result: Branch, hopf: HopfPoint) -> None:
         low, high = sorted((float(far), hopf.value))
     else:
         low = high = np.nan
+    # A subcritical point's unstable orbits bound the basin of stable sliding; until the
+    # branch folds or grazes, what lies beyond them (and whether it is a stable
+    # vibration) is not known: the range is undetermined, not absent.
+    undetermined = bool(hopf.on_boundary and kind == "subcritical" and not coexist.size)
     result.dataset.attrs.update({"hopf_value": hopf.value, "hopf_omega": hopf.omega,
                                  "hopf_direction": hopf.direction, "criticality": kind,
                                  "bistable_low": low, "bistable_high": high,
-                                 "bistable_open": int(open_end)})
+                                 "bistable_open": int(open_end),
+                                 "bistable_undetermined": int(undetermined)})
