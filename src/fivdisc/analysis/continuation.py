@@ -820,8 +820,15 @@ def _run(branch: _Branch, first, to: float, max_points: int, step: float, max_st
          min_step: float, time_budget: float, progress: bool, start: str):
     """The first point (``first(deadline)``), then the walk to ``to``: the branch."""
     from fivdisc.analysis.branch import Branch
+    from fivdisc.analysis.lyapunov import warm_tangent_kernel
     from fivdisc.progress import progress_bar
+    from fivdisc.split_compile import compile_split_tangents
 
+    # A start from a Hopf point or a saved orbit is the first use of the kernel with
+    # tangent vectors, minutes of compiling in a fresh installation: say so (as
+    # periodic_orbit does) before the first point, whose time it is not.
+    compile_split_tangents()
+    warm_tangent_kernel(show=progress)
     deadline = time.monotonic() + time_budget
     walk = _Walk()
     with progress_bar(max_points, f"continuing in {branch.key}", "point",
