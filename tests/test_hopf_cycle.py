@@ -232,3 +232,30 @@ def test_continue_announces_the_tangent_kernel_compiling(tmp_path, monkeypatch, 
     run = CliRunner().invoke(cli, ["continue", *args])
     assert run.exit_code == 0, run.output
     assert run.stderr.count("compiling the kernel with tangent vectors, once") == 1
+
+
+def test_the_bistable_range_ends_at_the_located_fold():
+    """Subcritical orbits that turn stable at a fold of cycles: the range of stable
+    sliding beside a stable vibration ends at the fold, located to 1e-6 relative, not at
+    the last stable point computed before it. On a three-slider trial case (speed 10
+    rad/s, in sliders.2.rotational_damping) the printed end was the point 0.25999818
+    next to the fold at 0.25999895. The branch here stands for that one: unstable points
+    up to the fold, stable ones as the parameter turns back."""
+    import types
+
+    import xarray as xr
+
+    from fivdisc.analysis.hopf_cycle import _judge
+
+    p = np.array([0.0414, 0.1, 0.2, 0.25999891, 0.25999818, 0.2599933])
+    stable = np.array([False, False, False, False, True, True])
+    fold = {"kind": "fold", "parameter": 0.259998949, "point": 3}
+    branch = types.SimpleNamespace(parameter=p, stable=stable, dataset=xr.Dataset(),
+                                   bifurcations=lambda: [fold])
+    hopf = types.SimpleNamespace(value=0.0413536562, direction=-1, on_boundary=True,
+                                 omega=1224.7)
+    _judge(branch, hopf)
+    attrs = branch.dataset.attrs
+    assert attrs["criticality"] == "subcritical"
+    assert (attrs["bistable_low"], attrs["bistable_high"]) == (0.0413536562, 0.259998949)
+    assert not attrs["bistable_open"]

@@ -95,7 +95,8 @@ def hopf_cycles(
     the first Lyapunov coefficient ``l1``: ``c`` has the sign of ``-l1 / (d Re lambda /
     dp)``). The bistable range is where the equilibrium is stable and a stable orbit of
     the branch exists: from the Hopf value to the farthest stable orbit on the
-    equilibrium's stable side (a fold of cycles), or at least to where unstable
+    equilibrium's stable side (a fold of cycles, at its located value), or at least to
+    where unstable
     slipping orbits on that side graze the stick boundary. There stick-slip orbits
     begin, and the unstable orbits separate the equilibrium's basin from them; the
     stick-slip orbits themselves are not continued here and may coexist with the
@@ -143,7 +144,13 @@ def _judge(result: Branch, hopf: HopfPoint) -> None:
     # grazing value, where they are not followed: the range is then open on that side.
     grazing = [b["parameter"] for b in result.bifurcations()
                if b["kind"] == "grazing" and (b["parameter"] - hopf.value) * unstable_side < 0]
-    coexist = np.array(coexist + grazing)
+    # A fold next to a stable point is the farthest end of those stable orbits, located
+    # more exactly than any point computed beside it.
+    n = len(p)
+    folds = [b["parameter"] for b in result.bifurcations()
+             if b["kind"] == "fold" and (b["parameter"] - hopf.value) * unstable_side < 0
+             and any(result.stable[i] for i in (b["point"], b["point"] + 1) if i < n)]
+    coexist = np.array(coexist + grazing + folds)
     open_end = False
     if hopf.on_boundary and coexist.size:
         far = coexist[np.argmax(np.abs(coexist - hopf.value))]
