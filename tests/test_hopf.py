@@ -169,6 +169,21 @@ def test_follow_keeps_crossing_branches_and_finds_flutter():
     assert ps[found[0][0]] == pytest.approx(abs(k1 - k2) / 2, abs=ps[1] - ps[0])
 
 
+def test_a_frequency_crossing_of_modes_already_apart_in_growth_is_no_coupling():
+    """Two modes of different sliders (a three-slider trial case at 1.5 rad/s: 191.2 and
+    191.7 Hz, growth rates 238 and 315 1/s) cross in frequency while their growth rates,
+    apart by 5 % of the frequency, go on parting: the eigenvalues never come near each
+    other, so nothing couples there. A coupling is two eigenvalues meeting: just outside
+    the merged interval their growth rates agree as closely as their frequencies."""
+    ps = np.linspace(0.0, 1.0, 21)
+    lam = []
+    for p in ps:
+        a = 0.3 * p + 1j * (1.0 + 0.2 * p)   # grows faster and faster
+        b = -0.1 + 1j * (1.2 - 0.2 * p)      # decays; the frequencies cross at p = 0.5
+        lam.append([a, b, a.conjugate(), b.conjugate()])
+    assert mode_couplings(follow(np.array(lam))) == []
+
+
 def test_existence_limit_where_the_reference_normal_force_vanishes():
     # Near the l = 2 critical speed the disc's static compliance grows without bound
     # and the slider's normal force falls to zero.

@@ -96,6 +96,29 @@ def test_stribeck_hopf_points_supercritical_below_subcritical_above(stribeck_hop
     assert (first.hopf()["criticality"], bool(first.stable[0])) == expected
 
 
+def test_a_subcritical_branch_stopped_before_grazing_leaves_bistability_open(
+        hopf, stribeck_hopf):
+    """A subcritical Hopf point's first orbits are unstable on the side where sliding is
+    stable: they bound the equilibrium's basin, and what lies outside them (stick-slip, in
+    test_simulations_agree_with_the_subcritical_verdict) may coexist with stable sliding.
+    A branch stopped before its orbits fold or graze (here after its first point) has not
+    decided the bistable range, so it must not print "none found" (read: no
+    bistability); a supercritical point's stable orbits on the unstable side do decide
+    that there is none near it."""
+    first = hopf_cycles(hopf, 30.0, max_points=1)
+    info = first.hopf()
+    assert info["criticality"] == "subcritical"
+    assert np.isnan(info["bistable"][0]) and info["bistable_undetermined"]
+    text = str(first)
+    assert "none found" not in text
+    assert "not determined" in text
+    super_first = hopf_cycles(stribeck_hopf[0], 30.0, max_points=1)
+    assert super_first.hopf()["criticality"] == "supercritical"
+    assert not super_first.hopf()["bistable_undetermined"]
+    assert "bistable range (stable sliding and a stable vibration): none found" in str(
+        super_first)
+
+
 def test_branch_grazes_and_gives_the_bistable_range(hopf, cycles):
     """The unstable slipping orbits grow with the speed until the slip speed touches
     zero; the branch ends there, and the bistable range runs from the Hopf speed to it
@@ -180,3 +203,59 @@ def test_continue_from_hopf_on_the_command_line(tmp_path):
                                    "30", "--from-hopf", "0.5:30"])
     assert bad.exit_code == 2
     assert "--from-hopf = '0.5:30' is invalid" in bad.output
+
+
+@pytest.mark.parametrize("start", ["hopf", "file"])
+def test_continue_announces_the_tangent_kernel_compiling(tmp_path, monkeypatch, start):
+    """Issue 27, item 3: a fresh installation's first `fivdisc continue --from-hopf` (or
+    `--from FILE`) compiles the kernel with tangent vectors, minutes on a loaded machine;
+    it ran 4 min 42 s without a word, since only `periodic_orbit`'s own search said
+    so. Both starts now say it once, as `fivdisc orbit` does."""
+    from click.testing import CliRunner
+
+    from fivdisc import compilation
+    from fivdisc.cli import cli
+
+    case = tmp_path / "rigid.toml"
+    case.write_text(CASE.to_toml())
+    args = ["--key", "speed.value", "--to", "30", "--points", "2"]
+    if start == "file":
+        first = CliRunner().invoke(cli, ["continue", str(case), *args, "--from-hopf",
+                                         "0.5:30:25", "-o", str(tmp_path / "b.nc")])
+        assert first.exit_code == 0, first.output
+        args = ["--from", str(tmp_path / "b.nc"), *args]
+    else:
+        args = [str(case), *args, "--from-hopf", "0.5:30:25"]
+    monkeypatch.setattr(compilation, "_announced", set())
+    monkeypatch.setattr(compilation, "needs_compiling", lambda dispatcher: True)
+    monkeypatch.setattr("fivdisc.split_compile._cores", lambda: 1)
+    run = CliRunner().invoke(cli, ["continue", *args])
+    assert run.exit_code == 0, run.output
+    assert run.stderr.count("compiling the kernel with tangent vectors, once") == 1
+
+
+def test_the_bistable_range_ends_at_the_located_fold():
+    """Subcritical orbits that turn stable at a fold of cycles: the range of stable
+    sliding beside a stable vibration ends at the fold, located to 1e-6 relative, not at
+    the last stable point computed before it. On a three-slider trial case (speed 10
+    rad/s, in sliders.2.rotational_damping) the printed end was the point 0.25999818
+    next to the fold at 0.25999895. The branch here stands for that one: unstable points
+    up to the fold, stable ones as the parameter turns back."""
+    import types
+
+    import xarray as xr
+
+    from fivdisc.analysis.hopf_cycle import _judge
+
+    p = np.array([0.0414, 0.1, 0.2, 0.25999891, 0.25999818, 0.2599933])
+    stable = np.array([False, False, False, False, True, True])
+    fold = {"kind": "fold", "parameter": 0.259998949, "point": 3}
+    branch = types.SimpleNamespace(parameter=p, stable=stable, dataset=xr.Dataset(),
+                                   bifurcations=lambda: [fold])
+    hopf = types.SimpleNamespace(value=0.0413536562, direction=-1, on_boundary=True,
+                                 omega=1224.7)
+    _judge(branch, hopf)
+    attrs = branch.dataset.attrs
+    assert attrs["criticality"] == "subcritical"
+    assert (attrs["bistable_low"], attrs["bistable_high"]) == (0.0413536562, 0.259998949)
+    assert not attrs["bistable_open"]

@@ -193,3 +193,23 @@ def test_paper_fig13_orbit_sits_just_outside_the_unit_circle():
     assert abs(orbit.largest - 1.0) < 1e-3
     assert abs(orbit.largest - 1.0) > 1e-5
     assert orbit.verdict == ("unstable" if orbit.largest > 1.0 else "stable")
+
+
+def test_state_labels_number_sliders_as_the_case_does():
+    """Slider j is ``sliders.j`` in a case, ``slider j`` in every summary and ``phi{j}`` in
+    the stability table, all from 0: an orbit's or a branch's coordinate labels must name
+    the same slider, or a reader of the monodromy matrix puts one slider's row on
+    another."""
+    from fivdisc import load_case
+    from fivdisc.analysis.orbits import state_labels
+    from fivdisc.analysis.stability import linear_stability
+    from fivdisc.examples import path
+
+    case = load_case(path("two-pads"))
+    labels = state_labels(build_model(case))
+    angles = [lab for lab in labels if lab.startswith("phi_") and not lab.endswith("_dot")]
+    assert angles == ["phi_0", "phi_1"]
+    assert {"z_0", "z_1", "phi_0_dot", "z_1_dot"} <= set(labels)
+    stability_names = {name for name in linear_stability(case).dominant
+                       if name.startswith("phi")}
+    assert stability_names <= {"phi0", "phi1"}

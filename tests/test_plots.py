@@ -432,3 +432,34 @@ def test_a_disc_variable_names_no_slider(simulated):
     assert "slider 0" in simulated.plot("timeseries", var="phi").axes[0].get_title()
 
 
+
+
+def test_labels_of_close_bifurcations_do_not_overlap():
+    """A torus point and a fold 0.002 rad/s apart on a branch spanning 3.5 rad/s (a
+    one-slider trial case) had their labels "NS" and "LP" drawn on top of each other.
+    Labels of bifurcations that nearly coincide on the figure are stacked instead."""
+    import types
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from fivdisc.branch_plots import draw_branch
+
+    p = np.linspace(5.5, 9.0, 50)
+    period = 5.9e-3 - 1.4e-4 * (p - 5.5)
+    bifs = [{"kind": "torus", "parameter": 5.79686, "point": 4},
+            {"kind": "fold", "parameter": 5.79904, "point": 4},
+            {"kind": "fold", "parameter": 8.5, "point": 42}]
+    branch = types.SimpleNamespace(parameter=p, stable=np.ones(50, bool),
+                                   dataset=xr.Dataset({"period": ("point", period)}),
+                                   bifurcations=lambda: bifs)
+    fig, ax = plt.subplots()
+    draw_branch(ax, branch)
+    offsets = {t.get_text() + str(i): t.xyann for i, t in enumerate(ax.texts)}
+    plt.close(fig)
+    assert len(offsets) == 3
+    first, second, far = offsets.values()
+    assert first != second        # stacked
+    assert far == first           # a label with room keeps the usual place

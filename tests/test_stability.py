@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from click.testing import CliRunner
@@ -283,3 +285,31 @@ def test_plot_command_draws_saved_branches_and_boundaries(tmp_path):
         out = runner.invoke(cli, ["plot", str(saved), "-o", str(figure)])
         assert out.exit_code == 0, out.output
         assert figure.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_scans_without_output_write_beside_the_case_under_its_name(tmp_path, monkeypatch):
+    """Without -o a scan wrote branches.nc, boundary.nc or stability.nc in the working
+    directory whatever the case, so the scan of a second case silently replaced the
+    first's. Like `fivdisc simulate`, each now writes beside the case file, named after
+    it (a packaged example's in the working directory), and says where."""
+    monkeypatch.chdir(tmp_path)
+    for name in ("one", "two"):
+        (tmp_path / "cases").mkdir(exist_ok=True)
+        (tmp_path / "cases" / f"{name}.toml").write_text("[speed]\nvalue = 1.0\n")
+    written = []
+    for name in ("one", "two"):
+        case = str(tmp_path / "cases" / f"{name}.toml")
+        for args in (["--x", "speed.value=1:2:3"],
+                     ["--x", "speed.value=1:2:3", "--y", "decay=0:1:2"],
+                     ["--boundary", "speed.value=1:2", "decay=0:1"]):
+            out = CliRunner().invoke(cli, ["stability", case, *args, "--no-progress"])
+            assert out.exit_code == 0, out.output
+            written.append(out.output.split("wrote ", 1)[1].split()[0])
+    assert written == [str(tmp_path / "cases" / f"{name}-{kind}.nc")
+                       for name in ("one", "two") for kind in ("branches", "stability", "boundary")]
+    assert all(Path(path).is_file() for path in written)
+    assert not list(tmp_path.glob("*.nc"))
+    example = CliRunner().invoke(cli, ["stability", "fig03a", "--x",
+                                       "rotational_damping=0:3:3", "--no-progress"])
+    assert example.exit_code == 0, example.output
+    assert (tmp_path / "fig03a-branches.nc").is_file()

@@ -60,6 +60,11 @@ def draw_branch(ax: Axes, branch: Branch, measure: str = "period", slider: int =
             piece = slice(a, min(b + 1, x.size))
             ax.plot(x[piece], y[piece], color=color, lw=1.4,
                     linestyle="-" if stable[a] else "--")
+    # Labels placed so far, in axes fractions of the data's span: one that would land on
+    # an earlier one (bifurcations a few thousandths of the span apart) is stacked above.
+    span_x = float(np.ptp(x)) or 1.0
+    span_y = max(float(np.nanmax(y) - np.nanmin(y)) for _, y, _ in curves) or 1.0
+    placed: list[tuple[float, float]] = []
     for b in branch.bifurcations():
         label, marker = _MARKS.get(b["kind"], ("?", "x"))
         i = b["point"]
@@ -74,8 +79,12 @@ def draw_branch(ax: Axes, branch: Branch, measure: str = "period", slider: int =
             ax.plot([b["parameter"]], [yb], marker=marker, color="C3", ms=6, mfc="none",
                     mew=1.3, linestyle="none")
             if labels:
+                here = (b["parameter"] / span_x, yb / span_y)
+                near = sum(abs(here[0] - u) < 0.03 and abs(here[1] - v) < 0.03
+                           for u, v in placed)
+                placed.append(here)
                 ax.annotate(label, (b["parameter"], yb), textcoords="offset points",
-                            xytext=(4, 4), fontsize=8, color="C3")
+                            xytext=(4, 4 + 9 * near), fontsize=8, color="C3")
 
 
 def plot_branch(branch: Branch, measure: str = "period", slider: int = 0,

@@ -120,8 +120,9 @@ class Branch:
         point's ``value``, ``omega`` [rad/s], ``direction``, ``criticality``
         (``"subcritical"`` or ``"supercritical"``), the ``bistable`` range (low, high;
         nan if none) and whether its end away from the Hopf point is only a bound
-        (``bistable_open``: the stick-slip orbits beyond a grazing are not followed);
-        else None."""
+        (``bistable_open``: the stick-slip orbits beyond a grazing are not followed),
+        and whether a subcritical branch stopped before deciding it
+        (``bistable_undetermined``: no fold or grazing reached); else None."""
         attrs = self.dataset.attrs
         if "criticality" not in attrs:
             return None
@@ -129,7 +130,8 @@ class Branch:
                 "direction": int(attrs["hopf_direction"]),
                 "criticality": str(attrs["criticality"]),
                 "bistable": (float(attrs["bistable_low"]), float(attrs["bistable_high"])),
-                "bistable_open": bool(attrs.get("bistable_open", 0))}
+                "bistable_open": bool(attrs.get("bistable_open", 0)),
+                "bistable_undetermined": bool(attrs.get("bistable_undetermined", 0))}
 
     # --- writing ------------------------------------------------------------------------
 
@@ -292,7 +294,13 @@ class Branch:
             lines.append(f"from the Hopf point at {self.key} = {hopf['value']:.9g}{unit}: "
                          f"{hopf['criticality']}")
             low, high = hopf["bistable"]
-            if math.isnan(low):
+            if math.isnan(low) and hopf["bistable_undetermined"]:
+                reach = (f"not determined up to {self.key} = {p[-1]:.9g}{unit}: the "
+                         "slipping orbits there are unstable and have neither folded nor "
+                         "grazed; they bound the basin of stable sliding, and the motion "
+                         "beyond them may be a stable vibration (continue further, or "
+                         "continue a stick-slip orbit with --from)")
+            elif math.isnan(low):
                 reach = "none found"
             elif hopf["bistable_open"]:
                 near_hopf = high if high == hopf["value"] else low

@@ -194,7 +194,9 @@ def mode_couplings(lam: np.ndarray, tolerance: float = COUPLING_TOLERANCE
                    ) -> list[tuple[int, int, int]]:
     """Where pairs of branches couple: ``(index, first, second)`` at each edge of an
     interval of values where the two positive frequencies agree within `tolerance`
-    (relative) and the growth rates are further apart than just outside it; `index` is
+    (relative) and the growth rates are further apart than just outside it, where they
+    agree within `tolerance` of the frequency (the eigenvalues meet; modes already apart
+    in growth rate that cross in frequency do not couple); `index` is
     the edge's value inside the interval (where the modes merge, and where they part
     again).
 
@@ -214,8 +216,12 @@ def mode_couplings(lam: np.ndarray, tolerance: float = COUPLING_TOLERANCE
                 if merged[i] == merged[i - 1] or not np.isfinite(wa[i - 1] + wb[i]):
                     continue
                 inside, outside = (i, i - 1) if merged[i] else (i - 1, i)
-                # The growth rates part on the merged side (a coupling, not a veering).
-                if split[inside] > split[outside]:
+                # The growth rates part on the merged side (a coupling, not a veering),
+                # and just outside it they agree as closely as the frequencies do: the
+                # eigenvalues meet. Modes whose growth rates are already apart only
+                # cross in frequency.
+                near = tolerance * max(abs(wa[outside]), abs(wb[outside]))
+                if split[outside] <= near and split[inside] > split[outside]:
                     found.append((inside, a, b))
     return sorted(found)
 

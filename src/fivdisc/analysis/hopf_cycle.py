@@ -95,13 +95,17 @@ def hopf_cycles(
     the first Lyapunov coefficient ``l1``: ``c`` has the sign of ``-l1 / (d Re lambda /
     dp)``). The bistable range is where the equilibrium is stable and a stable orbit of
     the branch exists: from the Hopf value to the farthest stable orbit on the
-    equilibrium's stable side (a fold of cycles), or at least to where unstable
+    equilibrium's stable side (a fold of cycles, at its located value), or at least to
+    where unstable
     slipping orbits on that side graze the stick boundary. There stick-slip orbits
     begin, and the unstable orbits separate the equilibrium's basin from them; the
     stick-slip orbits themselves are not continued here and may coexist with the
     equilibrium beyond the grazing value, so that end of the range is then a bound
     only (``bistable_open``; continue a stick-slip orbit there with
-    :func:`~fivdisc.analysis.continuation.continue_orbit` to find where it ends). The
+    :func:`~fivdisc.analysis.continuation.continue_orbit` to find where it ends). A
+    subcritical branch that stops before its orbits fold or graze leaves the range
+    undetermined (``bistable_undetermined``): its unstable orbits bound the equilibrium's
+    basin, and the motion beyond them may be a stable vibration coexisting with it. The
     equilibrium's stability beyond other Hopf points of the key is not checked.
     """
     if not (np.isfinite(amplitude) and 0 < amplitude <= 0.5):
@@ -140,7 +144,13 @@ def _judge(result: Branch, hopf: HopfPoint) -> None:
     # grazing value, where they are not followed: the range is then open on that side.
     grazing = [b["parameter"] for b in result.bifurcations()
                if b["kind"] == "grazing" and (b["parameter"] - hopf.value) * unstable_side < 0]
-    coexist = np.array(coexist + grazing)
+    # A fold next to a stable point is the farthest end of those stable orbits, located
+    # more exactly than any point computed beside it.
+    n = len(p)
+    folds = [b["parameter"] for b in result.bifurcations()
+             if b["kind"] == "fold" and (b["parameter"] - hopf.value) * unstable_side < 0
+             and any(result.stable[i] for i in (b["point"], b["point"] + 1) if i < n)]
+    coexist = np.array(coexist + grazing + folds)
     open_end = False
     if hopf.on_boundary and coexist.size:
         far = coexist[np.argmax(np.abs(coexist - hopf.value))]
@@ -148,7 +158,12 @@ def _judge(result: Branch, hopf: HopfPoint) -> None:
         low, high = sorted((float(far), hopf.value))
     else:
         low = high = np.nan
+    # A subcritical point's unstable orbits bound the basin of stable sliding; until the
+    # branch folds or grazes, what lies beyond them (and whether it is a stable
+    # vibration) is not known: the range is undetermined, not absent.
+    undetermined = bool(hopf.on_boundary and kind == "subcritical" and not coexist.size)
     result.dataset.attrs.update({"hopf_value": hopf.value, "hopf_omega": hopf.omega,
                                  "hopf_direction": hopf.direction, "criticality": kind,
                                  "bistable_low": low, "bistable_high": high,
-                                 "bistable_open": int(open_end)})
+                                 "bistable_open": int(open_end),
+                                 "bistable_undetermined": int(undetermined)})

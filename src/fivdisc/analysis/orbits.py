@@ -192,10 +192,11 @@ class PeriodicOrbit:
 
 
 def state_labels(model: Model) -> tuple[str, ...]:
-    """Names of the state's coordinates: ``q_C01``, ``phi_1``, ``z_1`` and their rates."""
+    """Names of the state's coordinates: ``q_C01``, ``phi_0``, ``z_0`` and their rates
+    (sliders numbered from 0, as ``sliders.J`` in a case)."""
     ns = model.n_sliders
-    pos = ([f"q_{lab}" for lab in model.labels] + [f"phi_{j + 1}" for j in range(ns)]
-           + [f"z_{j + 1}" for j in range(ns)])
+    pos = ([f"q_{lab}" for lab in model.labels] + [f"phi_{j}" for j in range(ns)]
+           + [f"z_{j}" for j in range(ns)])
     return tuple(pos + [f"{p}_dot" for p in pos])
 
 

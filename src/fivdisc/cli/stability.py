@@ -22,7 +22,8 @@ from fivdisc.errors import FivdiscError
               help="Trace the exact stability boundary (Hopf curves) in this box.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               help="map.nc (netCDF dataset) or a figure in any format matplotlib writes "
-              "(map.png, map.pdf, map.svg, ...).")
+              "(map.png, map.pdf, map.svg, ...). Default: beside the case file, "
+              "CASE-branches.nc, CASE-stability.nc or CASE-boundary.nc.")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the equilibrium and the eigenvalues as JSON (without a map).")
 @click.option("--progress/--no-progress", default=True, show_default=True)
@@ -74,10 +75,16 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
 
 
 def _target(case_file: Path | None, output: Path | None, default: str) -> tuple[Path, bool]:
-    """Checked output path, and whether it is a figure."""
+    """Checked output path, and whether it is a figure. Without `output`: beside the case
+    file, named after it (``CASE-branches.nc``; a packaged example's in the working
+    directory), as ``fivdisc simulate`` writes; without a case, `default` here."""
+    from fivdisc.cli._case import default_output
     from fivdisc.extras import require
     from fivdisc.files import check_output, figure_suffixes
 
+    if output is None and case_file is not None:
+        beside = default_output(case_file, ".nc")
+        output = beside.with_name(f"{beside.stem}-{Path(default).stem}.nc")
     target = output or Path(default)
     figure = target.suffix.lower() != ".nc"
     if figure:
