@@ -149,7 +149,8 @@ def callee_types(run: Integration) -> dict[str, tuple]:
     found.update({
         # tangent.jvp: the side a numpy bool, the complex-step arrays of the scratch
         "jvp_rhs": (f8, tcx[0], ph, sg, types.boolean, mdl, tcx[2], tcx[1]),
-        "saltation": (i8, i8, f8, ypre, ph, sgpre, ev_prev, y, ph, sg, row, mdl, tv, tk, tsc),
+        "saltation": (i8, i8, f8, ypre, ph, sgpre, ev_prev, y, ph, sg, row, mat, mdl, tv, tk,
+                      tsc),
         "tangent_stages": (f8, f8, y, ph, sg, mdl, mat, k, vec, vec, vec, tys, twk),
         "step": (f8, f8, ph, sg, mdl, tys, twk, tv, tk, tvn, tvs, tcx),
         "interpolate": (f8, f8, tv, tk, tsc),

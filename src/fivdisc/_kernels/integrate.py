@@ -423,7 +423,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
         _restart(t, y, ph, sg, mdl, wk, k, ev_prev)
         if tan is not None:
             tangent.saltation(MODE_START, NO_EVENT, t, ypre, ph_start, sgpre, ev_prev, y, ph, sg,
-                              k[0], mdl, tv, tk, tsc)
+                              k[0], wk, mdl, tv, tk, tsc)
         if h <= 0.0:
             h = _initial_step(t, y, k[0], ph, sg, mdl, wk, ctl, ytmp, dy, nd)
         if ist[I_OUT_NEXT] == 0 and out_y.shape[0] > 0:
@@ -587,7 +587,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
             ist[I_RHS] += 1
             if tan is not None:
                 tangent.saltation(MODE_EVENT, which, t, ypre, ph_start, sgpre, ev_start, y,
-                                  ph, sg, k[0], mdl, tv, tk, tsc)
+                                  ph, sg, k[0], wk, mdl, tv, tk, tsc)
             stop_mask = int(ctl[C_STOP_MASK])
             for e in range(first_new, ist[I_EVENTS]):
                 if stop_mask & (1 << ev_i[e, EVI_KIND]):
@@ -644,7 +644,7 @@ def run(t_target, mdl, ctl, fst, ist, y, ph, sg, k, ev_prev, breaks, out_y, out_
             ist[I_RHS] += 1
             if tan is not None:
                 tangent.saltation(MODE_KINK, NO_EVENT, t, ypre, ph_start, sgpre, ev_prev, y, ph, sg,
-                                  k[0], mdl, tv, tk, tsc)
+                                  k[0], wk, mdl, tv, tk, tsc)
 
     _complete_rows(first_row, ist[I_OUT_NEXT], ctl, mdl, wk, yout, dy, ph.copy(), sg.copy(),
                    out_y, out_aux, fst)

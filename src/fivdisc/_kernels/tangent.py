@@ -64,20 +64,26 @@ def scratch(mdl, y, n_vectors):
     """Work arrays of the tangent integration: (the complex step's state, derivative and
     work array), complex stages and event values, the tangents at a step's end, a stage's
     tangent, dense-output coefficients, two vectors, a real work array, the state and
-    slip signs before a switch (slots 9 and 10), and the state's stage states and work
-    arrays (slots 11 and 12), which the state's stages fill for :func:`step`.
+    slip signs before a switch (slots 9 and 10), the state's stage states and work
+    arrays (slots 11 and 12), which the state's stages fill for :func:`step`, and what
+    the switch on the complex state records and changes in :func:`saltation` (slot 13:
+    event times and rows, counters, floats, phases and signs).
 
     The per-step functions (:func:`step`, ``accept``, ...) never allocate and run
-    without reference counting."""
+    without reference counting; the saltation allocates nothing of its own."""
     nd = n_dynamic(mdl)
-    n_ev = 3 * sizes(mdl)[1]
+    n_sl = sizes(mdl)[1]
+    n_ev = 3 * n_sl
     yc = np.empty(nd, np.complex128)
     cplx = (yc, np.empty(nd, np.complex128), new_work(mdl, yc))
     wk = new_work(mdl, y)
+    n_rec = 8 * n_sl + 8
+    rec = (np.empty(n_rec), np.empty((n_rec, N_EVI), np.int64), np.empty(N_ISTATE, np.int64),
+           np.empty(N_FSTATE), np.empty(n_sl, np.int64), np.empty(n_sl, np.int64))
     return (cplx, np.empty((7, nd), np.complex128), np.empty(n_ev, np.complex128),
             np.empty((n_vectors, nd)), np.empty(nd), np.empty((5, nd)), np.empty(nd),
-            np.empty(nd), wk, np.empty(nd), np.empty(sizes(mdl)[1], np.int64),
-            np.empty((7, y.shape[0])), np.zeros((7, wk.shape[0], wk.shape[1])))
+            np.empty(nd), wk, np.empty(nd), np.empty(n_sl, np.int64),
+            np.empty((7, y.shape[0])), np.zeros((7, wk.shape[0], wk.shape[1])), rec)
 
 
 @njit(cache=True, _nrt=False)
@@ -211,29 +217,29 @@ def _event_rate(e, t, y, ph, sg, mdl, sc, v, dt):
 
 
 @njit(cache=True)
-def saltation(mode, e, t, ypre, ph_pre, sg_pre, ev_start, y, ph, sg, fplus, mdl, V, KV, sc):
+def saltation(mode, e, t, ypre, ph_pre, sg_pre, ev_start, y, ph, sg, fplus, wk, mdl, V, KV,
+              sc):
     """Map the tangents across the switch that took the state from ``ypre`` (phases
     ``ph_pre``, signs ``sg_pre``) to ``y`` (phases ``ph``) at time ``t``: event ``e`` for
     ``mode`` ``MODE_EVENT``, else a switch at a fixed time (a kink). ``fplus`` is the
-    new phases' right-hand side at ``y``. ``ev_start`` are the event values at the start
-    of the step, as the switch had them."""
+    new phases' right-hand side at ``y``, and ``wk`` what its evaluation left (the
+    restart's, ``switch._restart``). ``ev_start`` are the event values at the start of
+    the step, as the switch had them."""
     yc, dyc, wkc = sc[0]
     kc, evc = sc[1], sc[2]
     fm, w, wkr = sc[6], sc[7], sc[8]
+    ev_t, ev_i, ist, fst, phs, sgs = sc[13]
     nd = V.shape[1]
     n_sl = ph.shape[0]
-    ev_t = np.empty(8 * n_sl + 8)
-    ev_i = np.empty((ev_t.shape[0], N_EVI), np.int64)
-    ist = np.zeros(N_ISTATE, np.int64)
-    fst = np.full(N_FSTATE, np.inf)
+    for i in range(fst.shape[0]):
+        fst[i] = np.inf
     hdot = 1.0
     if mode == MODE_EVENT:
         evaluate(t, ypre, ph_pre, sg_pre, LEFT, mdl, wkr, fm)
         hdot = _event_rate(e, t, ypre, ph_pre, sg_pre, mdl, sc, fm, 1.0)
     else:
-        fm[:] = 0.0
-    phs = ph_pre.copy()
-    sgs = sg_pre.copy()
+        for i in range(nd):
+            fm[i] = 0.0
     for r in range(V.shape[0]):
         dtau = 0.0
         if mode == MODE_EVENT:
@@ -247,16 +253,16 @@ def saltation(mode, e, t, ypre, ph_pre, sg_pre, ev_start, y, ph, sg, fplus, mdl,
         for j in range(n_sl):
             phs[j] = ph_pre[j]
             sgs[j] = sg_pre[j]
-        ist[:] = 0
+        for i in range(ist.shape[0]):
+            ist[i] = 0
         _switch(mode, e, complex(t, h * dtau), yc, phs, sgs, ph_pre, ev_start, mdl, wkc, dyc,
                 kc, evc, ev_t, ev_i, ist, fst)
         for i in range(nd):
             V[r, i] = yc[i].imag / h - fplus[i] * dtau
         slave(ph, mdl, V[r])
-    # The new phases' right-hand side at the new state, for the first stages.
-    evaluate(t, y, ph, sg, RIGHT, mdl, wkr, np.empty_like(y))
+    # The first stages from the new phases' right-hand side at the new state.
     for r in range(V.shape[0]):
-        jvp(t, y, V[r], ph, sg, RIGHT, mdl, wkr, sc[0], KV[r, 0])
+        jvp(t, y, V[r], ph, sg, RIGHT, mdl, wk, sc[0], KV[r, 0])
 
 
 # One vector's scratch; not a literal (see the package docstring).
