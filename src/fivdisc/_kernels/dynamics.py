@@ -432,6 +432,57 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
     for i in range(n):
         dy[half + i] = wk[r_fq, i]
     for k in range(ns):
+        if ph[k] == STICK:
+            moment = sl[S_SHH, k] * wk[aux + A_F, k]
+            for i in range(n):
+                dy[half + i] += moment * wk[r_gp + k, i]
+    if ns == 2 and ph[0] != SEPARATION and ph[1] != SEPARATION:
+        _two_contacts(n, half, ph, omd, zero, sl, disc, r_gp, aux, r_sys, r_u, wk, dy)
+    else:
+        _system(n, ns, half, ph, omd, zero, sl, disc, r_gp, aux, r_sys, r_u, wk, dy)
+        _solve_inline(wk, r_sys, ns)
+
+    for k in range(ns):
+        if ph[k] == SEPARATION:
+            continue
+        nf = wk[r_sys + k, ns]
+        wk[aux + A_N, k] = nf
+        if ph[k] == SLIP:
+            wk[aux + A_F, k] = wk[aux + A_SMU, k] * nf
+            dy[half + n + k] = (wk[aux + A_FPHI, k] + sl[S_RADIUS, k] * wk[aux + A_F, k]) / (
+                sl[S_INERTIA, k])
+        else:
+            dy[half + n + k] = omd + y[n + k] * 0.0
+    # A flying slider's normal force is 0 (set by ``evaluate``), and so is its column.
+    for i in range(n):
+        acc = dy[half + i] * disc[D_MINV, i]
+        for k in range(ns):
+            acc -= wk[aux + A_N, k] * wk[r_u + i, k]
+        dy[half + i] = acc
+
+
+@njit(cache=True, inline="always")
+def _row_ends(j, ph, ajj, gf, omd, sl, aux, wk):
+    """Diagonal entry and right-hand side of contact j's row of the normal forces'
+    system, from ``ajj`` (its diagonal dot product times sigma_j m_j) and ``gf``
+    (g_j M^-1 F)."""
+    sm = sl[S_SMASS, j]
+    gpq = wk[aux + A_GPQ, j]
+    diag = ajj + 1.0
+    if ph[j] == SLIP:
+        diag -= sm * gpq * sl[S_RADIUS, j] * wk[aux + A_SMU, j] / sl[S_INERTIA, j]
+        rhs = (wk[aux + A_KNOWN, j] + sm * gf
+               + sm * gpq * wk[aux + A_FPHI, j] / sl[S_INERTIA, j])
+    else:
+        rhs = wk[aux + A_KNOWN, j] + sm * gf + sm * gpq * omd
+    return diag, rhs
+
+
+@njit(cache=True, _nrt=False)
+def _system(n, ns, half, ph, omd, zero, sl, disc, r_gp, aux, r_sys, r_u, wk, dy):
+    """The normal forces' system of :func:`_contacts` in rows ``r_sys ..`` of ``wk``,
+    and the contacts' columns ``r_u + i`` (the disc forces F are in ``dy``)."""
+    for k in range(ns):
         if ph[k] == SEPARATION:
             for i in range(n):
                 wk[r_u + i, k] = zero
@@ -439,10 +490,6 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
         c = zero
         if ph[k] == SLIP:
             c = sl[S_HH, k] * wk[aux + A_SMU, k]
-        else:
-            moment = sl[S_SHH, k] * wk[aux + A_F, k]
-            for i in range(n):
-                dy[half + i] += moment * wk[r_gp + k, i]
         sigma = sl[S_SIGMA, k]
         for i in range(n):
             wk[r_u + i, k] = sigma * (wk[k, i] - c * wk[r_gp + k, i]) * disc[D_MINV, i]
@@ -496,34 +543,64 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
             for i in range(n):
                 a0 += wk[j, i] * wk[r_u + i, k]
             wk[row, k] = a0 * sm
-        gpq = wk[aux + A_GPQ, j]
-        wk[row, j] += 1.0
-        if ph[j] == SLIP:
-            smu = wk[aux + A_SMU, j]
-            wk[row, j] -= sm * gpq * sl[S_RADIUS, j] * smu / sl[S_INERTIA, j]
-            wk[row, ns] = (wk[aux + A_KNOWN, j] + sm * gf
-                           + sm * gpq * wk[aux + A_FPHI, j] / sl[S_INERTIA, j])
-        else:
-            wk[row, ns] = wk[aux + A_KNOWN, j] + sm * gf + sm * gpq * omd
-    _solve_inline(wk, r_sys, ns)
+        wk[row, j], wk[row, ns] = _row_ends(j, ph, wk[row, j], gf, omd, sl, aux, wk)
 
-    for k in range(ns):
-        if ph[k] == SEPARATION:
-            continue
-        nf = wk[r_sys + k, ns]
-        wk[aux + A_N, k] = nf
-        if ph[k] == SLIP:
-            wk[aux + A_F, k] = wk[aux + A_SMU, k] * nf
-            dy[half + n + k] = (wk[aux + A_FPHI, k] + sl[S_RADIUS, k] * wk[aux + A_F, k]) / (
-                sl[S_INERTIA, k])
-        else:
-            dy[half + n + k] = omd + y[n + k] * 0.0
-    # A flying slider's normal force is 0 (set by ``evaluate``), and so is its column.
+
+@njit(cache=True, inline="always")
+def _two_contacts(n, half, ph, omd, zero, sl, disc, r_gp, aux, r_sys, r_u, wk, dy):
+    """The normal forces of two sliders, both in contact, left in ``wk[r_sys + k, 2]``
+    as :func:`_system` and :func:`solve_small` would leave them (the same operations in
+    the same order, so the same numbers), and the contacts' columns ``r_u + i``.
+
+    Every sum is taken in one pass over the modal coordinates and the 2 x 2 system is
+    solved in registers: at two sliders, the general path's separate passes and its
+    solve's loops cost more than their arithmetic."""
+    c0 = zero
+    if ph[0] == SLIP:
+        c0 = sl[S_HH, 0] * wk[aux + A_SMU, 0]
+    c1 = zero
+    if ph[1] == SLIP:
+        c1 = sl[S_HH, 1] * wk[aux + A_SMU, 1]
+    sig0 = sl[S_SIGMA, 0]
+    sig1 = sl[S_SIGMA, 1]
+    gf0 = zero
+    gf1 = zero
+    a00 = zero
+    a01 = zero
+    a10 = zero
+    a11 = zero
     for i in range(n):
-        acc = dy[half + i] * disc[D_MINV, i]
-        for k in range(ns):
-            acc -= wk[aux + A_N, k] * wk[r_u + i, k]
-        dy[half + i] = acc
+        minv = disc[D_MINV, i]
+        g0 = wk[0, i]
+        g1 = wk[1, i]
+        u0 = sig0 * (g0 - c0 * wk[r_gp, i]) * minv
+        u1 = sig1 * (g1 - c1 * wk[r_gp + 1, i]) * minv
+        f = dy[half + i]
+        gf0 += g0 * minv * f
+        gf1 += g1 * minv * f
+        a00 += g0 * u0
+        a01 += g0 * u1
+        a10 += g1 * u0
+        a11 += g1 * u1
+        wk[r_u + i, 0] = u0
+        wk[r_u + i, 1] = u1
+    sm0 = sl[S_SMASS, 0]
+    sm1 = sl[S_SMASS, 1]
+    d0, b0 = _row_ends(0, ph, a00 * sm0, gf0, omd, sl, aux, wk)
+    d1, b1 = _row_ends(1, ph, a11 * sm1, gf1, omd, sl, aux, wk)
+    e01 = a01 * sm0
+    e10 = a10 * sm1
+    # solve_small's elimination with partial pivoting on the real parts, written out.
+    if abs(e10.real) > abs(d0.real):
+        p00, p01, q0, p10, p11, q1 = e10, d1, b1, d0, e01, b0
+    else:
+        p00, p01, q0, p10, p11, q1 = d0, e01, b0, e10, d1, b1
+    fac = p10 * (1.0 / p00)
+    p11 -= fac * p01
+    q1 -= fac * q0
+    x1 = q1 / p11
+    wk[r_sys, 2] = (q0 - p01 * x1) / p00
+    wk[r_sys + 1, 2] = x1
 
 
 @njit(cache=True, _nrt=False)
