@@ -255,7 +255,11 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
     damped = opts[O_DAMPED] != 0.0
     om2 = om * om
     for i in range(n):
-        wk[r_fq, i] = _disc_force(i, y, om, om2, omd, eps, damped, disc, half)
+        fi = _disc_force(i, y, om, om2, omd, eps, damped, disc, half)
+        wk[r_fq, i] = fi
+        # Where several sliders' contacts gather the disc's forces (``_one_slider``
+        # overwrites it).
+        dy[half + i] = fi
         dy[i] = y[half + i]
 
     lmax = int(opts[O_LMAX])
@@ -429,8 +433,6 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
     (0 for a flying slider), so that the system's rows and the accelerations are sums of
     contiguous rows (which the compiler vectorises) rather than S^2 short dot products.
     """
-    for i in range(n):
-        dy[half + i] = wk[r_fq, i]
     for k in range(ns):
         if ph[k] == STICK:
             moment = sl[S_SHH, k] * wk[aux + A_F, k]
@@ -478,7 +480,7 @@ def _row_ends(j, ph, ajj, gf, omd, sl, aux, wk):
     return diag, rhs
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, inline="always")
 def _system(n, ns, half, ph, omd, zero, sl, disc, r_gp, aux, r_sys, r_u, wk, dy):
     """The normal forces' system of :func:`_contacts` in rows ``r_sys ..`` of ``wk``,
     and the contacts' columns ``r_u + i`` (the disc forces F are in ``dy``)."""
