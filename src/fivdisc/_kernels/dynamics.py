@@ -246,7 +246,7 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
     shape = mdl.shape
     opts = mdl.opts
     n, ns, half = sizes(mdl)
-    r_gp, r_fq, r_trig, r_aux, r_sys, r_u = work_rows(ns)
+    r_gp, r_fq, r_trig, r_aux, _, _ = work_rows(ns)
     om, omd = speed_at(t, mdl.speed, right)
     zero = y[n] * 0.0
 
@@ -370,8 +370,7 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
         _one_slider(n, half, phj, known, smu, fphi, f, gpq, s_gf, s_gg, s_ggp, y[n], omd,
                     zero, sl, disc, r_gp, r_fq, aux, wk, dy)
     else:
-        _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r_u, wk,
-                  dy)
+        _contacts(n, ns, half, y, ph, omd, zero, sl, disc, wk, dy)
 
     if y.shape[0] > n_dynamic(mdl):
         _powers(y, ph, om, omd, mdl, wk, dy)
@@ -415,7 +414,7 @@ def _one_slider(n, half, phj, known, smu, fphi, f, gpq, s_gf, s_gg, s_ggp, phi, 
 
 
 @njit(cache=True, _nrt=False)
-def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r_u, wk, dy):
+def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, wk, dy):
     """Normal forces and accelerations of several sliders.
 
     Notes
@@ -433,34 +432,39 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
     (0 for a flying slider), so that the system's rows and the accelerations are sums of
     contiguous rows (which the compiler vectorises) rather than S^2 short dot products.
     """
+    # The rows recomputed here rather than passed: each argument of a call is a store.
+    r_gp, _, _, aux, r_sys, r_u = work_rows(ns)
     for k in range(ns):
         if ph[k] == STICK:
             moment = sl[S_SHH, k] * wk[aux + A_F, k]
             for i in range(n):
                 dy[half + i] += moment * wk[r_gp + k, i]
     if ns == 2 and ph[0] != SEPARATION and ph[1] != SEPARATION:
-        _two_contacts(n, half, ph, omd, zero, sl, disc, r_gp, aux, r_sys, r_u, wk, dy)
-    else:
-        _system(n, ns, half, ph, omd, zero, sl, disc, r_gp, aux, r_sys, r_u, wk, dy)
-        _solve_inline(wk, r_sys, ns)
-
+        _two_contacts(n, half, y, ph, omd, zero, sl, disc, r_gp, aux, r_u, wk, dy)
+        return
+    _system(n, ns, half, ph, omd, zero, sl, disc, r_gp, aux, r_sys, r_u, wk, dy)
+    _solve_inline(wk, r_sys, ns)
     for k in range(ns):
-        if ph[k] == SEPARATION:
-            continue
-        nf = wk[r_sys + k, ns]
-        wk[aux + A_N, k] = nf
-        if ph[k] == SLIP:
-            wk[aux + A_F, k] = wk[aux + A_SMU, k] * nf
-            dy[half + n + k] = (wk[aux + A_FPHI, k] + sl[S_RADIUS, k] * wk[aux + A_F, k]) / (
-                sl[S_INERTIA, k])
-        else:
-            dy[half + n + k] = omd + y[n + k] * 0.0
+        if ph[k] != SEPARATION:
+            _contact_result(n, half, k, wk[r_sys + k, ns], y, ph, omd, sl, aux, wk, dy)
     # A flying slider's normal force is 0 (set by ``evaluate``), and so is its column.
     for i in range(n):
         acc = dy[half + i] * disc[D_MINV, i]
         for k in range(ns):
             acc -= wk[aux + A_N, k] * wk[r_u + i, k]
         dy[half + i] = acc
+
+
+@njit(cache=True, inline="always")
+def _contact_result(n, half, k, nf, y, ph, omd, sl, aux, wk, dy):
+    """Slider k's normal force ``nf`` [N], its friction force and its phi''."""
+    wk[aux + A_N, k] = nf
+    if ph[k] == SLIP:
+        wk[aux + A_F, k] = wk[aux + A_SMU, k] * nf
+        dy[half + n + k] = (wk[aux + A_FPHI, k] + sl[S_RADIUS, k] * wk[aux + A_F, k]) / (
+            sl[S_INERTIA, k])
+    else:
+        dy[half + n + k] = omd + y[n + k] * 0.0
 
 
 @njit(cache=True, inline="always")
@@ -549,14 +553,15 @@ def _system(n, ns, half, ph, omd, zero, sl, disc, r_gp, aux, r_sys, r_u, wk, dy)
 
 
 @njit(cache=True, inline="always")
-def _two_contacts(n, half, ph, omd, zero, sl, disc, r_gp, aux, r_sys, r_u, wk, dy):
-    """The normal forces of two sliders, both in contact, left in ``wk[r_sys + k, 2]``
-    as :func:`_system` and :func:`solve_small` would leave them (the same operations in
-    the same order, so the same numbers), and the contacts' columns ``r_u + i``.
+def _two_contacts(n, half, y, ph, omd, zero, sl, disc, r_gp, aux, r_u, wk, dy):
+    """:func:`_contacts` for two sliders, both in contact, with the operations of
+    :func:`_system`, :func:`solve_small` and the general path's end in the same order,
+    so the same numbers.
 
-    Every sum is taken in one pass over the modal coordinates and the 2 x 2 system is
-    solved in registers: at two sliders, the general path's separate passes and its
-    solve's loops cost more than their arithmetic."""
+    Every sum is taken in one pass over the modal coordinates, the 2 x 2 system is
+    solved in registers, and the accelerations recompute u_k rather than store it: at
+    two sliders the general path's separate passes and its solve's loops cost more than
+    their arithmetic."""
     c0 = zero
     if ph[0] == SLIP:
         c0 = sl[S_HH, 0] * wk[aux + A_SMU, 0]
@@ -584,8 +589,6 @@ def _two_contacts(n, half, ph, omd, zero, sl, disc, r_gp, aux, r_sys, r_u, wk, d
         a01 += g0 * u1
         a10 += g1 * u0
         a11 += g1 * u1
-        wk[r_u + i, 0] = u0
-        wk[r_u + i, 1] = u1
     sm0 = sl[S_SMASS, 0]
     sm1 = sl[S_SMASS, 1]
     d0, b0 = _row_ends(0, ph, a00 * sm0, gf0, omd, sl, aux, wk)
@@ -601,8 +604,15 @@ def _two_contacts(n, half, ph, omd, zero, sl, disc, r_gp, aux, r_sys, r_u, wk, d
     p11 -= fac * p01
     q1 -= fac * q0
     x1 = q1 / p11
-    wk[r_sys, 2] = (q0 - p01 * x1) / p00
-    wk[r_sys + 1, 2] = x1
+    x0 = (q0 - p01 * x1) / p00
+    _contact_result(n, half, 0, x0, y, ph, omd, sl, aux, wk, dy)
+    _contact_result(n, half, 1, x1, y, ph, omd, sl, aux, wk, dy)
+    for i in range(n):
+        minv = disc[D_MINV, i]
+        acc = dy[half + i] * minv
+        acc -= x0 * (sig0 * (wk[0, i] - c0 * wk[r_gp, i]) * minv)
+        acc -= x1 * (sig1 * (wk[1, i] - c1 * wk[r_gp + 1, i]) * minv)
+        dy[half + i] = acc
 
 
 @njit(cache=True, _nrt=False)
