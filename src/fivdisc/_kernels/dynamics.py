@@ -246,7 +246,7 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
     shape = mdl.shape
     opts = mdl.opts
     n, ns, half = sizes(mdl)
-    r_gp, r_fq, r_trig, r_aux, _, _ = work_rows(ns)
+    r_gp, r_fq, r_trig, r_aux, r_sys, r_u = work_rows(ns)
     om, omd = speed_at(t, mdl.speed, right)
     zero = y[n] * 0.0
 
@@ -370,7 +370,8 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
         _one_slider(n, half, phj, known, smu, fphi, f, gpq, s_gf, s_gg, s_ggp, y[n], omd,
                     zero, sl, disc, r_gp, r_fq, aux, wk, dy)
     else:
-        _contacts(n, ns, half, y, ph, omd, zero, sl, disc, wk, dy)
+        _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r_u, wk,
+                  dy)
 
     if y.shape[0] > n_dynamic(mdl):
         _powers(y, ph, om, omd, mdl, wk, dy)
@@ -414,7 +415,7 @@ def _one_slider(n, half, phj, known, smu, fphi, f, gpq, s_gf, s_gg, s_ggp, phi, 
 
 
 @njit(cache=True, _nrt=False)
-def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, wk, dy):
+def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r_u, wk, dy):
     """Normal forces and accelerations of several sliders.
 
     Notes
@@ -432,186 +433,150 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, wk, dy):
     (0 for a flying slider), so that the system's rows and the accelerations are sums of
     contiguous rows (which the compiler vectorises) rather than S^2 short dot products.
     """
-    # The rows recomputed here rather than passed: each argument of a call is a store.
-    r_gp, _, _, aux, r_sys, r_u = work_rows(ns)
     for k in range(ns):
         if ph[k] == STICK:
             moment = sl[S_SHH, k] * wk[aux + A_F, k]
             for i in range(n):
                 dy[half + i] += moment * wk[r_gp + k, i]
-    if ns == 2 and ph[0] != SEPARATION and ph[1] != SEPARATION:
-        _two_contacts(n, half, y, ph, omd, zero, sl, disc, r_gp, aux, r_u, wk, dy)
-        return
-    _system(n, ns, half, ph, omd, zero, sl, disc, r_gp, aux, r_sys, r_u, wk, dy)
-    _solve_inline(wk, r_sys, ns)
+    # Two sliders in contact: the contacts' columns, the system's entries and g_j M^-1 F
+    # in one pass over the modal coordinates, with the general path's operations in the
+    # same order (so the same numbers); its separate passes cost more than their
+    # arithmetic at two sliders.
+    two = ns == 2 and ph[0] != SEPARATION and ph[1] != SEPARATION
+    if two:
+        c0 = sl[S_HH, 0] * wk[aux + A_SMU, 0] if ph[0] == SLIP else zero
+        c1 = sl[S_HH, 1] * wk[aux + A_SMU, 1] if ph[1] == SLIP else zero
+        sig0 = sl[S_SIGMA, 0]
+        sig1 = sl[S_SIGMA, 1]
+        gf0 = zero
+        gf1 = zero
+        a00 = zero
+        a01 = zero
+        a10 = zero
+        a11 = zero
+        for i in range(n):
+            minv = disc[D_MINV, i]
+            g0 = wk[0, i]
+            g1 = wk[1, i]
+            u0 = sig0 * (g0 - c0 * wk[r_gp, i]) * minv
+            u1 = sig1 * (g1 - c1 * wk[r_gp + 1, i]) * minv
+            f = dy[half + i]
+            gf0 += g0 * minv * f
+            gf1 += g1 * minv * f
+            a00 += g0 * u0
+            a01 += g0 * u1
+            a10 += g1 * u0
+            a11 += g1 * u1
+            wk[r_u + i, 0] = u0
+            wk[r_u + i, 1] = u1
+        sm0 = sl[S_SMASS, 0]
+        sm1 = sl[S_SMASS, 1]
+        wk[r_sys, 0] = a00 * sm0
+        wk[r_sys, 1] = a01 * sm0
+        wk[r_sys, 2] = gf0
+        wk[r_sys + 1, 0] = a10 * sm1
+        wk[r_sys + 1, 1] = a11 * sm1
+        wk[r_sys + 1, 2] = gf1
+    else:
+        for k in range(ns):
+            if ph[k] == SEPARATION:
+                for i in range(n):
+                    wk[r_u + i, k] = zero
+                continue
+            c = zero
+            if ph[k] == SLIP:
+                c = sl[S_HH, k] * wk[aux + A_SMU, k]
+            sigma = sl[S_SIGMA, k]
+            for i in range(n):
+                wk[r_u + i, k] = sigma * (wk[k, i] - c * wk[r_gp + k, i]) * disc[D_MINV, i]
+        for j in range(ns):
+            row = r_sys + j
+            if ph[j] == SEPARATION:
+                for k in range(ns):
+                    wk[row, k] = zero
+                wk[row, j] = 1.0 + zero
+                wk[row, ns] = zero
+                continue
+            gf = zero
+            for i in range(n):
+                gf += wk[j, i] * disc[D_MINV, i] * dy[half + i]
+            sm = sl[S_SMASS, j]
+            # The entries summed in locals, four at a time: accumulated in wk, every
+            # term would be a load and a store of the same element (the compiler cannot
+            # tell wk's rows apart), and one at a time, a chain of n dependent additions
+            # each. Four chains side by side cost 0.8 x two at eight sliders (each
+            # entry's sum is the same, in the same order); the rest one at a time.
+            k = 0
+            while k + 3 < ns:
+                a0 = zero
+                a1 = zero
+                a2 = zero
+                a3 = zero
+                for i in range(n):
+                    gji = wk[j, i]
+                    a0 += gji * wk[r_u + i, k]
+                    a1 += gji * wk[r_u + i, k + 1]
+                    a2 += gji * wk[r_u + i, k + 2]
+                    a3 += gji * wk[r_u + i, k + 3]
+                wk[row, k] = a0 * sm
+                wk[row, k + 1] = a1 * sm
+                wk[row, k + 2] = a2 * sm
+                wk[row, k + 3] = a3 * sm
+                k += 4
+            while k < ns:
+                a0 = zero
+                for i in range(n):
+                    a0 += wk[j, i] * wk[r_u + i, k]
+                wk[row, k] = a0 * sm
+                k += 1
+            wk[row, ns] = gf
+
+    for j in range(ns):
+        row = r_sys + j
+        if ph[j] == SEPARATION:
+            continue
+        sm = sl[S_SMASS, j]
+        gpq = wk[aux + A_GPQ, j]
+        # Column S holds g_j M^-1 F until here.
+        gf = wk[row, ns]
+        wk[row, j] += 1.0
+        if ph[j] == SLIP:
+            smu = wk[aux + A_SMU, j]
+            wk[row, j] -= sm * gpq * sl[S_RADIUS, j] * smu / sl[S_INERTIA, j]
+            wk[row, ns] = (wk[aux + A_KNOWN, j] + sm * gf
+                           + sm * gpq * wk[aux + A_FPHI, j] / sl[S_INERTIA, j])
+        else:
+            wk[row, ns] = wk[aux + A_KNOWN, j] + sm * gf + sm * gpq * omd
+    if two:
+        # solve_small's operations for m = 2 written out (partial pivoting on the real
+        # parts, the same numbers), without its loops.
+        p = r_sys
+        q = r_sys + 1
+        if abs(wk[q, 0].real) > abs(wk[p, 0].real):
+            p, q = q, p
+        fac = wk[q, 0] * (1.0 / wk[p, 0])
+        x1 = (wk[q, 2] - fac * wk[p, 2]) / (wk[q, 1] - fac * wk[p, 1])
+        wk[r_sys, 2] = (wk[p, 2] - wk[p, 1] * x1) / wk[p, 0]
+        wk[r_sys + 1, 2] = x1
+    else:
+        _solve_inline(wk, r_sys, ns)
+
     for k in range(ns):
-        if ph[k] != SEPARATION:
-            _contact_result(n, half, k, wk[r_sys + k, ns], y, ph, omd, sl, aux, wk, dy)
+        if ph[k] == SEPARATION:
+            continue
+        nf = wk[r_sys + k, ns]
+        wk[aux + A_N, k] = nf
+        if ph[k] == SLIP:
+            wk[aux + A_F, k] = wk[aux + A_SMU, k] * nf
+            dy[half + n + k] = (wk[aux + A_FPHI, k] + sl[S_RADIUS, k] * wk[aux + A_F, k]) / (
+                sl[S_INERTIA, k])
+        else:
+            dy[half + n + k] = omd + y[n + k] * 0.0
     # A flying slider's normal force is 0 (set by ``evaluate``), and so is its column.
     for i in range(n):
         acc = dy[half + i] * disc[D_MINV, i]
         for k in range(ns):
             acc -= wk[aux + A_N, k] * wk[r_u + i, k]
-        dy[half + i] = acc
-
-
-@njit(cache=True, inline="always")
-def _contact_result(n, half, k, nf, y, ph, omd, sl, aux, wk, dy):
-    """Slider k's normal force ``nf`` [N], its friction force and its phi''."""
-    wk[aux + A_N, k] = nf
-    if ph[k] == SLIP:
-        wk[aux + A_F, k] = wk[aux + A_SMU, k] * nf
-        dy[half + n + k] = (wk[aux + A_FPHI, k] + sl[S_RADIUS, k] * wk[aux + A_F, k]) / (
-            sl[S_INERTIA, k])
-    else:
-        dy[half + n + k] = omd + y[n + k] * 0.0
-
-
-@njit(cache=True, inline="always")
-def _row_ends(j, ph, ajj, gf, omd, sl, aux, wk):
-    """Diagonal entry and right-hand side of contact j's row of the normal forces'
-    system, from ``ajj`` (its diagonal dot product times sigma_j m_j) and ``gf``
-    (g_j M^-1 F)."""
-    sm = sl[S_SMASS, j]
-    gpq = wk[aux + A_GPQ, j]
-    diag = ajj + 1.0
-    if ph[j] == SLIP:
-        diag -= sm * gpq * sl[S_RADIUS, j] * wk[aux + A_SMU, j] / sl[S_INERTIA, j]
-        rhs = (wk[aux + A_KNOWN, j] + sm * gf
-               + sm * gpq * wk[aux + A_FPHI, j] / sl[S_INERTIA, j])
-    else:
-        rhs = wk[aux + A_KNOWN, j] + sm * gf + sm * gpq * omd
-    return diag, rhs
-
-
-@njit(cache=True, inline="always")
-def _system(n, ns, half, ph, omd, zero, sl, disc, r_gp, aux, r_sys, r_u, wk, dy):
-    """The normal forces' system of :func:`_contacts` in rows ``r_sys ..`` of ``wk``,
-    and the contacts' columns ``r_u + i`` (the disc forces F are in ``dy``)."""
-    for k in range(ns):
-        if ph[k] == SEPARATION:
-            for i in range(n):
-                wk[r_u + i, k] = zero
-            continue
-        c = zero
-        if ph[k] == SLIP:
-            c = sl[S_HH, k] * wk[aux + A_SMU, k]
-        sigma = sl[S_SIGMA, k]
-        for i in range(n):
-            wk[r_u + i, k] = sigma * (wk[k, i] - c * wk[r_gp + k, i]) * disc[D_MINV, i]
-
-    for j in range(ns):
-        row = r_sys + j
-        if ph[j] == SEPARATION:
-            for k in range(ns):
-                wk[row, k] = zero
-            wk[row, j] = 1.0 + zero
-            wk[row, ns] = zero
-            continue
-        gf = zero
-        for i in range(n):
-            gf += wk[j, i] * disc[D_MINV, i] * dy[half + i]
-        sm = sl[S_SMASS, j]
-        # The entries summed in locals, four at a time: accumulated in wk, every term
-        # would be a load and a store of the same element (the compiler cannot tell wk's
-        # rows apart), and one at a time, a chain of n dependent additions each. Four
-        # chains side by side cost 0.8 x two at eight sliders (each entry's sum is the
-        # same, in the same order).
-        k = 0
-        while k + 3 < ns:
-            a0 = zero
-            a1 = zero
-            a2 = zero
-            a3 = zero
-            for i in range(n):
-                gji = wk[j, i]
-                a0 += gji * wk[r_u + i, k]
-                a1 += gji * wk[r_u + i, k + 1]
-                a2 += gji * wk[r_u + i, k + 2]
-                a3 += gji * wk[r_u + i, k + 3]
-            wk[row, k] = a0 * sm
-            wk[row, k + 1] = a1 * sm
-            wk[row, k + 2] = a2 * sm
-            wk[row, k + 3] = a3 * sm
-            k += 4
-        while k + 1 < ns:
-            a0 = zero
-            a1 = zero
-            for i in range(n):
-                gji = wk[j, i]
-                a0 += gji * wk[r_u + i, k]
-                a1 += gji * wk[r_u + i, k + 1]
-            wk[row, k] = a0 * sm
-            wk[row, k + 1] = a1 * sm
-            k += 2
-        if k < ns:
-            a0 = zero
-            for i in range(n):
-                a0 += wk[j, i] * wk[r_u + i, k]
-            wk[row, k] = a0 * sm
-        wk[row, j], wk[row, ns] = _row_ends(j, ph, wk[row, j], gf, omd, sl, aux, wk)
-
-
-@njit(cache=True, inline="always")
-def _two_contacts(n, half, y, ph, omd, zero, sl, disc, r_gp, aux, r_u, wk, dy):
-    """:func:`_contacts` for two sliders, both in contact, with the operations of
-    :func:`_system`, :func:`solve_small` and the general path's end in the same order,
-    so the same numbers.
-
-    Every sum is taken in one pass over the modal coordinates, the 2 x 2 system is
-    solved in registers, and the accelerations recompute u_k rather than store it: at
-    two sliders the general path's separate passes and its solve's loops cost more than
-    their arithmetic."""
-    c0 = zero
-    if ph[0] == SLIP:
-        c0 = sl[S_HH, 0] * wk[aux + A_SMU, 0]
-    c1 = zero
-    if ph[1] == SLIP:
-        c1 = sl[S_HH, 1] * wk[aux + A_SMU, 1]
-    sig0 = sl[S_SIGMA, 0]
-    sig1 = sl[S_SIGMA, 1]
-    gf0 = zero
-    gf1 = zero
-    a00 = zero
-    a01 = zero
-    a10 = zero
-    a11 = zero
-    for i in range(n):
-        minv = disc[D_MINV, i]
-        g0 = wk[0, i]
-        g1 = wk[1, i]
-        u0 = sig0 * (g0 - c0 * wk[r_gp, i]) * minv
-        u1 = sig1 * (g1 - c1 * wk[r_gp + 1, i]) * minv
-        f = dy[half + i]
-        gf0 += g0 * minv * f
-        gf1 += g1 * minv * f
-        a00 += g0 * u0
-        a01 += g0 * u1
-        a10 += g1 * u0
-        a11 += g1 * u1
-    sm0 = sl[S_SMASS, 0]
-    sm1 = sl[S_SMASS, 1]
-    d0, b0 = _row_ends(0, ph, a00 * sm0, gf0, omd, sl, aux, wk)
-    d1, b1 = _row_ends(1, ph, a11 * sm1, gf1, omd, sl, aux, wk)
-    e01 = a01 * sm0
-    e10 = a10 * sm1
-    # solve_small's elimination with partial pivoting on the real parts, written out.
-    if abs(e10.real) > abs(d0.real):
-        p00, p01, q0, p10, p11, q1 = e10, d1, b1, d0, e01, b0
-    else:
-        p00, p01, q0, p10, p11, q1 = d0, e01, b0, e10, d1, b1
-    fac = p10 * (1.0 / p00)
-    p11 -= fac * p01
-    q1 -= fac * q0
-    x1 = q1 / p11
-    x0 = (q0 - p01 * x1) / p00
-    _contact_result(n, half, 0, x0, y, ph, omd, sl, aux, wk, dy)
-    _contact_result(n, half, 1, x1, y, ph, omd, sl, aux, wk, dy)
-    for i in range(n):
-        minv = disc[D_MINV, i]
-        acc = dy[half + i] * minv
-        acc -= x0 * (sig0 * (wk[0, i] - c0 * wk[r_gp, i]) * minv)
-        acc -= x1 * (sig1 * (wk[1, i] - c1 * wk[r_gp + 1, i]) * minv)
         dy[half + i] = acc
 
 
