@@ -255,11 +255,7 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
     damped = opts[O_DAMPED] != 0.0
     om2 = om * om
     for i in range(n):
-        fi = _disc_force(i, y, om, om2, omd, eps, damped, disc, half)
-        wk[r_fq, i] = fi
-        # Where several sliders' contacts gather the disc's forces (``_one_slider``
-        # overwrites it).
-        dy[half + i] = fi
+        wk[r_fq, i] = _disc_force(i, y, om, om2, omd, eps, damped, disc, half)
         dy[i] = y[half + i]
 
     lmax = int(opts[O_LMAX])
@@ -433,17 +429,19 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
     (0 for a flying slider), so that the system's rows and the accelerations are sums of
     contiguous rows (which the compiler vectorises) rather than S^2 short dot products.
     """
+    for i in range(n):
+        dy[half + i] = wk[r_fq, i]
     for k in range(ns):
         if ph[k] == STICK:
             moment = sl[S_SHH, k] * wk[aux + A_F, k]
             for i in range(n):
                 dy[half + i] += moment * wk[r_gp + k, i]
-    # Two sliders in contact: the contacts' columns, the system's entries and g_j M^-1 F
-    # in one pass over the modal coordinates, with the general path's operations in the
-    # same order (so the same numbers); its separate passes cost more than their
-    # arithmetic at two sliders.
-    two = ns == 2 and ph[0] != SEPARATION and ph[1] != SEPARATION
-    if two:
+    if ns == 2 and ph[0] != SEPARATION and ph[1] != SEPARATION:
+        # Two sliders in contact: the general path's operations below in the same order
+        # (so the same numbers), but every sum taken in one pass over the modal
+        # coordinates, the 2 x 2 system solved in registers and u_k recomputed: at two
+        # sliders the general path's passes, its solve's loops and its values' trips
+        # through wk cost more than their arithmetic (the step was 1.45 x its floor).
         c0 = sl[S_HH, 0] * wk[aux + A_SMU, 0] if ph[0] == SLIP else zero
         c1 = sl[S_HH, 1] * wk[aux + A_SMU, 1] if ph[1] == SLIP else zero
         sig0 = sl[S_SIGMA, 0]
@@ -467,78 +465,108 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
             a01 += g0 * u1
             a10 += g1 * u0
             a11 += g1 * u1
-            wk[r_u + i, 0] = u0
-            wk[r_u + i, 1] = u1
+        # Rows [d_j, e_j | b_j] of the system, as the general path forms them.
         sm0 = sl[S_SMASS, 0]
         sm1 = sl[S_SMASS, 1]
-        wk[r_sys, 0] = a00 * sm0
-        wk[r_sys, 1] = a01 * sm0
-        wk[r_sys, 2] = gf0
-        wk[r_sys + 1, 0] = a10 * sm1
-        wk[r_sys + 1, 1] = a11 * sm1
-        wk[r_sys + 1, 2] = gf1
-    else:
-        for k in range(ns):
-            if ph[k] == SEPARATION:
-                for i in range(n):
-                    wk[r_u + i, k] = zero
-                continue
-            c = zero
+        d0 = a00 * sm0 + 1.0
+        d1 = a11 * sm1 + 1.0
+        e0 = a01 * sm0
+        e1 = a10 * sm1
+        gpq0 = wk[aux + A_GPQ, 0]
+        gpq1 = wk[aux + A_GPQ, 1]
+        if ph[0] == SLIP:
+            d0 -= sm0 * gpq0 * sl[S_RADIUS, 0] * wk[aux + A_SMU, 0] / sl[S_INERTIA, 0]
+            b0 = (wk[aux + A_KNOWN, 0] + sm0 * gf0
+                  + sm0 * gpq0 * wk[aux + A_FPHI, 0] / sl[S_INERTIA, 0])
+        else:
+            b0 = wk[aux + A_KNOWN, 0] + sm0 * gf0 + sm0 * gpq0 * omd
+        if ph[1] == SLIP:
+            d1 -= sm1 * gpq1 * sl[S_RADIUS, 1] * wk[aux + A_SMU, 1] / sl[S_INERTIA, 1]
+            b1 = (wk[aux + A_KNOWN, 1] + sm1 * gf1
+                  + sm1 * gpq1 * wk[aux + A_FPHI, 1] / sl[S_INERTIA, 1])
+        else:
+            b1 = wk[aux + A_KNOWN, 1] + sm1 * gf1 + sm1 * gpq1 * omd
+        # solve_small's elimination for m = 2 written out: partial pivoting on the real
+        # parts, the same operations, so as sound as the general solve and the same numbers.
+        if abs(e1.real) > abs(d0.real):
+            p00, p01, q0, p10, p11, q1 = e1, d1, b1, d0, e0, b0
+        else:
+            p00, p01, q0, p10, p11, q1 = d0, e0, b0, e1, d1, b1
+        fac = p10 * (1.0 / p00)
+        p11 -= fac * p01
+        q1 -= fac * q0
+        n1 = q1 / p11
+        n0 = (q0 - p01 * n1) / p00
+        wk[aux + A_N, 0] = n0
+        wk[aux + A_N, 1] = n1
+        for k in range(2):
+            nf = wk[aux + A_N, k]
             if ph[k] == SLIP:
-                c = sl[S_HH, k] * wk[aux + A_SMU, k]
-            sigma = sl[S_SIGMA, k]
+                wk[aux + A_F, k] = wk[aux + A_SMU, k] * nf
+                dy[half + n + k] = (wk[aux + A_FPHI, k] + sl[S_RADIUS, k] * wk[aux + A_F, k]) / (
+                    sl[S_INERTIA, k])
+            else:
+                dy[half + n + k] = omd + y[n + k] * 0.0
+        for i in range(n):
+            minv = disc[D_MINV, i]
+            acc = dy[half + i] * minv
+            acc -= n0 * (sig0 * (wk[0, i] - c0 * wk[r_gp, i]) * minv)
+            acc -= n1 * (sig1 * (wk[1, i] - c1 * wk[r_gp + 1, i]) * minv)
+            dy[half + i] = acc
+        return
+    for k in range(ns):
+        if ph[k] == SEPARATION:
             for i in range(n):
-                wk[r_u + i, k] = sigma * (wk[k, i] - c * wk[r_gp + k, i]) * disc[D_MINV, i]
-        for j in range(ns):
-            row = r_sys + j
-            if ph[j] == SEPARATION:
-                for k in range(ns):
-                    wk[row, k] = zero
-                wk[row, j] = 1.0 + zero
-                wk[row, ns] = zero
-                continue
-            gf = zero
-            for i in range(n):
-                gf += wk[j, i] * disc[D_MINV, i] * dy[half + i]
-            sm = sl[S_SMASS, j]
-            # The entries summed in locals, four at a time: accumulated in wk, every
-            # term would be a load and a store of the same element (the compiler cannot
-            # tell wk's rows apart), and one at a time, a chain of n dependent additions
-            # each. Four chains side by side cost 0.8 x two at eight sliders (each
-            # entry's sum is the same, in the same order); the rest one at a time.
-            k = 0
-            while k + 3 < ns:
-                a0 = zero
-                a1 = zero
-                a2 = zero
-                a3 = zero
-                for i in range(n):
-                    gji = wk[j, i]
-                    a0 += gji * wk[r_u + i, k]
-                    a1 += gji * wk[r_u + i, k + 1]
-                    a2 += gji * wk[r_u + i, k + 2]
-                    a3 += gji * wk[r_u + i, k + 3]
-                wk[row, k] = a0 * sm
-                wk[row, k + 1] = a1 * sm
-                wk[row, k + 2] = a2 * sm
-                wk[row, k + 3] = a3 * sm
-                k += 4
-            while k < ns:
-                a0 = zero
-                for i in range(n):
-                    a0 += wk[j, i] * wk[r_u + i, k]
-                wk[row, k] = a0 * sm
-                k += 1
-            wk[row, ns] = gf
+                wk[r_u + i, k] = zero
+            continue
+        c = zero
+        if ph[k] == SLIP:
+            c = sl[S_HH, k] * wk[aux + A_SMU, k]
+        sigma = sl[S_SIGMA, k]
+        for i in range(n):
+            wk[r_u + i, k] = sigma * (wk[k, i] - c * wk[r_gp + k, i]) * disc[D_MINV, i]
 
     for j in range(ns):
         row = r_sys + j
         if ph[j] == SEPARATION:
+            for k in range(ns):
+                wk[row, k] = zero
+            wk[row, j] = 1.0 + zero
+            wk[row, ns] = zero
             continue
+        gf = zero
+        for i in range(n):
+            gf += wk[j, i] * disc[D_MINV, i] * dy[half + i]
         sm = sl[S_SMASS, j]
+        # The entries summed in locals, four at a time: accumulated in wk, every term
+        # would be a load and a store of the same element (the compiler cannot tell wk's
+        # rows apart), and one at a time, a chain of n dependent additions each. Four
+        # chains side by side cost 0.8 x two at eight sliders (each entry's sum is the
+        # same, in the same order); the rest one at a time.
+        k = 0
+        while k + 3 < ns:
+            a0 = zero
+            a1 = zero
+            a2 = zero
+            a3 = zero
+            for i in range(n):
+                gji = wk[j, i]
+                a0 += gji * wk[r_u + i, k]
+                a1 += gji * wk[r_u + i, k + 1]
+                a2 += gji * wk[r_u + i, k + 2]
+                a3 += gji * wk[r_u + i, k + 3]
+            wk[row, k] = a0 * sm
+            wk[row, k + 1] = a1 * sm
+            wk[row, k + 2] = a2 * sm
+            wk[row, k + 3] = a3 * sm
+            k += 4
+        while k < ns:
+            a0 = zero
+            for i in range(n):
+                a0 += wk[j, i] * wk[r_u + i, k]
+            wk[row, k] = a0 * sm
+            k += 1
         gpq = wk[aux + A_GPQ, j]
-        # Column S holds g_j M^-1 F until here.
-        gf = wk[row, ns]
         wk[row, j] += 1.0
         if ph[j] == SLIP:
             smu = wk[aux + A_SMU, j]
@@ -547,19 +575,7 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
                            + sm * gpq * wk[aux + A_FPHI, j] / sl[S_INERTIA, j])
         else:
             wk[row, ns] = wk[aux + A_KNOWN, j] + sm * gf + sm * gpq * omd
-    if two:
-        # solve_small's operations for m = 2 written out (partial pivoting on the real
-        # parts, the same numbers), without its loops.
-        p = r_sys
-        q = r_sys + 1
-        if abs(wk[q, 0].real) > abs(wk[p, 0].real):
-            p, q = q, p
-        fac = wk[q, 0] * (1.0 / wk[p, 0])
-        x1 = (wk[q, 2] - fac * wk[p, 2]) / (wk[q, 1] - fac * wk[p, 1])
-        wk[r_sys, 2] = (wk[p, 2] - wk[p, 1] * x1) / wk[p, 0]
-        wk[r_sys + 1, 2] = x1
-    else:
-        _solve_inline(wk, r_sys, ns)
+    _solve_inline(wk, r_sys, ns)
 
     for k in range(ns):
         if ph[k] == SEPARATION:
