@@ -432,6 +432,89 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
     for i in range(n):
         dy[half + i] = wk[r_fq, i]
     for k in range(ns):
+        if ph[k] == STICK:
+            moment = sl[S_SHH, k] * wk[aux + A_F, k]
+            for i in range(n):
+                dy[half + i] += moment * wk[r_gp + k, i]
+    if ns == 2 and ph[0] != SEPARATION and ph[1] != SEPARATION:
+        # Two sliders in contact: the general path's operations below in the same order
+        # (so the same numbers), but every sum taken in one pass over the modal
+        # coordinates, the 2 x 2 system solved in registers and u_k recomputed: at two
+        # sliders the general path's passes, its solve's loops and its values' trips
+        # through wk cost more than their arithmetic (the step was 1.45 x its floor).
+        c0 = sl[S_HH, 0] * wk[aux + A_SMU, 0] if ph[0] == SLIP else zero
+        c1 = sl[S_HH, 1] * wk[aux + A_SMU, 1] if ph[1] == SLIP else zero
+        sig0 = sl[S_SIGMA, 0]
+        sig1 = sl[S_SIGMA, 1]
+        gf0 = zero
+        gf1 = zero
+        a00 = zero
+        a01 = zero
+        a10 = zero
+        a11 = zero
+        for i in range(n):
+            minv = disc[D_MINV, i]
+            g0 = wk[0, i]
+            g1 = wk[1, i]
+            u0 = sig0 * (g0 - c0 * wk[r_gp, i]) * minv
+            u1 = sig1 * (g1 - c1 * wk[r_gp + 1, i]) * minv
+            f = dy[half + i]
+            gf0 += g0 * minv * f
+            gf1 += g1 * minv * f
+            a00 += g0 * u0
+            a01 += g0 * u1
+            a10 += g1 * u0
+            a11 += g1 * u1
+        # Rows [d_j, e_j | b_j] of the system, as the general path forms them.
+        sm0 = sl[S_SMASS, 0]
+        sm1 = sl[S_SMASS, 1]
+        d0 = a00 * sm0 + 1.0
+        d1 = a11 * sm1 + 1.0
+        e0 = a01 * sm0
+        e1 = a10 * sm1
+        gpq0 = wk[aux + A_GPQ, 0]
+        gpq1 = wk[aux + A_GPQ, 1]
+        if ph[0] == SLIP:
+            d0 -= sm0 * gpq0 * sl[S_RADIUS, 0] * wk[aux + A_SMU, 0] / sl[S_INERTIA, 0]
+            b0 = (wk[aux + A_KNOWN, 0] + sm0 * gf0
+                  + sm0 * gpq0 * wk[aux + A_FPHI, 0] / sl[S_INERTIA, 0])
+        else:
+            b0 = wk[aux + A_KNOWN, 0] + sm0 * gf0 + sm0 * gpq0 * omd
+        if ph[1] == SLIP:
+            d1 -= sm1 * gpq1 * sl[S_RADIUS, 1] * wk[aux + A_SMU, 1] / sl[S_INERTIA, 1]
+            b1 = (wk[aux + A_KNOWN, 1] + sm1 * gf1
+                  + sm1 * gpq1 * wk[aux + A_FPHI, 1] / sl[S_INERTIA, 1])
+        else:
+            b1 = wk[aux + A_KNOWN, 1] + sm1 * gf1 + sm1 * gpq1 * omd
+        # solve_small's elimination for m = 2 written out: partial pivoting on the real
+        # parts, the same operations, so as sound as the general solve and the same numbers.
+        if abs(e1.real) > abs(d0.real):
+            p00, p01, q0, p10, p11, q1 = e1, d1, b1, d0, e0, b0
+        else:
+            p00, p01, q0, p10, p11, q1 = d0, e0, b0, e1, d1, b1
+        fac = p10 * (1.0 / p00)
+        p11 -= fac * p01
+        q1 -= fac * q0
+        n1 = q1 / p11
+        n0 = (q0 - p01 * n1) / p00
+        wk[aux + A_N, 0] = n0
+        wk[aux + A_N, 1] = n1
+        for k in range(2):
+            nf = wk[aux + A_N, k]
+            if ph[k] == SLIP:
+                wk[aux + A_F, k] = wk[aux + A_SMU, k] * nf
+                dy[half + n + k] = (wk[aux + A_FPHI, k] + sl[S_RADIUS, k] * wk[aux + A_F, k]) / (
+                    sl[S_INERTIA, k])
+            else:
+                dy[half + n + k] = omd + y[n + k] * 0.0
+        for i in range(n):
+            minv = disc[D_MINV, i]
+            acc = dy[half + i] * minv
+            acc -= n0 * (sig0 * (wk[0, i] - c0 * wk[r_gp, i]) * minv)
+            acc -= n1 * (sig1 * (wk[1, i] - c1 * wk[r_gp + 1, i]) * minv)
+            dy[half + i] = acc
+        return
+    for k in range(ns):
         if ph[k] == SEPARATION:
             for i in range(n):
                 wk[r_u + i, k] = zero
@@ -439,10 +522,6 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
         c = zero
         if ph[k] == SLIP:
             c = sl[S_HH, k] * wk[aux + A_SMU, k]
-        else:
-            moment = sl[S_SHH, k] * wk[aux + A_F, k]
-            for i in range(n):
-                dy[half + i] += moment * wk[r_gp + k, i]
         sigma = sl[S_SIGMA, k]
         for i in range(n):
             wk[r_u + i, k] = sigma * (wk[k, i] - c * wk[r_gp + k, i]) * disc[D_MINV, i]
@@ -463,7 +542,7 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
         # would be a load and a store of the same element (the compiler cannot tell wk's
         # rows apart), and one at a time, a chain of n dependent additions each. Four
         # chains side by side cost 0.8 x two at eight sliders (each entry's sum is the
-        # same, in the same order).
+        # same, in the same order); the rest one at a time.
         k = 0
         while k + 3 < ns:
             a0 = zero
@@ -481,21 +560,12 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
             wk[row, k + 2] = a2 * sm
             wk[row, k + 3] = a3 * sm
             k += 4
-        while k + 1 < ns:
-            a0 = zero
-            a1 = zero
-            for i in range(n):
-                gji = wk[j, i]
-                a0 += gji * wk[r_u + i, k]
-                a1 += gji * wk[r_u + i, k + 1]
-            wk[row, k] = a0 * sm
-            wk[row, k + 1] = a1 * sm
-            k += 2
-        if k < ns:
+        while k < ns:
             a0 = zero
             for i in range(n):
                 a0 += wk[j, i] * wk[r_u + i, k]
             wk[row, k] = a0 * sm
+            k += 1
         gpq = wk[aux + A_GPQ, j]
         wk[row, j] += 1.0
         if ph[j] == SLIP:
