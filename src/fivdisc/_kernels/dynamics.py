@@ -499,101 +499,95 @@ def _contacts(n, ns, half, y, ph, omd, zero, sl, disc, r_gp, r_fq, aux, r_sys, r
         n0 = (q0 - p01 * n1) / p00
         wk[aux + A_N, 0] = n0
         wk[aux + A_N, 1] = n1
-        for k in range(2):
-            nf = wk[aux + A_N, k]
-            if ph[k] == SLIP:
-                wk[aux + A_F, k] = wk[aux + A_SMU, k] * nf
-                dy[half + n + k] = (wk[aux + A_FPHI, k] + sl[S_RADIUS, k] * wk[aux + A_F, k]) / (
-                    sl[S_INERTIA, k])
-            else:
-                dy[half + n + k] = omd + y[n + k] * 0.0
         for i in range(n):
             minv = disc[D_MINV, i]
             acc = dy[half + i] * minv
             acc -= n0 * (sig0 * (wk[0, i] - c0 * wk[r_gp, i]) * minv)
             acc -= n1 * (sig1 * (wk[1, i] - c1 * wk[r_gp + 1, i]) * minv)
             dy[half + i] = acc
-        return
-    for k in range(ns):
-        if ph[k] == SEPARATION:
+    else:
+        for k in range(ns):
+            if ph[k] == SEPARATION:
+                for i in range(n):
+                    wk[r_u + i, k] = zero
+                continue
+            c = zero
+            if ph[k] == SLIP:
+                c = sl[S_HH, k] * wk[aux + A_SMU, k]
+            sigma = sl[S_SIGMA, k]
             for i in range(n):
-                wk[r_u + i, k] = zero
-            continue
-        c = zero
-        if ph[k] == SLIP:
-            c = sl[S_HH, k] * wk[aux + A_SMU, k]
-        sigma = sl[S_SIGMA, k]
-        for i in range(n):
-            wk[r_u + i, k] = sigma * (wk[k, i] - c * wk[r_gp + k, i]) * disc[D_MINV, i]
+                wk[r_u + i, k] = sigma * (wk[k, i] - c * wk[r_gp + k, i]) * disc[D_MINV, i]
 
-    for j in range(ns):
-        row = r_sys + j
-        if ph[j] == SEPARATION:
+        for j in range(ns):
+            row = r_sys + j
+            if ph[j] == SEPARATION:
+                for k in range(ns):
+                    wk[row, k] = zero
+                wk[row, j] = 1.0 + zero
+                wk[row, ns] = zero
+                continue
+            gf = zero
+            for i in range(n):
+                gf += wk[j, i] * disc[D_MINV, i] * dy[half + i]
+            sm = sl[S_SMASS, j]
+            # The entries summed in locals, four at a time: accumulated in wk, every term
+            # would be a load and a store of the same element (the compiler cannot tell wk's
+            # rows apart), and one at a time, a chain of n dependent additions each. Four
+            # chains side by side cost 0.8 x two at eight sliders (each entry's sum is the
+            # same, in the same order); the rest one at a time.
+            k = 0
+            while k + 3 < ns:
+                a0 = zero
+                a1 = zero
+                a2 = zero
+                a3 = zero
+                for i in range(n):
+                    gji = wk[j, i]
+                    a0 += gji * wk[r_u + i, k]
+                    a1 += gji * wk[r_u + i, k + 1]
+                    a2 += gji * wk[r_u + i, k + 2]
+                    a3 += gji * wk[r_u + i, k + 3]
+                wk[row, k] = a0 * sm
+                wk[row, k + 1] = a1 * sm
+                wk[row, k + 2] = a2 * sm
+                wk[row, k + 3] = a3 * sm
+                k += 4
+            while k < ns:
+                a0 = zero
+                for i in range(n):
+                    a0 += wk[j, i] * wk[r_u + i, k]
+                wk[row, k] = a0 * sm
+                k += 1
+            gpq = wk[aux + A_GPQ, j]
+            wk[row, j] += 1.0
+            if ph[j] == SLIP:
+                smu = wk[aux + A_SMU, j]
+                wk[row, j] -= sm * gpq * sl[S_RADIUS, j] * smu / sl[S_INERTIA, j]
+                wk[row, ns] = (wk[aux + A_KNOWN, j] + sm * gf
+                               + sm * gpq * wk[aux + A_FPHI, j] / sl[S_INERTIA, j])
+            else:
+                wk[row, ns] = wk[aux + A_KNOWN, j] + sm * gf + sm * gpq * omd
+        _solve_inline(wk, r_sys, ns)
+        for k in range(ns):
+            if ph[k] != SEPARATION:
+                wk[aux + A_N, k] = wk[r_sys + k, ns]
+        # A flying slider's normal force is 0 (set by ``evaluate``), and so is its column.
+        for i in range(n):
+            acc = dy[half + i] * disc[D_MINV, i]
             for k in range(ns):
-                wk[row, k] = zero
-            wk[row, j] = 1.0 + zero
-            wk[row, ns] = zero
-            continue
-        gf = zero
-        for i in range(n):
-            gf += wk[j, i] * disc[D_MINV, i] * dy[half + i]
-        sm = sl[S_SMASS, j]
-        # The entries summed in locals, four at a time: accumulated in wk, every term
-        # would be a load and a store of the same element (the compiler cannot tell wk's
-        # rows apart), and one at a time, a chain of n dependent additions each. Four
-        # chains side by side cost 0.8 x two at eight sliders (each entry's sum is the
-        # same, in the same order); the rest one at a time.
-        k = 0
-        while k + 3 < ns:
-            a0 = zero
-            a1 = zero
-            a2 = zero
-            a3 = zero
-            for i in range(n):
-                gji = wk[j, i]
-                a0 += gji * wk[r_u + i, k]
-                a1 += gji * wk[r_u + i, k + 1]
-                a2 += gji * wk[r_u + i, k + 2]
-                a3 += gji * wk[r_u + i, k + 3]
-            wk[row, k] = a0 * sm
-            wk[row, k + 1] = a1 * sm
-            wk[row, k + 2] = a2 * sm
-            wk[row, k + 3] = a3 * sm
-            k += 4
-        while k < ns:
-            a0 = zero
-            for i in range(n):
-                a0 += wk[j, i] * wk[r_u + i, k]
-            wk[row, k] = a0 * sm
-            k += 1
-        gpq = wk[aux + A_GPQ, j]
-        wk[row, j] += 1.0
-        if ph[j] == SLIP:
-            smu = wk[aux + A_SMU, j]
-            wk[row, j] -= sm * gpq * sl[S_RADIUS, j] * smu / sl[S_INERTIA, j]
-            wk[row, ns] = (wk[aux + A_KNOWN, j] + sm * gf
-                           + sm * gpq * wk[aux + A_FPHI, j] / sl[S_INERTIA, j])
-        else:
-            wk[row, ns] = wk[aux + A_KNOWN, j] + sm * gf + sm * gpq * omd
-    _solve_inline(wk, r_sys, ns)
-
+                acc -= wk[aux + A_N, k] * wk[r_u + i, k]
+            dy[half + i] = acc
+    # The sliders' own accelerations, from their normal forces (either path).
     for k in range(ns):
         if ph[k] == SEPARATION:
             continue
-        nf = wk[r_sys + k, ns]
-        wk[aux + A_N, k] = nf
+        nf = wk[aux + A_N, k]
         if ph[k] == SLIP:
             wk[aux + A_F, k] = wk[aux + A_SMU, k] * nf
             dy[half + n + k] = (wk[aux + A_FPHI, k] + sl[S_RADIUS, k] * wk[aux + A_F, k]) / (
                 sl[S_INERTIA, k])
         else:
             dy[half + n + k] = omd + y[n + k] * 0.0
-    # A flying slider's normal force is 0 (set by ``evaluate``), and so is its column.
-    for i in range(n):
-        acc = dy[half + i] * disc[D_MINV, i]
-        for k in range(ns):
-            acc -= wk[aux + A_N, k] * wk[r_u + i, k]
-        dy[half + i] = acc
 
 
 @njit(cache=True, _nrt=False)
