@@ -74,6 +74,9 @@ def source_tree(commit: str) -> Path:
 def run_previous(commit: str, code: str) -> str:
     """Standard output of ``code`` run by fivdisc at ``commit``."""
     python = environment(commit)
-    env = {**os.environ, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+    # Without PYTHONPATH: set to a clone's src (to time it), it would put today's fivdisc
+    # before the one installed at `commit`.
+    env = {key: value for key, value in os.environ.items() if key != "PYTHONPATH"}
+    env.update(OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
     return subprocess.run([str(python), "-c", code], check=True, capture_output=True,
                           text=True, env=env, cwd=tempfile.gettempdir()).stdout
