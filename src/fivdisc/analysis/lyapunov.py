@@ -30,8 +30,6 @@ __all__ = ["LyapunovSpectrum", "lyapunov"]
 
 # Blocks of the run whose exponents give the uncertainty (their spread).
 _BLOCKS = 10
-# Pieces of the transient, for its progress.
-_TRANSIENT_CHUNKS = 50
 # [s]: the default re-orthonormalisation interval.
 DEFAULT_INTERVAL = 0.05
 #: Most re-orthonormalisations of one measurement (each keeps a row of n logarithms).
@@ -224,81 +222,104 @@ def lyapunov(
     # needed next, begins meanwhile.
     compile_split(run, tangents=True)
     run.advance(0.0)
+    # The phases at the start are chosen by the first advance.
+    free = run.free()
+    if n > free.sum():
+        raise FivdiscError(f"n = {n} is invalid: must be at most {int(free.sum())}, the "
+                           "number of coordinates free at the start (where the tangent "
+                           "vectors start)")
+    limit = Deflection(model)
     # One bar in simulated time over the transient and the measurement: a long transient
     # is the first minutes of a run.
-    limit = Deflection(model)
     bar = progress_bar(transient + duration, "Lyapunov exponents", "s", show=progress,
                        bar_format=SIMULATED_TIME)
     try:
-        for chunk in range(1, _TRANSIENT_CHUNKS + 1 if transient > 0 else 1):
-            run.run_to(transient * chunk / _TRANSIENT_CHUNKS)
-            _check(run, limit, "the transient")
-            bar.update(run.t - bar.n)
-        spectrum = _measure(run, model, limit, n, seed, transient, duration, interval, progress,
-                            bar)
+        spectrum = _measure(run, model, limit, free, n, seed, transient, duration, interval,
+                            progress, bar)
     finally:
         bar.close()
     return spectrum
 
 
-def _measure(run: Integration, model: Model, limit: Any, n: int, seed: int | None,
-             transient: float, duration: float, interval: float, progress: bool,
-             bar: Any) -> LyapunovSpectrum:
-    """The exponents over `duration` after the transient, with `bar` counting it."""
+def _measure(run: Integration, model: Model, limit: Any, free: np.ndarray, n: int,
+             seed: int | None, transient: float, duration: float, interval: float,
+             progress: bool, bar: Any) -> LyapunovSpectrum:
+    """Align random tangent vectors over the transient, then measure the exponents over
+    `duration`, with `bar` counting both."""
     from fivdisc.analysis.orbits import energy_scales
-
-    free = run.free()
-    if n > free.sum():
-        raise FivdiscError(f"n = {n} is invalid: must be at most {int(free.sum())}, the "
-                           "number of coordinates free after the transient")
-    sc = energy_scales(model)
-    rng = np.random.default_rng(seed)
-    basis = rng.standard_normal((model.state_size, n)) * free[:, None]
-    q, _ = np.linalg.qr(basis)
-    t0 = run.t
-    steps = int(np.ceil(duration / interval - 1e-9))
-    logs = np.zeros((steps, n))
-    times = np.zeros(steps)
     from fivdisc.compilation import tangent_notice
     from fivdisc.split_compile import compile_split_tangents
 
+    sc = energy_scales(model)
+    rng = np.random.default_rng(seed)
+    q, _ = np.linalg.qr(rng.standard_normal((model.state_size, n)) * free[:, None])
+    aligning = transient > 0
+    t0 = run.t
     # The first interval compiles the kernel with tangents in a fresh installation.
     with tangent_notice(show=progress or None):
         compile_split_tangents()
         run.set_tangents((q * sc[:, None]).T)
-        _interval(run, limit, 0, logs, times, t0, interval, transient + duration, sc)
+        first = _interval(run, limit, min(interval, transient if aligning else duration), sc,
+                          "the transient" if aligning else "the measurement")
+    bar.update(run.t - bar.n)
+    # Alignment: the vectors are carried through the transient and re-orthonormalised as
+    # in the measurement, their stretching discarded, so that the measurement starts from
+    # directions that have forgotten their random start (Notes of `lyapunov`).
+    k = 2
+    while aligning and run.t < transient:
+        _interval(run, limit, min(k * interval, transient), sc, "the transient")
+        bar.update(run.t - bar.n)
+        k += 1
+    if aligning:
+        t0 = run.t
+    steps = int(np.ceil(duration / interval - 1e-9))
+    logs = np.zeros((steps, n))
+    times = np.zeros(steps)
     for k in range(steps):
-        if k:
-            _interval(run, limit, k, logs, times, t0, interval, transient + duration, sc)
+        if k or aligning:
+            logs[k] = _interval(run, limit, min(t0 + (k + 1) * interval, transient + duration),
+                                sc, "the measurement")
+        else:
+            logs[k] = first
+        times[k] = run.t - t0
         bar.update(run.t - bar.n)
     # Over a finite run the QR order need not be the order of the values: sort.
     order = np.argsort(-logs.sum(axis=0), kind="stable")
     logs = logs[:, order]
     exponents = logs.sum(axis=0) / times[-1]
     running = np.cumsum(logs, axis=0) / times[:, None]
+    return LyapunovSpectrum(exponents, _uncertainty(logs, times, exponents), times, running,
+                            float(transient), float(duration), float(interval))
+
+
+def _uncertainty(logs: np.ndarray, times: np.ndarray, exponents: np.ndarray) -> np.ndarray:
+    """Standard error of ten blocks combined with the drift from the second half's
+    estimate (formula in Notes of `lyapunov`); NaN with fewer than two intervals."""
+    steps = len(times)
+    if steps < 2:
+        return np.full(logs.shape[1], np.nan)
     blocks = np.array_split(np.arange(steps), min(_BLOCKS, steps))
     edges = np.r_[0.0, times]
+    half = steps // 2
     with np.errstate(invalid="ignore"):
         rates = np.array([logs[b].sum(axis=0) / (edges[b[-1] + 1] - edges[b[0]])
                           for b in blocks])
-        uncertainty = (rates.std(axis=0, ddof=1) / np.sqrt(len(blocks)) if len(blocks) > 1
-                       else np.full(n, np.nan))
-    return LyapunovSpectrum(exponents, uncertainty, times, running, float(transient),
-                            float(duration), float(interval))
+        error = rates.std(axis=0, ddof=1) / np.sqrt(len(blocks))
+        later = logs[half:].sum(axis=0) / (times[-1] - times[half - 1])
+        return np.hypot(error, exponents - later)
 
 
-def _interval(run: Integration, limit, k: int, logs: np.ndarray, times: np.ndarray,
-              t0: float, interval: float, end: float, sc: np.ndarray) -> None:
-    """Integrate the k-th interval, then re-orthonormalise (energy norm) and keep the
-    logarithms of the stretching factors."""
-    run.run_to(min(t0 + (k + 1) * interval, end))
-    _check(run, limit, "the measurement")
+def _interval(run: Integration, limit: Any, target: float, sc: np.ndarray,
+              what: str) -> np.ndarray:
+    """Integrate to `target`, re-orthonormalise the tangent vectors (energy norm) and
+    return the logarithms of their stretching factors."""
+    run.run_to(target)
+    _check(run, limit, what)
     q, r = np.linalg.qr(run.tangents(slaved=False).T / sc[:, None])
-    with np.errstate(divide="ignore"):
-        logs[k] = np.log(np.abs(np.diag(r)))
     signs = np.where(np.diag(r) < 0, -1.0, 1.0)
     run.set_tangents(((q * signs) * sc[:, None]).T)
-    times[k] = run.t - t0
+    with np.errstate(divide="ignore"):
+        return np.log(np.abs(np.diag(r)))
 
 
 def _check(run: Integration, limit, what: str) -> None:
