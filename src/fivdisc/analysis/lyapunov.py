@@ -3,7 +3,11 @@
 ``n`` tangent vectors are carried with the state (:mod:`fivdisc._kernels.tangent`: the
 variational equations inside each phase, saltation matrices at every switch) and
 re-orthonormalised every ``interval`` seconds: ``V = Q R``; the logarithms of ``|R_ii|``
-summed over the run and divided by its length are the exponents, largest first.
+summed over the measurement and divided by its length are the exponents, largest first.
+The vectors start at random with the run and are carried, re-orthonormalised the same
+way, through the transient, so that the measurement starts from aligned directions; the
+uncertainty adds the drift of the estimate to its statistical error (Notes of
+:func:`lyapunov`).
 
 The orthonormalisation uses the energy norm (:func:`fivdisc.analysis.orbits.energy_scales`),
 so that the result does not depend on the units of the coordinates over a finite run.
@@ -45,9 +49,10 @@ class LyapunovSpectrum:
     exponents : ndarray
         ``(n,)`` exponents [1/s], largest first.
     uncertainty : ndarray
-        ``(n,)`` standard error of each [1/s]: the spread of the exponents of ten equal
-        blocks of the run divided by sqrt(10); an estimate of how far the finite-time
-        value may be from the limit, not a bound.
+        ``(n,)`` uncertainty of each [1/s]: the standard error from ten equal blocks of
+        the measurement combined with the drift between the whole measurement's
+        estimate and its second half's (Notes of :func:`lyapunov`); an estimate of how
+        far the finite-time value may be from the limit, not a bound.
     times : ndarray
         ``(m,)`` times of the re-orthonormalisations [s], from the start of the
         measurement (after the transient).
@@ -89,7 +94,8 @@ class LyapunovSpectrum:
             return (f"lambda_{i + 1} = {e:+.6g} 1/s has no uncertainty estimate (too few "
                     "re-orthonormalisations: lengthen the measurement or shorten the interval)")
         return (f"lambda_{i + 1} = {e:+.6g} 1/s has an uncertainty of {u:.2g} 1/s, more than "
-                "its magnitude (lengthen the measurement)")
+                "its magnitude (lengthen the measurement, or the transient if the estimate "
+                "still drifts)")
 
     def to_dict(self) -> dict:
         """Exponents [1/s] (largest first) and their uncertainty as plain JSON types
@@ -115,7 +121,8 @@ class LyapunovSpectrum:
                 "exponent": ("index", self.exponents,
                              {"long_name": "Lyapunov exponent", "units": "s-1"}),
                 "uncertainty": ("index", self.uncertainty,
-                                {"long_name": "standard error of the exponent",
+                                {"long_name": "uncertainty of the exponent (standard "
+                                            "error and drift)",
                                  "units": "s-1"}),
                 "running": (("time", "index"), self.running,
                             {"long_name": "running estimate of the exponent",
@@ -150,7 +157,7 @@ def lyapunov(
     seed: int = 0,
     progress: bool = False,
 ) -> LyapunovSpectrum:
-    """The first ``n`` Lyapunov exponents of a case's trajectory.
+    r"""The first ``n`` Lyapunov exponents of a case's trajectory.
 
     Parameters
     ----------
@@ -158,10 +165,12 @@ def lyapunov(
         The case; any speed profile (for a varying speed the exponents are those of
         the finite run).
     n : int
-        How many exponents, at most the number of coordinates free after the transient.
+        How many exponents, at most the number of coordinates free at the start.
     transient : float, optional
         Simulated time before the measurement starts [s]; default a fifth of the case's
-        ``simulation.duration``.
+        ``simulation.duration``. The tangent vectors align with the most expanding
+        directions over it (Notes): it should last several times ``1 / (lambda_n -
+        lambda_(n+1))``.
     duration : float, optional
         Length of the measurement [s]; default the case's ``simulation.duration``.
     interval : float, optional
@@ -179,7 +188,7 @@ def lyapunov(
         :func:`fivdisc.integration.tangent_step`, so that the tangent dynamics is
         resolved where the state alone would allow long steps.
     seed : int
-        Seed of the random initial tangent vectors.
+        Seed of the random tangent vectors at the start of the transient.
     progress : bool
         Show a progress bar in simulated time over the transient and the measurement (on
         a terminal), and a notice when the kernel with tangent vectors compiles (first
@@ -188,6 +197,48 @@ def lyapunov(
     Returns
     -------
     LyapunovSpectrum
+
+    Notes
+    -----
+    **Alignment.** From random vectors, the QR method measures the exponents only once
+    the vectors have turned into the most expanding directions. Until then the k-th
+    vector grows more slowly than ``lambda_k``, and the deficit decays like
+    ``exp(-(lambda_k - lambda_(k+1)) t)``: with gaps of a few tenths of 1/s, as between
+    the lightly damped modes of a disc, that takes seconds, and a measurement started
+    from random vectors is biased by the deficit divided by its length. The vectors
+    therefore start at random with the run and are carried through the transient,
+    re-orthonormalised every ``interval`` as in the measurement, their stretching
+    discarded. This costs the tangent kernel over the transient instead of a plain run:
+    a step with one tangent vector costs about 1.8 plain steps, with four about 3.4
+    (``benchmarks/bench_tangent.py``), so a run whose transient is as long as its
+    measurement takes about 1.6 (one vector) to 1.9 (four) times as long as without
+    alignment. The transient serves both purposes: the trajectory forgets its start on
+    it, and so do the vectors.
+
+    **Uncertainty.** With the per-interval logarithms ``l_i^(k) = ln|R_ii|`` at the
+    times ``t_k`` (``k = 1 ... m``, ``t_m = T``), the exponent is
+    ``lambda_i = sum_k l_i^(k) / T``. Split into ``B = min(10, m)`` equal blocks of
+    rates ``lambda_i^(b)``, its standard error is ``s_i = std_b(lambda_i^(b)) /
+    sqrt(B)`` (sample standard deviation); the estimate over the second half is
+    ``lambda_i'' = sum_(k > m/2) l_i^(k) / (T - t_(m/2))``, and
+
+    .. math::
+
+        u_i = \sqrt{s_i^2 + (\lambda_i - \lambda_i'')^2}.
+
+    The drift term measures the finite-time bias the block spread does not: a deficit
+    ``C`` accumulated early in the measurement (the last of the alignment, or the
+    ``ln(kappa)`` of a non-normal linearisation) biases ``lambda_i`` by ``C / T`` and
+    the second half by little, so their difference is about the bias of the whole.
+    Where the estimate only fluctuates the drift is of the size of ``s_i``, and ``u_i``
+    is about sqrt(2) times the standard error.
+
+    No estimate from one run sees a vector that has not started to align by the end of
+    the measurement: it measures the next exponent instead, steadily. That happens when
+    the transient is short against ``1 / (lambda_k - lambda_(k+1))``; on the
+    three-slider case of ``tests/test_lyapunov_accuracy.py`` (gaps 0.37-0.48 1/s) the
+    fourth exponent needed 6-16 s depending on the seed. Doubling the transient (or
+    changing ``seed``) and comparing is the check.
     """
     sim = case.simulation
     transient = 0.2 * sim.duration if transient is None else transient

@@ -98,8 +98,8 @@ def orbit(case_file: Path | None, period: float | None, transient: float | None,
 @click.option("--n", "count", type=int, default=1, show_default=True,
               help="How many exponents (largest first).")
 @click.option("--transient", type=float,
-              help="Simulated time before the measurement [s] (default: a fifth of the "
-              "case's simulation.duration).")
+              help="Simulated time before the measurement, over which the tangent vectors "
+              "align [s] (default: a fifth of the case's simulation.duration).")
 @click.option("--duration", type=float,
               help="Length of the measurement [s] (default: simulation.duration).")
 @click.option("--interval", type=float,
@@ -115,7 +115,9 @@ def lyapunov(case_file: Path, count: int, transient: float | None, duration: flo
              interval: float | None, as_json: bool, output: Path | None, progress: bool) -> None:
     """Lyapunov exponents of CASE_FILE by the QR method on the tangent dynamics.
 
-    The tangent vectors are carried across every switch by its saltation matrix.
+    The tangent vectors are carried across every switch by its saltation matrix, and
+    through the transient so that they align before the measurement. Each exponent is
+    printed with its uncertainty: standard error of ten blocks and drift of the estimate.
     CASE_FILE is a TOML file or a packaged example. Exits with status 1 when the largest
     exponent is inconclusive (its uncertainty unknown or larger than itself).
     """

@@ -3,7 +3,7 @@
 Every point's section values (see :mod:`fivdisc.sweep.sections`) are drawn as dots above
 its value of the swept key (small ones where the points are many, visible ones where they
 are few); where the sweep keeps ``largest_lyapunov``, a second panel below, sharing the
-axis, draws the exponent with a line at zero, and its standard error as error bars where
+axis, draws the exponent with a line at zero, and its uncertainty as error bars where
 the sweep keeps ``largest_lyapunov_uncertainty`` too: a finite-time exponent whose bar
 reaches across zero does not tell chaos from a regular motion. Exponents stored as
 inconclusive (``largest_lyapunov_inconclusive``: uncertainty unknown or larger than the

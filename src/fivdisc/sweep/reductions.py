@@ -268,8 +268,8 @@ BUILTIN: dict[str, Reduction] = {
             "largest_lyapunov_uncertainty",
             _largest_lyapunov_uncertainty,
             "1/s",
-            "standard error of largest_lyapunov, from the spread of its estimates over ten "
-            "blocks of the measurement (the same run)",
+            "uncertainty of largest_lyapunov: the standard error from ten blocks of the "
+            "measurement combined with the drift from its second half (the same run)",
             needs_run=False,
         ),
         _builtin(
