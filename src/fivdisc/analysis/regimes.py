@@ -88,7 +88,7 @@ def lyapunov_label(spectrum: LyapunovSpectrum, zero: float = 0.1) -> tuple[str, 
     spectrum : LyapunovSpectrum
         At least two exponents tell a periodic orbit from a torus.
     zero : float
-        Absolute allowance [1/s] for a zero exponent beyond three standard errors.
+        Absolute allowance [1/s] for a zero exponent beyond three uncertainties.
     """
     lam = spectrum.exponents
     slack = 3.0 * np.nan_to_num(spectrum.uncertainty, nan=0.0) + zero
