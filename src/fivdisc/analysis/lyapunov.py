@@ -36,7 +36,8 @@ __all__ = ["LyapunovSpectrum", "lyapunov"]
 _BLOCKS = 10
 # [s]: the default re-orthonormalisation interval.
 DEFAULT_INTERVAL = 0.05
-#: Most re-orthonormalisations of one measurement (each keeps a row of n logarithms).
+#: Most re-orthonormalisations of one run, transient and measurement (each returns to
+#: Python, and each of the measurement keeps a row of n logarithms).
 MAX_INTERVALS = 1_000_000
 
 
@@ -252,11 +253,6 @@ def lyapunov(
     check_time("interval", interval)
     if not interval <= duration:
         raise FivdiscError(f"interval = {interval!r} is invalid: must be <= duration [s]")
-    if duration / interval > MAX_INTERVALS:
-        raise FivdiscError(
-            f"interval = {interval!r} is invalid: duration / interval = "
-            f"{duration / interval:.3g} re-orthonormalisations, more than {MAX_INTERVALS:g}; "
-            "must be >= duration / 1e6 [s]")
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise FivdiscError(f"n = {n!r} is invalid: must be an integer >= 1")
     from fivdisc.simulate import Deflection, initial_state
@@ -264,6 +260,12 @@ def lyapunov(
 
     model = build_model(case)
     check_steps(model, transient + duration)
+    # After check_steps, which names a transient or duration too long to run at all.
+    if (transient + duration) / interval > MAX_INTERVALS:
+        raise FivdiscError(
+            f"interval = {interval!r} is invalid: (transient + duration) / interval = "
+            f"{(transient + duration) / interval:.3g} re-orthonormalisations, more than "
+            f"{MAX_INTERVALS:g}; must be >= (transient + duration) / 1e6 [s]")
     cap = tangent_step(model)
     if sim.max_step > 0:
         cap = min(cap, sim.max_step)

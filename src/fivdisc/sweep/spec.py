@@ -393,12 +393,14 @@ class Sweep:
                     f"(or set {where}.duration)"
                 )
             interval = self.lyapunov.interval or min(DEFAULT_INTERVAL, duration)
-            if duration / interval > MAX_INTERVALS:
+            # The tangent vector is re-orthonormalised over the transient too (alignment).
+            if (transient + duration) / interval > MAX_INTERVALS:
                 raise SweepError(
                     f"point {i} ({self._describe(i)}): {where}.interval = {interval:g} s over "
-                    f"a measurement of {duration:g} s is {duration / interval:.3g} "
-                    f"re-orthonormalisations, more than {MAX_INTERVALS:g}: lengthen the "
-                    "interval or shorten the duration"
+                    f"a transient and measurement of {transient + duration:g} s is "
+                    f"{(transient + duration) / interval:.3g} re-orthonormalisations, more "
+                    f"than {MAX_INTERVALS:g}: lengthen the interval or shorten the transient "
+                    "or the duration"
                 )
             if self.lyapunov.interval is not None and self.lyapunov.interval > duration:
                 raise SweepError(
