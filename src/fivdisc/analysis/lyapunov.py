@@ -34,6 +34,9 @@ __all__ = ["LyapunovSpectrum", "lyapunov"]
 
 # Blocks of the run whose exponents give the uncertainty (their spread).
 _BLOCKS = 10
+# Sets of tangent vectors from independent random starts: the difference of their exponents
+# is what the start still does to the estimate (Notes of `lyapunov`).
+_STARTS = 2
 # [s]: the default re-orthonormalisation interval.
 DEFAULT_INTERVAL = 0.05
 #: Most re-orthonormalisations of one run, transient and measurement (each returns to
@@ -305,7 +308,8 @@ def _measure(run: Integration, model: Model, limit: Any, free: np.ndarray, n: in
 
     sc = energy_scales(model)
     rng = np.random.default_rng(seed)
-    q, _ = np.linalg.qr(rng.standard_normal((model.state_size, n)) * free[:, None])
+    q = np.hstack([np.linalg.qr(rng.standard_normal((model.state_size, n)) * free[:, None])[0]
+                   for _ in range(_STARTS)])
     aligning = transient > 0
     t0 = run.t
     # The first interval compiles the kernel with tangents in a fresh installation.
@@ -326,7 +330,7 @@ def _measure(run: Integration, model: Model, limit: Any, free: np.ndarray, n: in
     if aligning:
         t0 = run.t
     steps = int(np.ceil(duration / interval - 1e-9))
-    logs = np.zeros((steps, n))
+    logs = np.zeros((steps, _STARTS * n))
     times = np.zeros(steps)
     for k in range(steps):
         if k or aligning:
@@ -336,18 +340,24 @@ def _measure(run: Integration, model: Model, limit: Any, free: np.ndarray, n: in
             logs[k] = first
         times[k] = run.t - t0
         bar.update(run.t - bar.n)
-    # Over a finite run the QR order need not be the order of the values: sort.
-    order = np.argsort(-logs.sum(axis=0), kind="stable")
-    logs = logs[:, order]
+    # Over a finite run the QR order need not be the order of the values: sort each start's.
+    starts = []
+    for part in np.split(logs, _STARTS, axis=1):
+        starts.append(part[:, np.argsort(-part.sum(axis=0), kind="stable")])
+    logs = np.mean(starts, axis=0)
     exponents = logs.sum(axis=0) / times[-1]
     running = np.cumsum(logs, axis=0) / times[:, None]
-    return LyapunovSpectrum(exponents, _uncertainty(logs, times, exponents), times, running,
-                            float(transient), float(duration), float(interval))
+    with np.errstate(invalid="ignore"):
+        spread = np.ptp([part.sum(axis=0) / times[-1] for part in starts], axis=0)
+    return LyapunovSpectrum(exponents, _uncertainty(logs, times, exponents, spread), times,
+                            running, float(transient), float(duration), float(interval))
 
 
-def _uncertainty(logs: np.ndarray, times: np.ndarray, exponents: np.ndarray) -> np.ndarray:
+def _uncertainty(logs: np.ndarray, times: np.ndarray, exponents: np.ndarray,
+                 spread: np.ndarray) -> np.ndarray:
     """Standard error of ten blocks combined with the drift from the second half's
-    estimate (formula in Notes of `lyapunov`); NaN with fewer than two intervals."""
+    estimate and the spread between the starts (formula in Notes of `lyapunov`); NaN with
+    fewer than two intervals."""
     steps = len(times)
     if steps < 2:
         return np.full(logs.shape[1], np.nan)
@@ -359,20 +369,25 @@ def _uncertainty(logs: np.ndarray, times: np.ndarray, exponents: np.ndarray) -> 
                           for b in blocks])
         error = rates.std(axis=0, ddof=1) / np.sqrt(len(blocks))
         later = logs[half:].sum(axis=0) / (times[-1] - times[half - 1])
-        return np.hypot(error, exponents - later)
+        return np.sqrt(error**2 + (exponents - later) ** 2 + spread**2)
 
 
 def _interval(run: Integration, limit: Any, target: float, sc: np.ndarray,
               what: str) -> np.ndarray:
-    """Integrate to `target`, re-orthonormalise the tangent vectors (energy norm) and
-    return the logarithms of their stretching factors."""
+    """Integrate to `target`, re-orthonormalise each start's tangent vectors (energy norm)
+    and return the logarithms of their stretching factors, start after start."""
     run.run_to(target)
     _check(run, limit, what)
-    q, r = np.linalg.qr(run.tangents(slaved=False).T / sc[:, None])
-    signs = np.where(np.diag(r) < 0, -1.0, 1.0)
-    run.set_tangents(((q * signs) * sc[:, None]).T)
+    vectors = run.tangents(slaved=False).T / sc[:, None]
+    stretch = np.empty(vectors.shape[1])
+    for cols in np.split(np.arange(vectors.shape[1]), _STARTS):
+        q, r = np.linalg.qr(vectors[:, cols])
+        diag = np.diag(r)
+        vectors[:, cols] = q * np.where(diag < 0, -1.0, 1.0)
+        stretch[cols] = np.abs(diag)
+    run.set_tangents((vectors * sc[:, None]).T)
     with np.errstate(divide="ignore"):
-        return np.log(np.abs(np.diag(r)))
+        return np.log(stretch)
 
 
 def _check(run: Integration, limit, what: str) -> None:
