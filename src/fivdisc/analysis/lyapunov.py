@@ -1,13 +1,14 @@
 """Lyapunov exponents of the non-smooth flow by the QR (Benettin) method.
 
-``n`` tangent vectors are carried with the state (:mod:`fivdisc._kernels.tangent`: the
-variational equations inside each phase, saltation matrices at every switch) and
-re-orthonormalised every ``interval`` seconds: ``V = Q R``; the logarithms of ``|R_ii|``
-summed over the measurement and divided by its length are the exponents, largest first.
-The vectors start at random with the run and are carried, re-orthonormalised the same
-way, through the transient, so that the measurement starts from aligned directions; the
-uncertainty adds the drift of the estimate to its statistical error (Notes of
-:func:`lyapunov`).
+Two sets of ``n`` tangent vectors, from independent random starts, are carried with the
+state (:mod:`fivdisc._kernels.tangent`: the variational equations inside each phase,
+saltation matrices at every switch) and each re-orthonormalised every ``interval``
+seconds: ``V = Q R``; the logarithms of ``|R_ii|`` summed over the measurement and
+divided by its length are a set's exponents, largest first, and the exponents are the
+mean of the two sets'. The vectors start with the run and are carried through the
+transient, so that the measurement starts from aligned directions; the uncertainty adds
+the drift of the estimate and the difference between the two starts to its statistical
+error (Notes of :func:`lyapunov`).
 
 The orthonormalisation uses the energy norm (:func:`fivdisc.analysis.orbits.energy_scales`),
 so that the result does not depend on the units of the coordinates over a finite run.
@@ -55,8 +56,9 @@ class LyapunovSpectrum:
     uncertainty : ndarray
         ``(n,)`` uncertainty of each [1/s]: the standard error from ten equal blocks of
         the measurement combined with the drift between the whole measurement's
-        estimate and its second half's (Notes of :func:`lyapunov`); an estimate of how
-        far the finite-time value may be from the limit, not a bound.
+        estimate and its second half's and with the difference between two random
+        starts (Notes of :func:`lyapunov`); an estimate of how far the finite-time value
+        may be from the limit, not a bound.
     times : ndarray
         ``(m,)`` times of the re-orthonormalisations [s], from the start of the
         measurement (after the transient).
@@ -192,7 +194,7 @@ def lyapunov(
         :func:`fivdisc.integration.tangent_step`, so that the tangent dynamics is
         resolved where the state alone would allow long steps.
     seed : int
-        Seed of the random tangent vectors at the start of the transient.
+        Seed of the two sets of random tangent vectors at the start of the transient.
     progress : bool
         Show a progress bar in simulated time over the transient and the measurement (on
         a terminal), and a notice when the kernel with tangent vectors compiles (first
@@ -212,37 +214,49 @@ def lyapunov(
     from random vectors is biased by the deficit divided by its length. The vectors
     therefore start at random with the run and are carried through the transient,
     re-orthonormalised every ``interval`` as in the measurement, their stretching
-    discarded. This costs the tangent kernel over the transient instead of a plain run:
-    a step with one tangent vector costs about 1.8 plain steps, with four about 3.4
-    (``benchmarks/bench_tangent.py``), so a run whose transient is as long as its
-    measurement takes about 1.6 (one vector) to 1.9 (four) times as long as without
-    alignment. The transient serves both purposes: the trajectory forgets its start on
+    discarded. The transient serves both purposes: the trajectory forgets its start on
     it, and so do the vectors.
 
-    **Uncertainty.** With the per-interval logarithms ``l_i^(k) = ln|R_ii|`` at the
-    times ``t_k`` (``k = 1 ... m``, ``t_m = T``), the exponent is
-    ``lambda_i = sum_k l_i^(k) / T``. Split into ``B = min(10, m)`` equal blocks of
-    rates ``lambda_i^(b)``, its standard error is ``s_i = std_b(lambda_i^(b)) /
-    sqrt(B)`` (sample standard deviation); the estimate over the second half is
-    ``lambda_i'' = sum_(k > m/2) l_i^(k) / (T - t_(m/2))``, and
+    **Uncertainty.** With a set's per-interval logarithms ``l_i^(k) = ln|R_ii|`` at the
+    times ``t_k`` (``k = 1 ... m``, ``t_m = T``), its exponent is
+    ``lambda_i = sum_k l_i^(k) / T``; the two sets give ``lambda_i^a`` and
+    ``lambda_i^b``, and the reported exponent and the terms below are those of their
+    mean. Split into ``B = min(10, m)`` equal blocks of rates ``lambda_i^(b)``, its
+    standard error is ``s_i = std_b(lambda_i^(b)) / sqrt(B)`` (sample standard
+    deviation); the estimate over the second half is ``lambda_i'' = sum_(k > m/2)
+    l_i^(k) / (T - t_(m/2))``, and
 
     .. math::
 
-        u_i = \sqrt{s_i^2 + (\lambda_i - \lambda_i'')^2}.
+        u_i = \sqrt{s_i^2 + (\lambda_i - \lambda_i'')^2 + (\lambda_i^a - \lambda_i^b)^2}.
 
-    The drift term measures the finite-time bias the block spread does not: a deficit
+    The drift term measures a finite-time bias the block spread does not: a deficit
     ``C`` accumulated early in the measurement (the last of the alignment, or the
     ``ln(kappa)`` of a non-normal linearisation) biases ``lambda_i`` by ``C / T`` and
     the second half by little, so their difference is about the bias of the whole.
-    Where the estimate only fluctuates the drift is of the size of ``s_i``, and ``u_i``
-    is about sqrt(2) times the standard error.
+    Where the estimate only fluctuates the drift is of the size of ``s_i``. The last
+    term is what the random start still does to the estimate: once both sets have
+    aligned they are the same vectors and it vanishes, chaotic or not; while they align
+    their deficits differ. On three sliders at a stable equilibrium
+    (``tests/test_lyapunov_accuracy.py``, exponents -1.15, -1.15, -1.63, -1.63 1/s)
+    with a transient of 0.5 s, far too short to align, the second exponent over 3 s was
+    8 of ``sqrt(s^2 + drift^2)`` away from its limit, and is 2.3 of ``u`` away.
 
-    No estimate from one run sees a vector that has not started to align by the end of
-    the measurement: it measures the next exponent instead, steadily. That happens when
-    the transient is short against ``1 / (lambda_k - lambda_(k+1))``; on the
-    three-slider case of ``tests/test_lyapunov_accuracy.py`` (gaps 0.37-0.48 1/s) the
-    fourth exponent needed 6-16 s depending on the seed. Doubling the transient (or
-    changing ``seed``) and comparing is the check.
+    **Limits.** A vector whose start had almost nothing along its direction measures the
+    next exponent until it turns, steadily, after about ``ln(1/p) / (lambda_k -
+    lambda_(k+1))`` for a start's component ``p``; if every start is like that (a
+    direction that random vectors in the energy norm barely touch) no estimate from the
+    run sees it. On the stick-slip orbit of that test file the third exponent, -1.95
+    1/s, took 15-20 s to turn from the next, -2.14 1/s. Doubling the transient and
+    comparing is the check.
+
+    **Cost.** The transient costs the tangent kernel instead of a plain run, and twice
+    the vectors: a step with one tangent vector costs about 1.8 plain steps, with two
+    2.4, with four 3.4 (``benchmarks/bench_tangent.py``). Measured on that three-slider
+    case with a transient as long as the measurement, one exponent takes 2.1 and four
+    3.3 times as long as with vectors started at the measurement from one start (1.6
+    and 1.8 of that is the alignment, the rest the second start); with a transient of a
+    fifth of it, 1.7 and 2.2 times.
     """
     sim = case.simulation
     transient = 0.2 * sim.duration if transient is None else transient
