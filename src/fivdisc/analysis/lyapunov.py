@@ -128,7 +128,7 @@ class LyapunovSpectrum:
                              {"long_name": "Lyapunov exponent", "units": "s-1"}),
                 "uncertainty": ("index", self.uncertainty,
                                 {"long_name": "uncertainty of the exponent (standard "
-                                            "error and drift)",
+                                            "error, drift, difference of two starts)",
                                  "units": "s-1"}),
                 "running": (("time", "index"), self.running,
                             {"long_name": "running estimate of the exponent",
@@ -326,7 +326,8 @@ def _measure(run: Integration, model: Model, limit: Any, free: np.ndarray, n: in
                    for _ in range(_STARTS)])
     aligning = transient > 0
     t0 = run.t
-    # The first interval compiles the kernel with tangents in a fresh installation.
+    # The first interval compiles the kernel with tangents in a fresh installation; it
+    # is the transient's first, or without a transient the measurement's.
     with tangent_notice(show=progress or None):
         compile_split_tangents()
         run.set_tangents((q * sc[:, None]).T)
