@@ -1,14 +1,14 @@
 """Lyapunov exponents of the non-smooth flow by the QR (Benettin) method.
 
-Two sets of ``n`` tangent vectors, from independent random starts, are carried with the
-state (:mod:`fivdisc._kernels.tangent`: the variational equations inside each phase,
-saltation matrices at every switch) and each re-orthonormalised every ``interval``
-seconds: ``V = Q R``; the logarithms of ``|R_ii|`` summed over the measurement and
-divided by its length are a set's exponents, largest first, and the exponents are the
-mean of the two sets'. The vectors start with the run and are carried through the
-transient, so that the measurement starts from aligned directions; the uncertainty adds
-the drift of the estimate and the difference between the two starts to its statistical
-error (Notes of :func:`lyapunov`).
+``n`` tangent vectors are carried with the state (:mod:`fivdisc._kernels.tangent`: the
+variational equations inside each phase, saltation matrices at every switch) and
+re-orthonormalised every ``interval`` seconds: ``V = Q R``; the logarithms of ``|R_ii|``
+summed over the measurement and divided by its length are the exponents, largest first.
+For more than one exponent two such sets, from independent random starts, are carried
+and the exponents are their mean. The vectors start with the run and are carried through
+the transient, so that the measurement starts from aligned directions; the uncertainty
+adds the drift of the estimate (and the difference between the two starts) to its
+statistical error (Notes of :func:`lyapunov`).
 
 The orthonormalisation uses the energy norm (:func:`fivdisc.analysis.orbits.energy_scales`),
 so that the result does not depend on the units of the coordinates over a finite run.
@@ -35,8 +35,9 @@ __all__ = ["LyapunovSpectrum", "lyapunov"]
 
 # Blocks of the run whose exponents give the uncertainty (their spread).
 _BLOCKS = 10
-# Sets of tangent vectors from independent random starts: the difference of their exponents
-# is what the start still does to the estimate (Notes of `lyapunov`).
+# Sets of tangent vectors from independent random starts for more than one exponent: the
+# difference of their exponents is what the start still does to the estimate (Notes of
+# `lyapunov`). The largest exponent alone keeps one set: sweeps compute it at every point.
 _STARTS = 2
 # [s]: the default re-orthonormalisation interval.
 DEFAULT_INTERVAL = 0.05
@@ -56,9 +57,9 @@ class LyapunovSpectrum:
     uncertainty : ndarray
         ``(n,)`` uncertainty of each [1/s]: the standard error from ten equal blocks of
         the measurement combined with the drift between the whole measurement's
-        estimate and its second half's and with the difference between two random
-        starts (Notes of :func:`lyapunov`); an estimate of how far the finite-time value
-        may be from the limit, not a bound.
+        estimate and its second half's and, for more than one exponent, with the
+        difference between two random starts (Notes of :func:`lyapunov`); an estimate of
+        how far the finite-time value may be from the limit, not a bound.
     times : ndarray
         ``(m,)`` times of the re-orthonormalisations [s], from the start of the
         measurement (after the transient).
@@ -128,7 +129,7 @@ class LyapunovSpectrum:
                              {"long_name": "Lyapunov exponent", "units": "s-1"}),
                 "uncertainty": ("index", self.uncertainty,
                                 {"long_name": "uncertainty of the exponent (standard "
-                                            "error, drift, difference of two starts)",
+                                            "error, drift, difference of starts)",
                                  "units": "s-1"}),
                 "running": (("time", "index"), self.running,
                             {"long_name": "running estimate of the exponent",
@@ -194,7 +195,7 @@ def lyapunov(
         :func:`fivdisc.integration.tangent_step`, so that the tangent dynamics is
         resolved where the state alone would allow long steps.
     seed : int
-        Seed of the two sets of random tangent vectors at the start of the transient.
+        Seed of the random tangent vectors at the start of the transient.
     progress : bool
         Show a progress bar in simulated time over the transient and the measurement (on
         a terminal), and a notice when the kernel with tangent vectors compiles (first
@@ -219,12 +220,12 @@ def lyapunov(
 
     **Uncertainty.** With a set's per-interval logarithms ``l_i^(k) = ln|R_ii|`` at the
     times ``t_k`` (``k = 1 ... m``, ``t_m = T``), its exponent is
-    ``lambda_i = sum_k l_i^(k) / T``; the two sets give ``lambda_i^a`` and
-    ``lambda_i^b``, and the reported exponent and the terms below are those of their
-    mean. Split into ``B = min(10, m)`` equal blocks of rates ``lambda_i^(b)``, its
-    standard error is ``s_i = std_b(lambda_i^(b)) / sqrt(B)`` (sample standard
-    deviation); the estimate over the second half is ``lambda_i'' = sum_(k > m/2)
-    l_i^(k) / (T - t_(m/2))``, and
+    ``lambda_i = sum_k l_i^(k) / T``. For ``n > 1`` two sets from independent random
+    starts give ``lambda_i^a`` and ``lambda_i^b``, and the reported exponent and the
+    terms below are those of their mean; for ``n = 1`` the last term is 0. Split into
+    ``B = min(10, m)`` equal blocks of rates ``lambda_i^(b)``, its standard error is
+    ``s_i = std_b(lambda_i^(b)) / sqrt(B)`` (sample standard deviation); the estimate
+    over the second half is ``lambda_i'' = sum_(k > m/2) l_i^(k) / (T - t_(m/2))``, and
 
     .. math::
 
@@ -240,7 +241,10 @@ def lyapunov(
     their deficits differ. On three sliders at a stable equilibrium
     (``tests/test_lyapunov_accuracy.py``, exponents -1.15, -1.15, -1.63, -1.63 1/s)
     with a transient of 0.5 s, far too short to align, the second exponent over 3 s was
-    8 of ``sqrt(s^2 + drift^2)`` away from its limit, and is 2.3 of ``u`` away.
+    8 of ``sqrt(s^2 + drift^2)`` away from its limit, and is 2.3 of ``u`` away. The
+    largest exponent alone is computed from one start: it is what sweeps compute at
+    every point, and a second set of vectors would cost a third more (below), for a
+    direction that the first vector, the fastest to align, finds soonest.
 
     **Limits.** A vector whose start had almost nothing along its direction measures the
     next exponent until it turns, steadily, after about ``ln(1/p) / (lambda_k -
@@ -250,13 +254,13 @@ def lyapunov(
     1/s, took 15-20 s to turn from the next, -2.14 1/s. Doubling the transient and
     comparing is the check.
 
-    **Cost.** The transient costs the tangent kernel instead of a plain run, and twice
-    the vectors: a step with one tangent vector costs about 1.8 plain steps, with two
-    2.4, with four 3.4 (``benchmarks/bench_tangent.py``). Measured on that three-slider
-    case with a transient as long as the measurement, one exponent takes 2.1 and four
-    3.3 times as long as with vectors started at the measurement from one start (1.6
-    and 1.8 of that is the alignment, the rest the second start); with a transient of a
-    fifth of it, 1.7 and 2.2 times.
+    **Cost.** The transient costs the tangent kernel instead of a plain run, and for
+    ``n > 1`` twice the vectors: a step with one tangent vector costs about 1.8 plain
+    steps, with two 2.4, with four 3.4 (``benchmarks/bench_tangent.py``). Measured on
+    that three-slider case with a transient as long as the measurement, one exponent
+    takes 1.6 and four 3.3 times as long as with one set of vectors started at the
+    measurement (1.8 of that is the alignment, the rest the second start); with a
+    transient of a fifth of it, 1.1 and 2.2 times.
     """
     sim = case.simulation
     transient = 0.2 * sim.duration if transient is None else transient
@@ -322,8 +326,9 @@ def _measure(run: Integration, model: Model, limit: Any, free: np.ndarray, n: in
 
     sc = energy_scales(model)
     rng = np.random.default_rng(seed)
+    starts = _STARTS if n > 1 else 1
     q = np.hstack([np.linalg.qr(rng.standard_normal((model.state_size, n)) * free[:, None])[0]
-                   for _ in range(_STARTS)])
+                   for _ in range(starts)])
     aligning = transient > 0
     t0 = run.t
     # The first interval compiles the kernel with tangents in a fresh installation; it
@@ -332,38 +337,37 @@ def _measure(run: Integration, model: Model, limit: Any, free: np.ndarray, n: in
         compile_split_tangents()
         run.set_tangents((q * sc[:, None]).T)
         first = _interval(run, limit, min(interval, transient if aligning else duration), sc,
-                          "the transient" if aligning else "the measurement")
+                          starts, "the transient" if aligning else "the measurement")
     bar.update(run.t - bar.n)
     # Alignment: the vectors are carried through the transient and re-orthonormalised as
     # in the measurement, their stretching discarded, so that the measurement starts from
     # directions that have forgotten their random start (Notes of `lyapunov`).
     k = 2
     while aligning and run.t < transient:
-        _interval(run, limit, min(k * interval, transient), sc, "the transient")
+        _interval(run, limit, min(k * interval, transient), sc, starts, "the transient")
         bar.update(run.t - bar.n)
         k += 1
     if aligning:
         t0 = run.t
     steps = int(np.ceil(duration / interval - 1e-9))
-    logs = np.zeros((steps, _STARTS * n))
+    logs = np.zeros((steps, starts * n))
     times = np.zeros(steps)
     for k in range(steps):
         if k or aligning:
             logs[k] = _interval(run, limit, min(t0 + (k + 1) * interval, transient + duration),
-                                sc, "the measurement")
+                                sc, starts, "the measurement")
         else:
             logs[k] = first
         times[k] = run.t - t0
         bar.update(run.t - bar.n)
     # Over a finite run the QR order need not be the order of the values: sort each start's.
-    starts = []
-    for part in np.split(logs, _STARTS, axis=1):
-        starts.append(part[:, np.argsort(-part.sum(axis=0), kind="stable")])
-    logs = np.mean(starts, axis=0)
+    sets = [part[:, np.argsort(-part.sum(axis=0), kind="stable")]
+            for part in np.split(logs, starts, axis=1)]
+    logs = np.mean(sets, axis=0)
     exponents = logs.sum(axis=0) / times[-1]
     running = np.cumsum(logs, axis=0) / times[:, None]
     with np.errstate(invalid="ignore"):
-        spread = np.ptp([part.sum(axis=0) / times[-1] for part in starts], axis=0)
+        spread = np.ptp([part.sum(axis=0) / times[-1] for part in sets], axis=0)
     return LyapunovSpectrum(exponents, _uncertainty(logs, times, exponents, spread), times,
                             running, float(transient), float(duration), float(interval))
 
@@ -387,7 +391,7 @@ def _uncertainty(logs: np.ndarray, times: np.ndarray, exponents: np.ndarray,
         return np.sqrt(error**2 + (exponents - later) ** 2 + spread**2)
 
 
-def _interval(run: Integration, limit: Any, target: float, sc: np.ndarray,
+def _interval(run: Integration, limit: Any, target: float, sc: np.ndarray, starts: int,
               what: str) -> np.ndarray:
     """Integrate to `target`, re-orthonormalise each start's tangent vectors (energy norm)
     and return the logarithms of their stretching factors, start after start."""
@@ -395,7 +399,7 @@ def _interval(run: Integration, limit: Any, target: float, sc: np.ndarray,
     _check(run, limit, what)
     vectors = run.tangents(slaved=False).T / sc[:, None]
     stretch = np.empty(vectors.shape[1])
-    for cols in np.split(np.arange(vectors.shape[1]), _STARTS):
+    for cols in np.split(np.arange(vectors.shape[1]), starts):
         q, r = np.linalg.qr(vectors[:, cols])
         diag = np.diag(r)
         vectors[:, cols] = q * np.where(diag < 0, -1.0, 1.0)

@@ -115,10 +115,11 @@ def lyapunov(case_file: Path, count: int, transient: float | None, duration: flo
              interval: float | None, as_json: bool, output: Path | None, progress: bool) -> None:
     """Lyapunov exponents of CASE_FILE by the QR method on the tangent dynamics.
 
-    The tangent vectors (two sets, from independent random starts) are carried across
-    every switch by its saltation matrix, and through the transient so that they align
-    before the measurement. Each exponent is printed with its uncertainty: standard error
-    of ten blocks, drift of the estimate and difference between the starts.
+    The tangent vectors are carried across every switch by its saltation matrix, and
+    through the transient so that they align before the measurement; for --n above 1,
+    two sets from independent random starts. Each exponent is printed with its
+    uncertainty: standard error of ten blocks, drift of the estimate and difference
+    between the starts.
     CASE_FILE is a TOML file or a packaged example. Exits with status 1 when the largest
     exponent is inconclusive (its uncertainty unknown or larger than itself).
     """

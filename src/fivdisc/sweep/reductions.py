@@ -135,8 +135,8 @@ class LyapunovSettings:
     """How the ``largest_lyapunov`` reduction measures (``[reduce.largest_lyapunov]``).
 
     The exponent is measured from `transient` for `duration` (see
-    :func:`fivdisc.lyapunov`), in a run of its own that carries two tangent
-    vectors from independent random starts, through the transient too.
+    :func:`fivdisc.lyapunov`), in a run of its own that carries a tangent
+    vector, through the transient too.
 
     Attributes
     ----------
@@ -269,8 +269,7 @@ BUILTIN: dict[str, Reduction] = {
             _largest_lyapunov_uncertainty,
             "1/s",
             "uncertainty of largest_lyapunov: the standard error from ten blocks of the "
-            "measurement combined with the drift from its second half and the difference "
-            "between two random starts (the same run)",
+            "measurement combined with the drift from its second half (the same run)",
             needs_run=False,
         ),
         _builtin(
