@@ -114,15 +114,17 @@ def _timed(f) -> float:
     return time.perf_counter() - start
 
 
-def processes(count: int) -> None:
-    """The one-vector figure of :func:`per_step` (3 rounds) in ``count`` fresh processes.
+def processes(count: int, cpu_time: bool = False) -> None:
+    """The one-vector figure of :func:`per_step` (3 rounds) in ``count`` fresh processes,
+    timed by the same clock as this process's figures.
 
     Within a process the rounds agree to about 1 %, but the figure moves by several per
     cent from one process to the next (the same code, the same steps): this shows the
     spread a single run of this script can land anywhere in."""
     figures = []
+    clock = ["--cpu-time"] if cpu_time else []
     for _ in range(count):
-        out = subprocess.run([sys.executable, __file__, "--one"], check=True,
+        out = subprocess.run([sys.executable, __file__, "--one", *clock], check=True,
                              capture_output=True, text=True).stdout
         figures.append(float(out.split("1 tangent vector(s):")[1].split("x")[0]))
     print(f"1 tangent vector in {count} fresh processes: "
@@ -154,7 +156,7 @@ def main() -> None:
     if not args.no_exponent:
         exponent(case)
     if args.processes:
-        processes(args.processes)
+        processes(args.processes, args.cpu_time)
 
 
 if __name__ == "__main__":

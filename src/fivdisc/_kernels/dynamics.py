@@ -31,6 +31,8 @@ from fivdisc._kernels.layout import (
     A_KNOWN,
     A_L2GQ,
     A_N,
+    A_OM,
+    A_OMD,
     A_PHID,
     A_SGGP,
     A_SMU,
@@ -248,6 +250,10 @@ def evaluate(t, y, ph, sg, right, mdl, wk, dy):
     n, ns, half = sizes(mdl)
     r_gp, r_fq, r_trig, r_aux, r_sys, r_u = work_rows(ns)
     om, omd = speed_at(t, mdl.speed, right)
+    # Kept for the tangent-linear right-hand side, which would otherwise look the speed
+    # up again at every stage of every tangent vector.
+    wk[r_aux + A_OM, 0] = om
+    wk[r_aux + A_OMD, 0] = omd
     zero = y[n] * 0.0
 
     # Disc forces that do not depend on the contacts: stiffness, spin, damping.
@@ -690,10 +696,10 @@ def complex_step_jacobian(t, y, ph, sg, mdl):
 
 
 @njit(cache=True, inline="always")
-def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
+def linearised_one(y, v, ph, sg, mdl, wk, out):
     """``out = J(t, y) v`` for a single slider: the tangent-linear form of ``evaluate``
     (forward-mode derivative, operation by operation), using the values ``evaluate``
-    left in ``wk`` at the same ``(t, y)``, phases and ``right``.
+    left in ``wk`` at the same ``(t, y)``, phases and ``right`` (the speed among them).
 
     Every intermediate x of ``evaluate`` has its derivative dx along v. The mode shapes
     move with the slider's angle: dg = g' dpsi and dg' = -l^2 g dpsi. The friction law's
@@ -706,7 +712,8 @@ def linearised_one(t, y, v, ph, sg, right, mdl, wk, out):
     opts = mdl.opts
     n, ns, half = sizes(mdl)
     r_gp, r_fq, _, aux, _, _ = work_rows(ns)
-    om, omd = speed_at(t, mdl.speed, right)
+    om = wk[aux + A_OM, 0]
+    omd = wk[aux + A_OMD, 0]
     eps = opts[O_OMDOT]
     damped = opts[O_DAMPED] != 0.0
     om2 = om * om

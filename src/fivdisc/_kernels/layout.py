@@ -127,7 +127,9 @@ A_SMU = 10  # s mu in slip
 A_FPHI = 11  # in-plane spring and damper force
 A_KNOWN = 12  # the part of N that does not depend on the accelerations
 A_DEN = 13  # one slider in contact: the divisor of its N in closed form
-N_AUX = 14
+A_OM = 14  # column 0: the disc's speed Omega [rad/s] at the evaluation (one per evaluation)
+A_OMD = 15  # column 0: its rate dOmega/dt [rad/s^2]
+N_AUX = 16
 
 
 class KernelModel(NamedTuple):

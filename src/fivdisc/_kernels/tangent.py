@@ -101,7 +101,7 @@ def jvp(t, y, v, ph, sg, right, mdl, wk, cplx, out):
     slider takes the tangent-linear right-hand side (about the cost of one evaluation),
     several the complex step of ``evaluate`` (a complex evaluation)."""
     if sizes(mdl)[1] == 1:
-        linearised_one(t, y, v, ph, sg, right, mdl, wk, out)
+        linearised_one(y, v, ph, sg, mdl, wk, out)
         return
     yc, dyc, wkc = cplx
     nd = out.shape[0]
