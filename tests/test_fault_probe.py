@@ -21,7 +21,8 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from fivdisc import Case, simulate
+from fivdisc import Case, lyapunov, simulate
+from fivdisc.analysis.checks import check_orbit_request
 from fivdisc.cli import cli
 from fivdisc.errors import FivdiscError
 from fivdisc.speed import SpeedProfile
@@ -91,6 +92,24 @@ def test_hard_dynamics_is_refused_or_ends(tables, expected, bound) -> None:
         assert expected in str(outcome)
     else:
         assert outcome.status == expected, outcome.message
+
+
+@pytest.mark.parametrize(("call", "named"), [
+    (lambda: simulate(Case(simulation={"duration": 10.0, "max_steps": 1000})),
+     "over simulation.duration = 10.0 s"),
+    (lambda: lyapunov(Case(), transient=1e30, duration=1.0),
+     "over transient + duration = 1e+30 s"),
+    (lambda: check_orbit_request(Case(), transient=1e30),
+     "over --transient + --window = 1e+30 s"),
+    (lambda: check_orbit_request(Case(simulation={"duration": 1e30})),
+     "over simulation.duration + --window = 1e+30 s"),
+], ids=["simulate", "lyapunov transient", "orbit transient", "orbit default transient"])
+def test_a_run_too_long_to_integrate_names_what_set_its_length(call, named) -> None:
+    """The work estimate refuses the run before it starts and names the setting the user
+    gave (a Lyapunov transient was named simulation.duration), in one line."""
+    with pytest.raises(FivdiscError, match=r"more than simulation\.max_steps") as info:
+        call()
+    assert named in str(info.value) and "\n" not in str(info.value)
 
 
 @pytest.mark.parametrize("tables", [
@@ -269,9 +288,16 @@ DIVERGING = [
 
 @pytest.mark.parametrize(("tables", "word"), DIVERGING, ids=["printed sign", "1e4 rad/s"])
 def test_lyapunov_of_a_diverging_run_is_refused(tables, word, tmp_path: Path) -> None:
-    """simulate calls the run diverged; lyapunov must not print an exponent for it."""
+    """simulate calls the run diverged; lyapunov must not print an exponent for it, and
+    says so as soon as the transient leaves the model's range. The tangent vectors are
+    carried from the start (they align over the transient), so a fresh installation
+    compiles the kernel with tangents first: loaded here, so that the bound is on the
+    refusal (`benchmarks/bench_first_use.py` times the compilation)."""
+    from fivdisc.analysis.lyapunov import warm_tangent_kernel
+
     case = Case(**tables)
     assert simulate(case).status == "diverged"
+    warm_tangent_kernel()
     path = tmp_path / "c.toml"
     case.save(path)
     result, wall = cli_run(["lyapunov", str(path), "--no-progress"])

@@ -139,9 +139,12 @@ def estimate_steps(model: Model, duration: float) -> tuple[float, str, float]:
     return worst
 
 
-def check_steps(model: Model, duration: float) -> None:
+def check_steps(model: Model, duration: float, span: str = "simulation.duration") -> None:
     """Refuse a run whose estimated steps (:func:`estimate_steps`) exceed
     ``simulation.max_steps``, before it starts.
+
+    ``duration`` [s] is the simulated time the command will integrate; ``span`` names
+    what the user set to get it, for the message (e.g. ``"transient + duration"``).
 
     Raises
     ------
@@ -154,7 +157,7 @@ def check_steps(model: Model, duration: float) -> None:
         raise FivdiscError(
             f"the run needs about {steps:.3g} integrator steps, more than "
             f"simulation.max_steps = {budget}: {what} = {rate:.3g} 1/s limits the step to "
-            f"{duration / steps:.3g} s over simulation.duration = {duration!r} s; change "
+            f"{duration / steps:.3g} s over {span} = {duration!r} s; change "
             "that parameter, shorten the run or raise simulation.max_steps"
         )
 

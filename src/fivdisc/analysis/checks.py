@@ -105,4 +105,6 @@ def check_orbit_request(case: Case, *, period: float | None = None,
     model = build_model(case)
     run = case.simulation.duration if transient is None else transient
     # The transient, the window searched, and at least one shot over the period.
-    check_steps(model, run + window + (period or 0.0))
+    span = " + ".join([t_name if transient is not None else "simulation.duration", w_name]
+                      + ([p_name] if period else []))
+    check_steps(model, run + window + (period or 0.0), span)

@@ -280,7 +280,7 @@ def lyapunov(
     from fivdisc.split_compile import compile_split
 
     model = build_model(case)
-    check_steps(model, transient + duration)
+    check_steps(model, transient + duration, "transient + duration")
     # After check_steps, which names a transient or duration too long to run at all.
     if (transient + duration) / interval > MAX_INTERVALS:
         raise FivdiscError(
