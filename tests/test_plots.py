@@ -463,3 +463,58 @@ def test_labels_of_close_bifurcations_do_not_overlap():
     first, second, far = offsets.values()
     assert first != second        # stacked
     assert far == first           # a label with room keeps the usual place
+
+
+def _s_branch(fold_a: float, fold_b: float):
+    """A branch over 5.5 to 9 rad/s that folds back at ``fold_a`` and forward again at
+    ``fold_b``: stable, unstable between the folds, stable (the trial's S-shaped stretch,
+    folds at 5.79904 and 5.75712)."""
+    import types
+
+    up = np.linspace(5.5, fold_a - 1e-3, 12)
+    back = np.linspace(fold_a - 2e-3, fold_b + 2e-3, 6)
+    on = np.linspace(fold_b + 1e-3, 9.0, 40)
+    p = np.r_[up, back, on]
+    stable = np.r_[np.ones(up.size, bool), np.zeros(back.size, bool), np.ones(on.size, bool)]
+    # The period follows the key, as on the trial's branch, and the three sheets of the S
+    # differ a little.
+    period = 5.9e-3 - 1.4e-4 * (p - 5.5) + 2e-7 * np.linspace(0.0, 1.0, p.size)
+    bifs = [{"kind": "fold", "parameter": fold_a, "point": up.size - 1},
+            {"kind": "fold", "parameter": fold_b, "point": up.size + back.size - 1}]
+    return types.SimpleNamespace(parameter=p, stable=stable, key="speed.value",
+                                 dataset=xr.Dataset({"period": ("point", period),
+                                                     "parameter": ("point", p)}),
+                                 bifurcations=lambda: bifs)
+
+
+def test_an_unstable_stretch_too_short_to_show_dashed_is_marked_and_named():
+    """An unstable stretch 0.04 rad/s wide between two folds, on a branch 3.5 rad/s wide,
+    was invisible on the branch figure (trial s33): shorter than one dash of the unstable
+    line. Its points are now marked, and the legend names its range from the located
+    folds; a stretch as wide as a third of the figure is left to its dashes."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib import rcParams
+
+    from fivdisc.branch_plots import NARROW, narrow_unstable, plot_branch
+
+    narrow = _s_branch(5.79904, 5.75712)
+    assert narrow_unstable(narrow) == [(5.79904, 5.75712)]
+    fig = plot_branch(narrow)
+    ax = fig.axes[0]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any("5.75712 to 5.79904" in t for t in labels), labels
+    marked = [ln for ln in ax.get_lines()
+              if ln.get_marker() == "o" and ln.get_linestyle() == "None"]
+    assert len(marked) == 1 and marked[0].get_xdata().size == 6
+    # The threshold is about one dash and gap of the unstable line on this figure.
+    fig.canvas.draw()
+    width_pt = ax.get_window_extent().width * 72.0 / fig.dpi
+    dash_pt = sum(rcParams["lines.dashed_pattern"]) * 1.4
+    assert 0.5 * NARROW < dash_pt / width_pt < 1.5 * NARROW
+
+    wide = _s_branch(7.5, 6.3)
+    assert narrow_unstable(wide) == []
+    labels = [t.get_text() for t in plot_branch(wide).axes[0].get_legend().get_texts()]
+    assert labels == ["stable", "unstable"]

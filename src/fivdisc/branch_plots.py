@@ -17,11 +17,14 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["BRANCH_MEASURES", "draw_branch", "plot_branch"]
+__all__ = ["BRANCH_MEASURES", "NARROW", "draw_branch", "narrow_unstable", "plot_branch"]
 
 #: What :func:`plot_branch` can draw: the period, or a measure per slider, as its
 #: largest (``_max``) or smallest (``_min``) value over a period, or both (no suffix).
 BRANCH_MEASURES = ("period", *MEASURES, *(f"{m}_{e}" for m in MEASURES for e in ("max", "min")))
+#: Largest fraction of a branch figure's width and height that :func:`narrow_unstable`
+#: calls too short to show dashed.
+NARROW = 0.02
 # Short labels of the bifurcations on a figure.
 _MARKS = {"fold": ("LP", "s"), "period doubling": ("PD", "D"), "torus": ("NS", "o"),
           "branch point": ("BP", "^"), "signature change": ("DIB", "v")}
@@ -44,26 +47,71 @@ def _columns(branch: Branch, measure: str, slider: int) -> list[tuple[str, np.nd
     return [(n, ds[n].values[:, slider], ds[n].attrs.get("units", "")) for n in names]
 
 
+def _spans(x: np.ndarray, curves: list[tuple[str, np.ndarray, str]]) -> tuple[float, float]:
+    """The figure's extent in the key and in the measure (1 where a branch has none)."""
+    return (float(np.ptp(x)) or 1.0,
+            max(float(np.nanmax(y) - np.nanmin(y)) for _, y, _ in curves) or 1.0)
+
+
+def _narrow_stretches(branch: Branch, curves: list[tuple[str, np.ndarray, str]]
+                      ) -> list[tuple[int, int, float, float]]:
+    """(first point, end point, start and end of the key) of each unstable stretch of
+    :func:`narrow_unstable`."""
+    x = branch.parameter
+    stable = np.asarray(branch.stable, bool)
+    span_x, span_y = _spans(x, curves)
+    ends = {b["point"]: b["parameter"] for b in branch.bifurcations()}
+    cuts = np.flatnonzero(np.diff(stable.astype(int))) + 1
+    found = []
+    for a, b in itertools.pairwise(np.r_[0, cuts, x.size]):
+        if stable[a]:
+            continue
+        # The stretch as drawn: from the last stable point before it to the first after.
+        drawn = slice(max(a - 1, 0), min(b + 1, x.size))
+        wide = np.ptp(x[drawn]) / span_x
+        high = max(float(np.ptp(y[drawn])) for _, y, _ in curves) / span_y
+        if max(wide, high) < NARROW:
+            found.append((int(a), int(b), float(ends.get(a - 1, x[a])),
+                          float(ends.get(b - 1, x[b - 1]))))
+    return found
+
+
+def narrow_unstable(branch: Branch, measure: str = "period",
+                    slider: int = 0) -> list[tuple[float, float]]:
+    """Unstable stretches of a branch too short to show dashed on its figure, each as the
+    range of the key it spans (from the located bifurcations that bound it where there
+    are, else its first and last points), in the order of the branch.
+
+    A stretch counts when it spans less than :data:`NARROW` of the figure's width and of
+    its height (the measure's span): one dash and gap of the unstable line style, at the
+    default line width on a figure 7 in wide, take about 1.7 % of the axes."""
+    curves = _columns(branch, measure, slider)
+    return [(lo, hi) for _, _, lo, hi in _narrow_stretches(branch, curves)]
+
+
 def draw_branch(ax: Axes, branch: Branch, measure: str = "period", slider: int = 0,
                 color: str = "C0", labels: bool = True) -> None:
     """Draw a measure of a branch on existing axes: stable stretches solid, unstable
     dashed, bifurcations marked (LP fold, PD period doubling, NS torus, BP branch point,
-    DIB a change of the event signature) and, with ``labels``, named."""
+    DIB a change of the event signature) and, with ``labels``, named. The points of an
+    unstable stretch too short to show dashed (:func:`narrow_unstable`) are marked."""
     x = branch.parameter
     stable = branch.stable
     curves = _columns(branch, measure, slider)
+    cuts = np.flatnonzero(np.diff(stable.astype(int))) + 1
+    bounds = np.r_[0, cuts, x.size]
+    narrow = _narrow_stretches(branch, curves)
     for _name, y, _ in curves:
         # Split where the stability changes; each piece shares its end point with the next.
-        cuts = np.flatnonzero(np.diff(stable.astype(int))) + 1
-        bounds = np.r_[0, cuts, x.size]
         for a, b in itertools.pairwise(bounds):
             piece = slice(a, min(b + 1, x.size))
             ax.plot(x[piece], y[piece], color=color, lw=1.4,
                     linestyle="-" if stable[a] else "--")
+        for a, b, _, _ in narrow:
+            ax.plot(x[a:b], y[a:b], color=color, ls="none", marker="o", ms=2.5)
     # Labels placed so far, in axes fractions of the data's span: one that would land on
     # an earlier one (bifurcations a few thousandths of the span apart) is stacked above.
-    span_x = float(np.ptp(x)) or 1.0
-    span_y = max(float(np.nanmax(y) - np.nanmin(y)) for _, y, _ in curves) or 1.0
+    span_x, span_y = _spans(x, curves)
     placed: list[tuple[float, float]] = []
     for b in branch.bifurcations():
         label, marker = _MARKS.get(b["kind"], ("?", "x"))
@@ -135,9 +183,14 @@ def plot_branch(branch: Branch, measure: str = "period", slider: int = 0,
         what += {"_max": ", largest", "_min": ", smallest"}.get(measure[-4:], ", range")
     ax.set_ylabel(f"{what} [{unit}]" if unit and unit != "1" else what)
     ax.set_title(f"periodic orbits continued in {branch.key}", fontsize=10)
-    ax.legend(handles=[Line2D([], [], color="C0", ls="-", label="stable"),
-                       Line2D([], [], color="C0", ls="--", label="unstable")],
-              loc="best", fontsize=8, frameon=False)
+    handles = [Line2D([], [], color="C0", ls="-", label="stable"),
+               Line2D([], [], color="C0", ls="--", label="unstable")]
+    narrow = narrow_unstable(branch, measure, slider)
+    if narrow:
+        spans = ", ".join(f"{min(lo, hi):.6g} to {max(lo, hi):.6g}" for lo, hi in narrow)
+        handles.append(Line2D([], [], color="C0", ls="none", marker="o", ms=2.5,
+                              label=f"unstable, too short to see dashed: {spans}"))
+    ax.legend(handles=handles, loc="best", fontsize=8, frameon=False)
     ax.grid(alpha=0.3)
     return fig
 
