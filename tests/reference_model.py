@@ -4,8 +4,8 @@ This module is an *independent* implementation of the model stated in
 ``docs/model.md`` (the printed paper has errors; that page wins): S sliders on
 either face, disc damping and several friction laws.  It exists to check the package's fast
 (numba) simulator and to serve as the speed baseline of the benchmarks.  It
-deliberately shares no code with ``fivdisc._kernels`` or ``fivdisc.simulate``:
-it only takes modal data from ``fivdisc.plate`` and parameters from a case
+deliberately shares no code with ``fivdisc.core`` or ``fivdisc.simulate``:
+it only takes modal data from ``fivdisc.model.plate`` and parameters from a case
 object (``fivdisc.case.Case`` or any object with the same attributes, e.g. a
 ``types.SimpleNamespace``).
 
@@ -408,12 +408,12 @@ class ModeData:
 
 
 def mode_data_from_case(case: Any) -> ModeData:
-    """Modal data of ``case.disc.modes`` at every slider's radius, from ``fivdisc.plate``."""
+    """Modal data of ``case.disc.modes`` at every slider's radius, from ``fivdisc.model.plate``."""
     modes = list(case.disc.modes)
     radii = [float(s.track_radius) for s in slider_list(case)]
     cols, M, om, ll, sine = [], [], [], [], []
     if modes:
-        from fivdisc.plate import AnnularPlate
+        from fivdisc.model.plate import AnnularPlate
 
         plate = AnnularPlate.from_disc(case.disc)
         for k, l in modes:

@@ -17,11 +17,11 @@ import pytest
 import xarray as xr
 from click.testing import CliRunner
 
-from fivdisc.analysis.lyapunov import lyapunov
+from fivdisc.analysis.exponents import lyapunov
 from fivdisc.case import Case
 from fivdisc.cli import cli
-from fivdisc.model import build_model
-from fivdisc.simulate import simulate
+from fivdisc.engine.simulation import simulate
+from fivdisc.model.build import build_model
 from fivdisc.sweep import (
     LyapunovSettings,
     Section,
@@ -30,14 +30,14 @@ from fivdisc.sweep import (
     SweepStore,
     load_sweep,
     open_sweep,
-    read_mask,
     run_sweep,
-    store_lock,
     verify_store,
 )
 from fivdisc.sweep.reductions import evaluate
 from fivdisc.sweep.sections import VARIABLES, section_values
-from fivdisc.sweep.store import PointOutcome
+from fivdisc.sweep.store.health import read_mask
+from fivdisc.sweep.store.lock import store_lock
+from fivdisc.sweep.store.sweep_store import PointOutcome
 
 # One axisymmetric disc mode and a heavy slider: a stick-slip cycle of about 20 ms
 # (the light case of test_orbits.py).
@@ -338,11 +338,11 @@ def test_section_chunks_are_checksummed_and_recomputed(tmp_path) -> None:
 def test_stores_of_format_3_are_read_not_resumed(tmp_path, monkeypatch) -> None:
     """A store written before sections existed is format 4 without them, one point per
     chunk: read and verified, not resumed."""
-    from fivdisc.sweep import store as module
+    from fivdisc.sweep.store import layout as module
 
     plain = Sweep(base=STORED.base, axes=STORED.axes, keep=STORED.keep)
     path = tmp_path / "old.zarr"
-    monkeypatch.setattr(module, "_BLOCK_POINTS", 1)
+    monkeypatch.setattr(module, "BLOCK_POINTS", 1)
     with store_lock(path):
         SweepStore.open(path, plain).write(
             [PointOutcome(i, {"max_normal_force": 1.0 + i}) for i in range(2)])
@@ -460,7 +460,7 @@ def test_sections_only_and_the_definition() -> None:
 
 
 def test_command_runs_the_sweep_and_draws_the_diagram(diagram, sweep_file) -> None:
-    from fivdisc.sweep import plot_bifurcation
+    from fivdisc.plots import plot_bifurcation
 
     store, figure, output = diagram
     assert "3 points: 0 already stored, 3 computed" in output
@@ -545,7 +545,7 @@ def test_diagram_needs_a_section(tmp_path) -> None:
 
 def test_inconclusive_exponents_are_ringed_in_the_diagram(diagram) -> None:
     # Issue 28, item 3: a reader of the diagram sees which exponents are not usable.
-    from fivdisc.sweep import plot_bifurcation
+    from fivdisc.plots import plot_bifurcation
 
     data = open_sweep(diagram[0])
     flags = np.array([True, False, True])

@@ -60,7 +60,7 @@ def test_bad_case_file_is_one_line(tmp_path):
 def test_endless_switching_stops_with_status(monkeypatch):
     # No physical case here chatters (the phase choice prevents it), so the guard is
     # exercised by declaring any 5 consecutive switches less than 1 s apart "endless".
-    integration = importlib.import_module("fivdisc.integration")
+    integration = importlib.import_module("fivdisc.engine.integration")
     monkeypatch.setattr(integration, "ZENO_DT", 1.0)
     monkeypatch.setattr(integration, "ZENO_COUNT", 5)
     res = simulate(Case(simulation={"duration": 0.5}))

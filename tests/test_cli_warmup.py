@@ -21,14 +21,14 @@ _FIRST_USES = """
 import json, sys
 from numba.core.registry import CPUDispatcher
 from fivdisc import Case, simulate
-from fivdisc.analysis.lyapunov import lyapunov
+from fivdisc.analysis.exponents import lyapunov
 from fivdisc.analysis.stability import linear_stability
 case = Case(simulation={"duration": 0.01})
 simulate(case)
 lyapunov(case, transient=0.0, duration=0.01, interval=0.005, seed=1)
 linear_stability(Case())
 dispatchers = {id(d): d for name, module in list(sys.modules.items())
-               if name.startswith("fivdisc._kernels") for d in vars(module).values()
+               if name.startswith("fivdisc.core") for d in vars(module).values()
                if isinstance(d, CPUDispatcher)}.values()
 print(json.dumps([sum(sum(d.stats.cache_misses.values()) for d in dispatchers),
                   sum(sum(d.stats.cache_hits.values()) for d in dispatchers)]))

@@ -9,8 +9,8 @@ import types
 import pytest
 from click.testing import CliRunner
 
-from fivdisc import compilation
 from fivdisc.cli import cli
+from fivdisc.engine import compilation
 
 
 def _dispatcher(signatures=(), index=None, cache_path=None):
@@ -158,7 +158,7 @@ def test_simulate_command_announces_compilation(tmp_path, monkeypatch, quiet):
     compilation out."""
     monkeypatch.setattr(compilation, "needs_compiling", lambda dispatcher: True)
     # The kernel is in the cache: no helper process to share a compilation with.
-    monkeypatch.setattr("fivdisc.split_compile._cores", lambda: 1)
+    monkeypatch.setattr("fivdisc.engine.split_compile._cores", lambda: 1)
     case = tmp_path / "c.toml"
     case.write_text("[simulation]\nduration = 0.01\n")
     run = CliRunner().invoke(cli, ["simulate", str(case), "-o", str(tmp_path / "c.nc"),
@@ -175,7 +175,7 @@ def test_orbit_command_without_progress_announces_the_tangent_kernel(tmp_path, m
     from test_orbits import RIGID
 
     monkeypatch.setattr(compilation, "needs_compiling", lambda dispatcher: True)
-    monkeypatch.setattr("fivdisc.split_compile._cores", lambda: 1)
+    monkeypatch.setattr("fivdisc.engine.split_compile._cores", lambda: 1)
     case = tmp_path / "rigid.toml"
     case.write_text(RIGID.replace({"simulation.duration": 4.0}).to_toml())
     run = CliRunner().invoke(cli, ["orbit", str(case), "--no-progress", "--json"])

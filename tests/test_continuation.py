@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from fivdisc.analysis.branch import open_branch
-from fivdisc.analysis.continuation import continue_orbit
 from fivdisc.analysis.orbits import periodic_orbit
 from fivdisc.cli import cli
+from fivdisc.continuation.branch import open_branch
+from fivdisc.continuation.walk import continue_orbit
 from fivdisc.errors import CaseError, ConvergenceError, FivdiscError
 from test_orbits import LIGHT, RIGID, _rigid_disc_closed_form
 
@@ -86,7 +86,7 @@ def test_continuation_in_a_slider_key_matches_independent_solves():
     # The stored point is the orbit's in every coordinate, those the contact holds (the
     # slider's z, zdot) included: one period of a plain run returns to it.
     from fivdisc.analysis.orbits import Shooting, energy_scales
-    from fivdisc.model import build_model
+    from fivdisc.model.build import build_model
 
     model = build_model(LIGHT.replace({"slider.normal_damping": 40.0}))
     x = br.dataset["state"].values[-1]
@@ -194,9 +194,9 @@ def test_the_doubled_orbits_are_born_at_the_period_doubling():
     (a^2 proportional to the distance in the key, the same constant to 5 % over the
     branch's first points), on one side of it only."""
     from fivdisc import examples, load_case
-    from fivdisc.analysis.continuation import doubled_start
     from fivdisc.analysis.orbits import Shooting, energy_scales
-    from fivdisc.model import build_model
+    from fivdisc.continuation.starts import doubled_start
+    from fivdisc.model.build import build_model
 
     case = load_case(examples.path("damped-disc")).replace({"speed.value": 2.5911321532805127})
     start = periodic_orbit(case, transient=6.0)
@@ -380,9 +380,9 @@ _GRAZE_SPAN = 0.004  # [s]: one period of the disc mode, 4.2 ms
 
 
 def _graze_run(phi0: float, max_step: float = 0.0):
-    from fivdisc._kernels import layout as lay
-    from fivdisc.integration import Integration
-    from fivdisc.model import build_model
+    from fivdisc.engine.integration import Integration
+    from fivdisc.model import layout as lay
+    from fivdisc.model.build import build_model
 
     model = build_model(_GRAZE)
     y = np.zeros(model.state_size)
@@ -441,7 +441,7 @@ def test_fig13_branch_ends_where_its_stick_phase_splits():
     onto it. Its points move continuously (each within a tenth of the state's size of
     the previous), every period stays a one-cycle period, and it ends at the split."""
     from fivdisc.analysis.cycle import one_period
-    from fivdisc.model import build_model
+    from fivdisc.model.build import build_model
     from fivdisc.paper.cases import FIGURES
 
     case = FIGURES[13].case

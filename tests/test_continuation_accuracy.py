@@ -16,8 +16,8 @@ from __future__ import annotations
 import numpy as np
 
 from fivdisc import Case
-from fivdisc.analysis.continuation import continue_orbit
 from fivdisc.analysis.orbits import periodic_orbit
+from fivdisc.continuation.walk import continue_orbit
 
 CASE = Case.from_toml("""
 [disc]

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from fivdisc import examples, load_case, simulate
-from fivdisc.analysis.continuation import continue_orbit
 from fivdisc.analysis.orbits import periodic_orbit
+from fivdisc.continuation.walk import continue_orbit
 
 CASE = load_case(examples.path("damped-disc")).replace({"speed.value": 12.3})
 

@@ -21,9 +21,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fivdisc.analysis.continuation import continue_orbit
 from fivdisc.analysis.orbits import periodic_orbit
 from fivdisc.case import Case
+from fivdisc.continuation.walk import continue_orbit
 from reference_model import mode_data_from_case, reference_simulate
 
 # A light disc with one axisymmetric mode and a damped slider under exponential friction: a

@@ -7,9 +7,9 @@ from click.testing import CliRunner
 
 from fivdisc.case import Case
 from fivdisc.cli import cli
-from fivdisc.integration import Integration
-from fivdisc.model import build_model
-from fivdisc.simulate import Deflection, initial_state, simulate
+from fivdisc.engine.integration import Integration
+from fivdisc.engine.simulation import Deflection, initial_state, simulate
+from fivdisc.model.build import build_model
 from test_fault_probe import messages
 
 

@@ -126,7 +126,7 @@ def _effective(text: str):
     measurement window and interval of its Lyapunov exponent."""
     if not _is_sweep(text):
         return load_case_text(text)
-    from fivdisc.analysis.lyapunov import DEFAULT_INTERVAL
+    from fivdisc.analysis.exponents import DEFAULT_INTERVAL
 
     spec = load_sweep_text(text)
     lyap = None

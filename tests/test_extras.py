@@ -39,7 +39,8 @@ def no_work(monkeypatch):
     def never(*args, **kwargs):
         raise AssertionError("the command started working before saying what it needs")
 
-    for module, name in [("fivdisc.simulate", "simulate"), ("fivdisc.paper.reproduce", "reproduce"),
+    for module, name in [("fivdisc.engine.simulation", "simulate"),
+                         ("fivdisc.paper.reproduce", "reproduce"),
                          ("fivdisc.analysis.stability", "stability_map"),
                          ("fivdisc.sweep.run", "run_sweep"), ("fivdisc.sweep.spec", "load_sweep")]:
         monkeypatch.setattr(importlib.import_module(module), name, never)

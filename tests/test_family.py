@@ -11,13 +11,13 @@ import pytest
 from scipy.interpolate import PchipInterpolator
 
 import fivdisc
-from fivdisc._kernels import dynamics as dyn
-from fivdisc._kernels import layout as lay
-from fivdisc._kernels.impact import solve_lcp
 from fivdisc.case import Case, load_case
+from fivdisc.core import dynamics as dyn
+from fivdisc.core.impact import solve_lcp
+from fivdisc.engine.simulation import simulate
 from fivdisc.examples import DIRECTORY as EXAMPLES
-from fivdisc.model import build_model
-from fivdisc.simulate import simulate
+from fivdisc.model import layout as lay
+from fivdisc.model.build import build_model
 
 TIGHT = {"rtol": 1e-10, "atol": 1e-13}
 

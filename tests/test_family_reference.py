@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 
 from fivdisc.case import Case
-from fivdisc.model import build_model
-from fivdisc.simulate import simulate
+from fivdisc.engine.simulation import simulate
+from fivdisc.model.build import build_model
 from reference_model import reference_simulate
 
 SPAN = 0.1

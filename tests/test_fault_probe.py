@@ -25,7 +25,7 @@ from fivdisc import Case, lyapunov, simulate
 from fivdisc.analysis.checks import check_orbit_request
 from fivdisc.cli import cli
 from fivdisc.errors import FivdiscError
-from fivdisc.speed import SpeedProfile
+from fivdisc.model.speed import SpeedProfile
 
 BIG_INT = 9223372036854775807  # 2**63 - 1, what a TOML integer can hold
 
@@ -123,8 +123,8 @@ def test_the_estimate_is_below_the_steps_taken_but_not_far(tables) -> None:
     so that refusing beyond the budget refuses only what is too long. (Above: a slider's
     damper acts on the slider's mass alone only while it flies; in contact the disc's
     modal mass moves with it and slows the decay.)"""
-    from fivdisc.integration import estimate_steps
-    from fivdisc.model import build_model
+    from fivdisc.engine.integration import estimate_steps
+    from fivdisc.model.build import build_model
 
     case = Case(**tables).replace({"simulation.duration": 2e-2})
     steps, _, _ = estimate_steps(build_model(case), 2e-2)
@@ -152,9 +152,9 @@ def test_splitting_a_run_into_calls_changes_no_step() -> None:
     """The per-call step budget pauses the kernel with its step-size controller's state
     saved: a run cut into calls of 7 steps is bit for bit the run of one call per
     chunk."""
-    from fivdisc.integration import Integration
-    from fivdisc.model import build_model
-    from fivdisc.simulate import initial_state
+    from fivdisc.engine.integration import Integration
+    from fivdisc.engine.simulation import initial_state
+    from fivdisc.model.build import build_model
 
     case = Case(simulation={"duration": 0.05, "output_rate": 2000.0})
     model = build_model(case)
@@ -201,10 +201,10 @@ def test_sigint_stops_a_run_within_a_second_and_keeps_it() -> None:
 def test_accumulating_switches_end_as_zeno_naming_the_sliders() -> None:
     """Switches whose spacings interleave tiny and longer ones escape the test of 1000 in
     a row under 1e-10 s; the rate test (10,000 within 1e-5 s) takes them."""
-    from fivdisc._kernels import slots
-    from fivdisc.integration import ZENO_RATE_COUNT, ZENO_RATE_SPAN, Integration
-    from fivdisc.model import build_model
-    from fivdisc.simulate import initial_state
+    from fivdisc.core import slots
+    from fivdisc.engine.integration import ZENO_RATE_COUNT, ZENO_RATE_SPAN, Integration
+    from fivdisc.engine.simulation import initial_state
+    from fivdisc.model.build import build_model
 
     model = build_model(Case(sliders=[{"angle": 0.0}, {"angle": 1.0}, {"angle": 2.0}]))
     run = Integration(model, initial_state(model), duration=1.0)
@@ -293,7 +293,7 @@ def test_lyapunov_of_a_diverging_run_is_refused(tables, word, tmp_path: Path) ->
     carried from the start (they align over the transient), so a fresh installation
     compiles the kernel with tangents first: loaded here, so that the bound is on the
     refusal (`benchmarks/bench_first_use.py` times the compilation)."""
-    from fivdisc.analysis.lyapunov import warm_tangent_kernel
+    from fivdisc.analysis.exponents import warm_tangent_kernel
 
     case = Case(**tables)
     assert simulate(case).status == "diverged"
@@ -378,7 +378,7 @@ def test_an_inconclusive_exponent_is_marked_and_fails_the_command() -> None:
 
 
 def test_conclusive_follows_the_uncertainty() -> None:
-    from fivdisc.analysis.lyapunov import LyapunovSpectrum
+    from fivdisc.analysis.exponents import LyapunovSpectrum
 
     spectrum = LyapunovSpectrum(np.array([5.0, 1.0, 2.0, -np.inf]),
                                 np.array([1.0, 3.0, np.nan, np.nan]), np.zeros(1),

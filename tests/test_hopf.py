@@ -14,10 +14,10 @@ from fivdisc import Case
 from fivdisc.analysis.eigenbranches import eigen_branches, follow, mode_couplings
 from fivdisc.analysis.hopf import hopf_points
 from fivdisc.analysis.stability import linear_stability
+from fivdisc.engine.integration import Integration
 from fivdisc.errors import CaseError
 from fivdisc.examples import path
-from fivdisc.integration import Integration
-from fivdisc.model import build_model
+from fivdisc.model.build import build_model
 from reference_model import sliding_equilibrium as reference_equilibrium
 
 # The rigid-disc limit: no disc modes, so N = N0 and the slider is the oscillator
@@ -244,9 +244,9 @@ def test_hopf_eigenvector_in_the_full_layout_on_a_flexible_disc():
     the eigenvector solves J v = lambda v on every free row of the full Jacobian, and its
     z rows are the change of the disc's w under the slider (from the plate's mode shapes,
     independent of the kernel)."""
-    from fivdisc._kernels import dynamics as dyn
-    from fivdisc.analysis.equilibrium import slip_phases
     from fivdisc.case import load_case
+    from fivdisc.core import dynamics as dyn
+    from fivdisc.engine.equilibrium import slip_phases
 
     case = load_case(path("fig03a"))
     hp = hopf_points(case, "slider.rotational_damping", np.linspace(0.0, 3.0, 16))[0]

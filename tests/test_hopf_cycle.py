@@ -9,10 +9,10 @@ import pytest
 
 from fivdisc import Case
 from fivdisc.analysis.hopf import hopf_points
-from fivdisc.analysis.hopf_cycle import hopf_cycles
+from fivdisc.continuation.from_hopf import hopf_cycles
+from fivdisc.engine.integration import Integration
 from fivdisc.errors import FivdiscError
-from fivdisc.integration import Integration
-from fivdisc.model import build_model
+from fivdisc.model.build import build_model
 
 # The rigid-disc oscillator of test_hopf: I u'' + C u' + K u = r N0 mu(r (Omega - u')) with
 # mu = mu_k + dmu exp(-alpha v). Expanded about steady sliding in the slip-speed change
@@ -142,7 +142,7 @@ def test_branch_grazes_and_gives_the_bistable_range(hopf, cycles):
 def _run(speed: float, rate: float, duration: float = 0.4) -> tuple[float, int]:
     """From the sliding equilibrium at ``speed`` with phi_dot kicked by ``rate``: the
     last 0.05 s's largest |phi_dot - phi_dot_eq| and the number of stick events."""
-    from fivdisc.analysis.equilibrium import sliding_equilibrium
+    from fivdisc.engine.equilibrium import sliding_equilibrium
 
     model = build_model(CASE.replace({"speed.value": speed}))
     start = sliding_equilibrium(model).state.copy()
@@ -185,8 +185,8 @@ def test_continue_from_hopf_on_the_command_line(tmp_path):
     keeps them; a bad range is refused in one line (exit status 2)."""
     from click.testing import CliRunner
 
-    from fivdisc.analysis.branch import open_branch
     from fivdisc.cli import cli
+    from fivdisc.continuation.branch import open_branch
 
     case = tmp_path / "rigid.toml"
     case.write_text(CASE.to_toml())
@@ -213,8 +213,8 @@ def test_continue_announces_the_tangent_kernel_compiling(tmp_path, monkeypatch, 
     so. Both starts now say it once, as `fivdisc orbit` does."""
     from click.testing import CliRunner
 
-    from fivdisc import compilation
     from fivdisc.cli import cli
+    from fivdisc.engine import compilation
 
     case = tmp_path / "rigid.toml"
     case.write_text(CASE.to_toml())
@@ -228,7 +228,7 @@ def test_continue_announces_the_tangent_kernel_compiling(tmp_path, monkeypatch, 
         args = [str(case), *args, "--from-hopf", "0.5:30:25"]
     monkeypatch.setattr(compilation, "_announced", set())
     monkeypatch.setattr(compilation, "needs_compiling", lambda dispatcher: True)
-    monkeypatch.setattr("fivdisc.split_compile._cores", lambda: 1)
+    monkeypatch.setattr("fivdisc.engine.split_compile._cores", lambda: 1)
     run = CliRunner().invoke(cli, ["continue", *args])
     assert run.exit_code == 0, run.output
     assert run.stderr.count("compiling the kernel with tangent vectors, once") == 1
@@ -245,7 +245,7 @@ def test_the_bistable_range_ends_at_the_located_fold():
 
     import xarray as xr
 
-    from fivdisc.analysis.hopf_cycle import _judge
+    from fivdisc.continuation.from_hopf import _judge
 
     p = np.array([0.0414, 0.1, 0.2, 0.25999891, 0.25999818, 0.2599933])
     stable = np.array([False, False, False, False, True, True])

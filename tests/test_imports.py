@@ -21,33 +21,28 @@ import fivdisc
 
 SOURCE = Path(fivdisc.__file__).parent
 
-# Layers from the bottom; a module may import from its own layer and those below.
-# ``_kernels.layout`` (the arrays the model builds and the kernels read) and the kernels'
-# package with its cache set-up belong to the model layer: the model fills that layout.
+# Layers from the bottom, each a folder (the foundation: a few modules every layer uses);
+# a module may import from its own layer and those below.
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("foundation", ("fivdisc.errors", "fivdisc.files", "fivdisc.extras", "fivdisc.warmup",
-                    "fivdisc.record",
-                    "fivdisc._lazy", "fivdisc._plot_kinds", "fivdisc.selection",
-                    "fivdisc.examples")),
+    ("foundation", ("fivdisc.errors", "fivdisc.files", "fivdisc.extras", "fivdisc.limits",
+                    "fivdisc._lazy", "fivdisc.examples")),
     # A case's keys and error messages, which its tables use: they import no table.
     ("case messages", ("fivdisc.case.tree", "fivdisc.case.messages")),
-    ("case", ("fivdisc.case", "fivdisc.plate", "fivdisc.plate_cache", "fivdisc.speed",
-              "fivdisc.limits", "fivdisc.conventions")),
-    ("model", ("fivdisc.model", "fivdisc._kernels", "fivdisc._kernels.cache",
-               "fivdisc._kernels.layout")),
-    ("kernels", ("fivdisc._kernels.",)),
-    ("engine", ("fivdisc.integration", "fivdisc.result", "fivdisc.compilation",
-                "fivdisc.split_compile", "fivdisc.start", "fivdisc.simulate",
-                "fivdisc.progress")),
+    ("case", ("fivdisc.case",)),
+    ("model", ("fivdisc.model",)),
+    ("core", ("fivdisc.core",)),
+    ("engine", ("fivdisc.engine",)),
     ("analysis", ("fivdisc.analysis",)),
-    ("top", ("fivdisc.plots", "fivdisc.branch_plots", "fivdisc.sweep", "fivdisc.paper",
-             "fivdisc.cli", "fivdisc.__main__", "fivdisc")),
+    ("continuation", ("fivdisc.continuation",)),
+    ("top", ("fivdisc.plots", "fivdisc.sweep", "fivdisc.paper", "fivdisc.cli",
+             "fivdisc.__main__", "fivdisc")),
 )
 
 # Imports that go up a layer on purpose: a method that hands its object to the layer
 # above, imported when called. The circle test still counts them, so the layer above
 # cannot import back.
-ACCESSORS = {("fivdisc.result", "fivdisc.plots")}  # Result.plot
+ACCESSORS = {("fivdisc.engine.result", "fivdisc.plots"),  # Result.plot
+             ("fivdisc.engine.result", "fivdisc.plots.result")}
 
 
 def _modules() -> dict[str, tuple[Path, bool]]:
@@ -148,7 +143,7 @@ def _circle(graph: dict[str, set[str]]) -> list[str] | None:
 
 def test_the_graph_sees_function_level_and_type_only_imports():
     # Both kinds exist in the sources; a graph without them would miss circles.
-    assert "fivdisc.plots" in GRAPH["fivdisc.result"]  # inside Result.plot
+    assert "fivdisc.plots.result" in GRAPH["fivdisc.engine.result"]  # inside Result.plot
     assert "fivdisc.sweep.sections" in GRAPH["fivdisc.sweep.reductions"]  # TYPE_CHECKING
     assert "fivdisc.analysis.stability" in GRAPH["fivdisc.paper.fig_stability"]  # a lazy name
 
@@ -172,7 +167,20 @@ def test_imports_go_down_the_layers():
     assert not upward, "\n".join(upward)
 
 
-@pytest.mark.parametrize("module", ["fivdisc.simulate", "fivdisc.conventions"])
+@pytest.mark.parametrize("module", ["fivdisc.engine.simulation", "fivdisc.engine.conventions"])
 def test_the_engine_does_not_import_the_package_root(module):
     # The root's names import the analyses; the engine below them must not use it.
     assert "fivdisc" not in GRAPH[module]
+
+
+def test_no_module_is_named_like_a_public_name_of_its_package():
+    # Importing fivdisc.analysis.exponents binds the module to fivdisc.analysis.exponents;
+    # were it named lyapunov, it would hide the function fivdisc.analysis.lyapunov.
+    clashes = []
+    for package, (_, is_package) in MODULES.items():
+        if not is_package:
+            continue
+        for name, home in _lazy_homes(package).items():
+            if f"{package}.{name}" in MODULES:
+                clashes.append(f"{package}.{name} is a module and a name from {home}")
+    assert not clashes, "\n".join(clashes)

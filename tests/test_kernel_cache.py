@@ -1,5 +1,5 @@
 """numba's cache never serves a stale kernel (issue 11, item 4): the cache entry of every
-kernel is keyed to all the sources of ``fivdisc._kernels``, so editing one file
+kernel is keyed to all the sources of ``fivdisc.core``, so editing one file
 recompiles the kernels of the others that call into it."""
 
 from __future__ import annotations
@@ -19,9 +19,9 @@ import fivdisc
 _PROBE = """
 import json
 import numpy as np
-from fivdisc._kernels.cache import sources_hash
-from fivdisc._kernels.switch import _aux
-from fivdisc._kernels.layout import KernelModel
+from fivdisc.core.cache import sources_hash
+from fivdisc.core.switch import _aux
+from fivdisc.model.layout import KernelModel
 mdl = KernelModel(*(np.zeros((1, 1)) for _ in range(5)), np.zeros(1))
 rows = _aux(mdl, np.zeros((40, 1))).shape[0]
 stats = _aux.stats
@@ -67,7 +67,7 @@ def test_an_edited_kernel_is_recompiled(tmp_path):
 def test_other_numba_code_keeps_numba_s_own_locators():
     from numba.core import caching
 
-    from fivdisc._kernels import cache
+    from fivdisc.core import cache
 
     classes = cache._impl()._locator_classes
     assert classes[: len(cache.LOCATORS)] == list(cache.LOCATORS)

@@ -18,7 +18,7 @@ import ast
 import importlib
 from pathlib import Path
 
-import fivdisc._kernels as kernels
+import fivdisc.core as kernels
 
 SOURCES = sorted(Path(kernels.__file__).parent.glob("*.py"))
 
@@ -103,7 +103,7 @@ def test_no_compiled_kernel_receives_a_python_literal():
     assert 5 in passed["jvp"]
     found = []
     for path in SOURCES:
-        module = importlib.import_module(f"fivdisc._kernels.{path.stem}")
+        module = importlib.import_module(f"fivdisc.core.{path.stem}")
         for node in ast.walk(ast.parse(path.read_text())):
             if not isinstance(node, ast.Call):
                 continue

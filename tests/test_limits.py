@@ -20,7 +20,7 @@ from fivdisc.limits import (
     check_memory,
     simulation_bytes,
 )
-from fivdisc.plate import clear_cache
+from fivdisc.model.plate import clear_cache
 from fivdisc.sweep import Sweep
 
 

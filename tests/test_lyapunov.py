@@ -11,14 +11,14 @@ from click.testing import CliRunner
 from scipy.integrate import simpson
 
 import fivdisc
-from fivdisc._kernels import dynamics as dyn
-from fivdisc.analysis.lyapunov import lyapunov
+from fivdisc.analysis.exponents import lyapunov
 from fivdisc.analysis.orbits import periodic_orbit
 from fivdisc.analysis.stability import linear_stability
 from fivdisc.case import Case
 from fivdisc.cli import cli
+from fivdisc.core import dynamics as dyn
 from fivdisc.errors import FivdiscError
-from fivdisc.model import build_model
+from fivdisc.model.build import build_model
 
 LIGHT = Case(disc={"density": 720.0, "modes": [[0, 0]]},
              slider={"mass": 1.0, "normal_damping": 20.0}, speed={"value": 1.0},

@@ -16,11 +16,11 @@ import math
 
 import numpy as np
 
-from fivdisc.analysis.lyapunov import lyapunov
+from fivdisc.analysis.exponents import lyapunov
 from fivdisc.analysis.orbits import periodic_orbit
 from fivdisc.case import Case
-from fivdisc.integration import fastest_time_scale
-from fivdisc.model import build_model
+from fivdisc.engine.integration import fastest_time_scale
+from fivdisc.model.build import build_model
 
 DISC = {"inner_radius": 0.05, "outer_radius": 0.14, "thickness": 0.004,
         "modes": [[0, 0], [0, 1], [0, 2]], "damping_ratio": 0.001, "damping_frame": "space"}

@@ -28,8 +28,12 @@ from hypothesis import HealthCheck, event, given, settings
 from fivdisc import Case, simulate
 from fivdisc.cli import cli
 from fivdisc.cli.plot import KINDS
-from fivdisc.sweep import SweepStore, load_sweep, store_lock
-from fivdisc.sweep.store import PointOutcome
+from fivdisc.sweep import (
+    SweepStore,
+    load_sweep,
+)
+from fivdisc.sweep.store.lock import store_lock
+from fivdisc.sweep.store.sweep_store import PointOutcome
 from test_fault_probe import messages
 
 # --- the property ----------------------------------------------------------------------------

@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from fivdisc._kernels import layout as lay
 from fivdisc.analysis.orbits import periodic_orbit
 from fivdisc.case import Case
 from fivdisc.cli import cli
+from fivdisc.engine.integration import Integration
 from fivdisc.errors import FivdiscError
-from fivdisc.integration import Integration
-from fivdisc.model import build_model
+from fivdisc.model import layout as lay
+from fivdisc.model.build import build_model
 
 MU_S, MU_K, OMEGA = 0.8, 0.5, 1.0
 # One axisymmetric disc mode (l = 0): its slope under the slider is zero, so the slider's

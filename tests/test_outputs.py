@@ -157,7 +157,7 @@ def test_simulate_into_a_missing_directory_fails_before_running(case_file: Path,
         raise AssertionError("simulated before checking the output")
 
     # the module, not the function fivdisc.simulate that shadows it on the package
-    monkeypatch.setattr(importlib.import_module("fivdisc.simulate"), "simulate", never)
+    monkeypatch.setattr(importlib.import_module("fivdisc.engine.simulation"), "simulate", never)
     _refused(["simulate", str(case_file), "-o", str(case_file.parent / "no" / "x.nc")],
              "does not exist")
 

@@ -19,7 +19,7 @@ from fivdisc import examples, linear_stability, load_case, open_result, simulate
 from fivdisc.cli import cli
 from fivdisc.cli.reproduce import reproduce as reproduce_command
 from fivdisc.errors import FivdiscError
-from fivdisc.model import build_model
+from fivdisc.model.build import build_model
 from fivdisc.paper import (
     FIG3,
     FIG4,

@@ -1,4 +1,4 @@
-"""Tests of :mod:`fivdisc.plate` against results that do not come from its own code.
+"""Tests of :mod:`fivdisc.model.plate` against results that do not come from its own code.
 
 References used: the numbers printed in the paper (Table 1 and the text after it), Leissa's
 handbook table, the boundary conditions and orthogonality relations themselves, an
@@ -21,7 +21,7 @@ from numpy.polynomial import legendre
 from scipy import integrate, linalg, optimize
 
 from fivdisc.errors import ModeError
-from fivdisc.plate import AnnularPlate
+from fivdisc.model.plate import AnnularPlate
 
 TABLE1 = {
     "inner_radius": 0.044,
@@ -493,11 +493,11 @@ def test_other_geometries_match_ritz(a: float, b: float, nu: float, l: int) -> N
 
 
 def test_stored_modes_are_the_solved_ones_to_the_last_bit(monkeypatch, tmp_path) -> None:
-    """The modes a later process reads from fivdisc.plate_cache (so that it imports no root
+    """The modes a later process reads from fivdisc.model.mode_cache (so that it imports no root
     finder) are exactly those solved: a model is bit for bit the same either way. A
     damaged file, or one stamped by other sources, is ignored."""
-    from fivdisc import plate as plate_module
-    from fivdisc import plate_cache
+    from fivdisc.model import mode_cache as plate_cache
+    from fivdisc.model import plate as plate_module
 
     monkeypatch.setenv("FIVDISC_CACHE_DIR", str(tmp_path))
 

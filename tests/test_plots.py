@@ -13,9 +13,10 @@ import xarray as xr
 from click.testing import CliRunner
 
 from fivdisc import plots
-from fivdisc.analysis.spectra import dominant_frequency
+from fivdisc.analysis.spectra import dominant_frequency, find_peaks, spectrum
 from fivdisc.cli.plot import plot as plot_command
 from fivdisc.errors import FivdiscError
+from fivdisc.plots import result as result_plots
 
 FS = 10_000.0  # [Hz]
 F0 = 206.0  # fundamental of the synthetic slider motion [Hz] (paper Fig. 13)
@@ -203,7 +204,7 @@ def test_cli_bad_input_names_the_option(result_file, tmp_path, monkeypatch, args
 
 def test_simulated_result_end_to_end(tmp_path):
     from fivdisc.case import Case
-    from fivdisc.simulate import simulate
+    from fivdisc.engine.simulation import simulate
 
     # The paper's first example (Figs. 8-9) for 0.2 s: stick-slip from rest.
     result = simulate(Case(simulation={"duration": 0.2}))
@@ -303,22 +304,22 @@ def test_zero_hz_is_never_a_peak():
     drifting = 5.0 + 20.0 * t**2 + 1e-2 * np.sin(2 * np.pi * F0 * t)
     ds = xr.Dataset({"x": ("time", drifting, {"units": "m", "long_name": "x"})},
                     coords={"time": ("time", t, {"units": "s"})})
-    spec = plots.spectrum(ds, "x")
+    spec = spectrum(ds, "x")
     assert spec.frequencies[np.argmax(spec.amplitude)] < 1.0  # the lobe dominates
-    peaks = plots.find_peaks(spec, n=3, min_rel_height=0.5)
+    peaks = find_peaks(spec, n=3, min_rel_height=0.5)
     np.testing.assert_allclose(peaks.frequencies, [F0], atol=0.01)
     # A slow line of its own, above the lobe, is still found.
     slow = ds.assign(x=("time", np.sin(2 * np.pi * 3.0 * t), {"units": "m"}))
-    assert plots.find_peaks(plots.spectrum(slow, "x"), n=1).frequencies[0] == pytest.approx(
+    assert find_peaks(spectrum(slow, "x"), n=1).frequencies[0] == pytest.approx(
         3.0, abs=0.05)
 
 
 def test_spectrogram_segment_follows_the_record_and_the_band():
     # 100 segments per record, or bins of 1/50 of the band shown, whichever is longer
-    assert plots.default_segment(35.0, 1000.0) == 0.35
-    assert plots.default_segment(1.0, 1000.0) == 0.05
-    assert plots.default_segment(1.0, 5000.0) == 0.01
-    assert plots.default_segment(0.1, 100.0) == 0.025  # at most a quarter of the record
+    assert result_plots.default_segment(35.0, 1000.0) == 0.35
+    assert result_plots.default_segment(1.0, 1000.0) == 0.05
+    assert result_plots.default_segment(1.0, 5000.0) == 0.01
+    assert result_plots.default_segment(0.1, 100.0) == 0.025  # at most a quarter of the record
     fig = plots.plot_spectrogram(_result(), "phi", fmax=1000.0)
     assert "0.05 s segments (20 Hz bins)" in fig.axes[0].get_title()
 
@@ -410,7 +411,7 @@ def test_the_spectrogram_band_covers_the_content():
     ax = plots.plot_spectrogram(_result(), "phi").axes[0]
     top = ax.get_ylim()[1]
     assert 412.0 < top <= 1100.0
-    assert plots.content_band(_result()["phi"], 5000.0) in (500.0, 1000.0)
+    assert result_plots.content_band(_result()["phi"], 5000.0) in (500.0, 1000.0)
     assert "0-" in ax.get_title() and " Hz," in ax.get_title()
 
 
@@ -445,7 +446,7 @@ def test_labels_of_close_bifurcations_do_not_overlap():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from fivdisc.branch_plots import draw_branch
+    from fivdisc.plots.branch import draw_branch
 
     p = np.linspace(5.5, 9.0, 50)
     period = 5.9e-3 - 1.4e-4 * (p - 5.5)
@@ -497,7 +498,7 @@ def test_an_unstable_stretch_too_short_to_show_dashed_is_marked_and_named():
     matplotlib.use("Agg")
     from matplotlib import rcParams
 
-    from fivdisc.branch_plots import NARROW, narrow_unstable, plot_branch
+    from fivdisc.plots.branch import NARROW, narrow_unstable, plot_branch
 
     narrow = _s_branch(5.79904, 5.75712)
     assert narrow_unstable(narrow) == [(5.79904, 5.75712)]

@@ -8,7 +8,7 @@ import sys
 import pytest
 
 from fivdisc import Case, simulate
-from fivdisc.progress import progress_bar
+from fivdisc.engine.progress import progress_bar
 
 
 class _Terminal(io.StringIO):

@@ -1,4 +1,4 @@
-"""A run's record (fivdisc.record) writes the netCDF file xarray writes for its dataset.
+"""A run's record (fivdisc.engine.record) writes the netCDF file xarray writes for its dataset.
 
 ``fivdisc simulate`` writes its result without importing xarray (issue 29, item 2): the
 file must be the one ``xarray.Dataset.to_netcdf`` writes with its default encoding, so
@@ -18,9 +18,9 @@ import numpy as np
 import pytest
 
 from fivdisc import Case, open_result, simulate
+from fivdisc.engine.record import Record
+from fivdisc.engine.result import Result
 from fivdisc.files import netcdf_checksum
-from fivdisc.record import Record
-from fivdisc.result import Result
 
 CASES = {
     # The default case: events, one slider, two probes.

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import fivdisc
-from fivdisc.analysis.lyapunov import lyapunov
+from fivdisc.analysis.exponents import lyapunov
 from fivdisc.analysis.orbits import periodic_orbit
 from fivdisc.analysis.regimes import cross_check
 from fivdisc.analysis.spectra import classify, find_peaks, spectrum

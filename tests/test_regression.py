@@ -30,7 +30,7 @@ import pytest
 import xarray as xr
 
 from fivdisc.case import Case
-from fivdisc.simulate import simulate
+from fivdisc.engine.simulation import simulate
 
 FILES = sorted((Path(__file__).parent / "data").glob("regression_*.nc"))
 PER_SLIDER = ("phi", "phi_dot", "normal_force", "friction_force", "phase", "z", "z_dot", "gap")

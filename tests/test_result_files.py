@@ -212,7 +212,7 @@ def test_a_full_disk_keeps_the_run_in_the_temporary_directory(tmp_path: Path, mo
     import errno
     import tempfile
 
-    from fivdisc.record import Record
+    from fivdisc.engine.record import Record
 
     full, spare = tmp_path / "full", tmp_path / "spare"
     full.mkdir()

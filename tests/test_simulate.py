@@ -5,16 +5,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fivdisc._kernels import dynamics as dyn
-from fivdisc._kernels import layout as lay
-from fivdisc._kernels.impact import single_impact
-from fivdisc.analysis.equilibrium import sliding_equilibrium
 from fivdisc.case import Case
+from fivdisc.core import dynamics as dyn
+from fivdisc.core.impact import single_impact
+from fivdisc.core.sizes import work_rows
+from fivdisc.engine.equilibrium import sliding_equilibrium
+from fivdisc.engine.result import select_slider
+from fivdisc.engine.simulation import simulate
 from fivdisc.errors import SimulationError
-from fivdisc.model import build_model
-from fivdisc.result import select_slider
-from fivdisc.simulate import simulate
-from fivdisc.speed import SpeedProfile
+from fivdisc.model import layout as lay
+from fivdisc.model.build import build_model
+from fivdisc.model.speed import SpeedProfile
 from reference_model import jacobi_integral, mode_data_from_case
 
 
@@ -107,7 +108,7 @@ def test_impact_map_equal_velocities_and_energy_loss():
         # Half the trials with the slider moving with the disc (v = 0).
         y[2 * n + 2] = omega if trial % 2 else rng.uniform(0, 2 * omega)
         work = dyn.new_work(mdl, y)
-        aux = lay.work_rows(1)[3]
+        aux = work_rows(1)[3]
         dyn.evaluate(0.0, y, flying, sign, True, mdl, work, dy)
         y[n + 1] = work[aux + lay.A_WC, 0]
         # Slider approaching the disc surface.
@@ -234,14 +235,14 @@ def test_bad_initial_state_is_rejected():
 
 
 def test_the_kernel_lets_other_threads_run():
-    """The integration kernel releases the GIL, so that the imports of fivdisc.warmup
+    """The integration kernel releases the GIL, so that the imports of fivdisc.engine.preload
     overlap it: a thread waking every millisecond keeps waking during one long kernel
     call. Holding the GIL, the call would let it wake at most once."""
     import threading
     import time
 
-    from fivdisc.integration import Integration
-    from fivdisc.simulate import initial_state
+    from fivdisc.engine.integration import Integration
+    from fivdisc.engine.simulation import initial_state
 
     model = build_model(Case())
     run = Integration(model, initial_state(model), duration=20.0)

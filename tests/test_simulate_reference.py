@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from fivdisc.case import Case
-from fivdisc.result import select_slider
-from fivdisc.simulate import simulate
+from fivdisc.engine.result import select_slider
+from fivdisc.engine.simulation import simulate
 from reference_model import reference_simulate
 
 SPAN = 0.1

@@ -15,8 +15,8 @@ from fivdisc.analysis.spectra import (
     spectrum,
     stft,
 )
+from fivdisc.engine.result import Result
 from fivdisc.errors import FivdiscError
-from fivdisc.result import Result
 
 FS = 10_000.0  # the simulator's default output rate [Hz]
 

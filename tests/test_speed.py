@@ -12,7 +12,7 @@ import pytest
 
 from fivdisc import Case, simulate
 from fivdisc.errors import CaseError
-from fivdisc.speed import SpeedProfile
+from fivdisc.model.speed import SpeedProfile
 
 TWO_PI = 2.0 * math.pi
 

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 
 from fivdisc import Case, simulate, split_compile
-from fivdisc.integration import Integration
-from fivdisc.model import build_model
-from fivdisc.simulate import initial_state
+from fivdisc.engine.integration import Integration
+from fivdisc.engine.simulation import initial_state
+from fivdisc.model.build import build_model
 
 _CASE = {"simulation": {"duration": 0.01}}
 
@@ -61,7 +61,7 @@ def test_no_split_when_cached_or_on_one_core(monkeypatch):
     assert not split_compile.compile_split(run)
     assert not split_compile.compile_split_tangents()
 
-    monkeypatch.setattr("fivdisc.compilation.needs_compiling", lambda dispatcher: True)
+    monkeypatch.setattr("fivdisc.engine.compilation.needs_compiling", lambda dispatcher: True)
     monkeypatch.setattr(split_compile, "_cores", lambda: 1)
     assert not split_compile.compile_split(run)
     assert not split_compile.compile_split_tangents()
@@ -87,8 +87,8 @@ def test_each_function_of_a_share_is_typed_with_all_its_arguments():
 
 _COLD_TANGENTS = """
 import json
-from fivdisc import split_compile
-from fivdisc.analysis.lyapunov import lyapunov
+from fivdisc.engine import split_compile
+from fivdisc.analysis.exponents import lyapunov
 from fivdisc.case import Case
 spectrum = lyapunov(Case(**json.loads({case!r})), transient=0.0, duration=0.01,
                     interval=0.005, seed=1)
@@ -104,7 +104,7 @@ def test_a_cold_compile_with_tangents_loads_the_helpers_parts_from_the_cache(tmp
     """lyapunov from an empty cache: the plain kernel, then the one with tangents, each
     shared with a helper whose part this process only loads; the exponents are this
     process's own (a few minutes: two whole compilations)."""
-    from fivdisc.analysis.lyapunov import lyapunov
+    from fivdisc.analysis.exponents import lyapunov
 
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
     out = subprocess.run(
@@ -127,7 +127,7 @@ def test_a_cold_compile_with_tangents_loads_the_helpers_parts_from_the_cache(tmp
 
 _COLD_RHS = """
 import json
-from fivdisc import split_compile
+from fivdisc.engine import split_compile
 from fivdisc.analysis.stability import linear_stability
 from fivdisc.case import Case
 result = linear_stability(Case())
@@ -160,7 +160,7 @@ def test_a_cold_stability_loads_the_helper_s_jacobian_from_the_cache(tmp_path):
 
 
 def test_a_failing_helper_costs_time_only(monkeypatch):
-    monkeypatch.setattr("fivdisc.compilation.needs_compiling", lambda dispatcher: True)
+    monkeypatch.setattr("fivdisc.engine.compilation.needs_compiling", lambda dispatcher: True)
     monkeypatch.setattr(split_compile, "_cores", lambda: 2)
     # The helper's interpreter exits at once with an error.
     monkeypatch.setattr(sys, "executable", "/bin/false")

@@ -73,25 +73,15 @@ def test_an_unknown_name_is_an_attribute_error():
     assert not hasattr(fivdisc, "__wrapped__")
 
 
-def test_simulate_stays_the_function_when_its_module_is_imported_first():
-    """The import system binds the module fivdisc.simulate to the package's attribute of
-    that name when something imports the module before fivdisc.simulate is looked up."""
-    code = ("import sys, fivdisc, fivdisc.simulate\n"
-            "from fivdisc import simulate\n"
-            "assert fivdisc.simulate is simulate is sys.modules['fivdisc.simulate'].simulate\n")
-    out = _run(code)
-    assert out.returncode == 0, out.stderr
-
-
 def test_the_simulator_leaves_the_netcdf_library_to_the_warm_up():
     """Importing the simulator imports no netCDF library: ``fivdisc simulate`` imports it in
-    a thread while its kernel integrates (fivdisc.warmup), and the waiter it gets returns
+    a thread while its kernel integrates (fivdisc.engine.preload), and the waiter it gets returns
     only once it is imported."""
     code = (
         "import sys\n"
-        "import fivdisc.simulate\n"
+        "import fivdisc.engine.simulation\n"
         "print(sorted(m for m in ('xarray', 'netCDF4') if m in sys.modules))\n"
-        "from fivdisc.warmup import warm_up\n"
+        "from fivdisc.engine.preload import warm_up\n"
         "wait = warm_up('netcdf')\n"
         "wait()\n"
         "print(sorted(m for m in ('xarray', 'netCDF4') if m in sys.modules))\n"
@@ -102,7 +92,7 @@ def test_the_simulator_leaves_the_netcdf_library_to_the_warm_up():
 
 
 def test_simulate_writes_its_file_without_xarray(tmp_path):
-    """``fivdisc simulate`` writes its netCDF file from the run's record (fivdisc.record):
+    """``fivdisc simulate`` writes its netCDF file from the run's record (fivdisc.engine.record):
     xarray, with pandas and the array libraries it probes for, was over a second of
     processor time of a short run's process (issue 29, item 2)."""
     case = tmp_path / "short.toml"
@@ -119,15 +109,15 @@ def test_simulate_writes_its_file_without_xarray(tmp_path):
 def test_the_simulators_model_imports_no_root_finder(tmp_path, monkeypatch):
     """Building a model (the disc's modes: Bessel roots and the peaks of their shapes)
     imports no scipy.optimize, a third of a second of every short run, once an earlier
-    process stored the geometry's modes (fivdisc.plate_cache; tests/test_plate.py checks
+    process stored the geometry's modes (fivdisc.model.mode_cache; tests/test_plate.py checks
     they are the solved ones)."""
     monkeypatch.setenv("FIVDISC_CACHE_DIR", str(tmp_path))
     code = (
         "import sys\n"
         "from fivdisc import examples\n"
         "from fivdisc.case import load_case\n"
-        "from fivdisc.model import build_model\n"
-        "from fivdisc.start import initial_state\n"
+        "from fivdisc.model.build import build_model\n"
+        "from fivdisc.engine.equilibrium import initial_state\n"
         "model = build_model(load_case(examples.path('fig10')))\n"
         "initial_state(model)\n"
         "print(sorted(m for m in ('scipy.optimize', 'scipy.linalg', 'matplotlib', 'dask', "

@@ -32,10 +32,10 @@ from fivdisc.sweep import (
     load_sweep,
     open_sweep,
     run_sweep,
-    store_lock,
     verify_store,
 )
-from fivdisc.sweep.store import PointOutcome
+from fivdisc.sweep.store.lock import store_lock
+from fivdisc.sweep.store.sweep_store import PointOutcome
 
 DAMPING = [0.1, 0.2, 0.3]
 SPEED = [5.0, 6.0]
@@ -343,7 +343,8 @@ def _checksum_of(digest: str, index: int, row: list) -> int:
 
 def test_checksums_a_column_at_a_time_are_the_point_by_point_definition() -> None:
     # Stores written before the checksum was computed a column at a time verify unchanged.
-    from fivdisc.sweep.store import _STRING, _checksums
+    from fivdisc.sweep.store.checksum import checksums
+    from fivdisc.sweep.store.layout import STRING
 
     rng = np.random.default_rng(28)
     n = 40
@@ -351,7 +352,7 @@ def test_checksums_a_column_at_a_time_are_the_point_by_point_definition() -> Non
     floats[:2] = [-0.0, np.float64("-nan")]
     section = np.where(rng.random((n, 3)) < 0.3, np.nan, rng.normal(size=(n, 3)))
     columns = [rng.random(n) < 0.5, floats, section, rng.integers(0, 4, n).astype(np.int32),
-               np.array(["", "RuntimeError: boom é"] * (n // 2), dtype=_STRING)]
+               np.array(["", "RuntimeError: boom é"] * (n // 2), dtype=STRING)]
     indices = list(range(7, 7 + n))
     expected = [_checksum_of("d1g", i, [c[k] for c in columns]) for k, i in enumerate(indices)]
-    assert _checksums("d1g", indices, columns).tolist() == expected
+    assert checksums("d1g", indices, columns).tolist() == expected

@@ -20,20 +20,20 @@ from click.testing import CliRunner
 from fivdisc import examples
 from fivdisc.case import Case
 from fivdisc.cli.sweep import separation_map, sweep
+from fivdisc.engine.simulation import simulate
 from fivdisc.errors import CaseError, FivdiscError
-from fivdisc.simulate import simulate
 from fivdisc.sweep import (
     BUILTIN,
     Sweep,
     SweepError,
     load_sweep,
     open_sweep,
-    parse_range,
-    read_mask,
     run_sweep,
 )
 from fivdisc.sweep.reductions import evaluate, resolve, stop_events
 from fivdisc.sweep.run import run_point
+from fivdisc.sweep.spec import parse_range
+from fivdisc.sweep.store.health import read_mask
 
 # A user reduction, importable by the workers through PYTHONPATH / sys.path.
 HELPER = '''
@@ -622,7 +622,8 @@ def test_separation_map_options_are_checked(tmp_path) -> None:
 
 
 def test_accelerating_map_and_figure(tmp_path) -> None:
-    from fivdisc.sweep import plot_separation_map, separation_sweep
+    from fivdisc.plots import plot_separation_map
+    from fivdisc.sweep import separation_sweep
 
     spec = separation_sweep("accelerating", x=[15.0, 20.0], y=[0.5], duration=3.0)
     assert spec.cases[0].simulation.duration == 3.0

@@ -20,10 +20,10 @@ from fivdisc.sweep import (
     SweepError,
     load_sweep,
     open_sweep,
-    read_mask,
     run_sweep,
     verify_store,
 )
+from fivdisc.sweep.store.health import read_mask
 
 distributed = pytest.importorskip("distributed")
 

@@ -27,12 +27,12 @@ from fivdisc.sweep import (
     SweepError,
     SweepStore,
     open_sweep,
-    read_mask,
     run_sweep,
-    store_lock,
     verify_store,
 )
-from fivdisc.sweep.store import PointOutcome
+from fivdisc.sweep.store.health import read_mask
+from fivdisc.sweep.store.lock import store_lock
+from fivdisc.sweep.store.sweep_store import PointOutcome
 
 N = 6
 FAILED = 3  # the point whose run failed
@@ -85,9 +85,9 @@ BLOCK = 4  # points per chunk where a test sets it: chunks of points 0-3 and 4-5
 @pytest.fixture
 def blocks(monkeypatch, tmp_path: Path) -> Path:
     """A store of chunks of BLOCK points (every store of the test is laid out so)."""
-    from fivdisc.sweep import store
+    from fivdisc.sweep.store import layout
 
-    monkeypatch.setattr(store, "_BLOCK_POINTS", BLOCK)
+    monkeypatch.setattr(layout, "BLOCK_POINTS", BLOCK)
     return _store(tmp_path / "b.zarr")
 
 
@@ -236,9 +236,9 @@ def test_a_store_of_an_older_format_is_refused(store: Path) -> None:
 def test_a_store_of_one_point_per_chunk_is_read_and_verified_not_resumed(
         tmp_path: Path, monkeypatch) -> None:
     # Format 4, as earlier versions of fivdisc wrote it: one point per chunk.
-    from fivdisc.sweep import store as module
+    from fivdisc.sweep.store import layout as module
 
-    monkeypatch.setattr(module, "_BLOCK_POINTS", 1)
+    monkeypatch.setattr(module, "BLOCK_POINTS", 1)
     path = _store(tmp_path / "old.zarr")
     monkeypatch.undo()
     assert len(list((path / "max_normal_force" / "c").iterdir())) == N - 1  # FAILED's is NaN
@@ -290,7 +290,7 @@ def test_the_lock_holds_across_processes_and_ends_with_its_holder(tmp_path: Path
     path = _store(tmp_path / "s.zarr")
     holder = subprocess.Popen(
         [sys.executable, "-c",
-         "import sys, time\nfrom fivdisc.sweep.store import store_lock\n"
+         "import sys, time\nfrom fivdisc.sweep.store.sweep_store import store_lock\n"
          f"with store_lock({str(path)!r}):\n    print('held', flush=True)\n    time.sleep(60)"],
         stdout=subprocess.PIPE, text=True,
     )
@@ -380,9 +380,9 @@ def test_verify_of_something_else_is_one_line(tmp_path: Path) -> None:
     ((300, 300), [1000]), ((40,), [200_000]),
 ])
 def test_a_chunk_is_a_run_of_at_most_1024_consecutive_points(shape, max_points) -> None:
-    from fivdisc.sweep.store import _point_chunks
+    from fivdisc.sweep.store.layout import point_chunks
 
-    chunks = _point_chunks(shape, max_points)
+    chunks = point_chunks(shape, max_points)
     size = int(np.prod(chunks))
     # as many points as fit, under both bounds (a section's values: 8 bytes each)
     bound = min(1024, max(1, 2**20 // (8 * max([1, *max_points]))))

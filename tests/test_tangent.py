@@ -22,11 +22,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fivdisc._kernels import layout as lay
 from fivdisc.case import Case
-from fivdisc.integration import Integration
-from fivdisc.model import build_model
-from fivdisc.result import EVENT_KINDS
+from fivdisc.engine.integration import Integration
+from fivdisc.engine.result import EVENT_KINDS
+from fivdisc.model import layout as lay
+from fivdisc.model.build import build_model
 
 RTOL, ATOL = 1e-12, 1e-16
 BASE = {"disc": {"density": 720.0, "modes": [[0, 0], [0, 1]]}, "speed": {"value": 1.0}}
@@ -188,7 +188,7 @@ def test_tangent_linear_rhs_equals_the_complex_step(friction):
     right-hand side; the complex step of the right-hand side itself is its independent
     reference (both exact to rounding). Random states and directions, every phase and
     slip sign, a damped disc with doublets, the bottom face, a decelerating disc."""
-    from fivdisc._kernels import dynamics as dyn
+    from fivdisc.core import dynamics as dyn
 
     fr = {"law": "exponential"} | friction
     case = Case(disc={"modes": [[0, 0], [0, 2], [1, 1]], "damping_ratio": 0.01},

@@ -13,7 +13,7 @@ from fivdisc.analysis.trajectories import (
     separation_intervals,
     separation_stats,
 )
-from fivdisc.result import Result
+from fivdisc.engine.result import Result
 
 RATE = 1000.0  # samples per second of the synthetic record
 # Exact switch times, deliberately between samples; (start, end, peak gap [m]).

@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from fivdisc.case import Case, load_case
+from fivdisc.engine.simulation import simulate
 from fivdisc.examples import DIRECTORY as EXAMPLES
-from fivdisc.simulate import simulate
 
 HERE = Path(__file__).parent
 

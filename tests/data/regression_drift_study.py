@@ -22,7 +22,7 @@ import numpy as np
 import xarray as xr
 
 from fivdisc.case import Case
-from fivdisc.simulate import simulate
+from fivdisc.engine.simulation import simulate
 
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE.parent))

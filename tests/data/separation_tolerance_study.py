@@ -22,11 +22,11 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from fivdisc.model import build_model
+from fivdisc.engine.result import select_slider
+from fivdisc.engine.simulation import initial_state, simulate
+from fivdisc.model.build import build_model
 from fivdisc.paper import FIG7, FIG8, FIG10, FIG13, FIG15, FIG18, FIG19, FIG24, FIG28, FIGURES
 from fivdisc.paper import measure as ms
-from fivdisc.result import select_slider
-from fivdisc.simulate import initial_state, simulate
 
 RTOLS = (1e-5, 1e-6, 1e-7, 1e-8)  # the default is 1e-6 with atol = 1e-3 rtol
 # The cases of docs/deviations.md whose separation (fivdisc's skew gyroscopic terms) or
