@@ -4,9 +4,9 @@ A package lists its public API once, as a table of modules and the names each gi
 :func:`public` makes ``__all__``, ``__getattr__`` and ``__dir__`` from it. Such a package
 imports none of its modules itself: importing one of them (for example
 ``fivdisc.analysis.spectra``) then runs no other, the import graph stays one-way
-(``tests/test_imports.py``), and ``import fivdisc`` starts without scipy, xarray or
+(``tests/package/test_imports.py``), and ``import fivdisc`` starts without scipy, xarray or
 matplotlib. No module of such a package is named like a name it gives the package (the
-import system would bind the module over it once imported; ``tests/test_imports.py``
+import system would bind the module over it once imported; ``tests/package/test_imports.py``
 checks).
 """
 
@@ -28,7 +28,7 @@ def public(namespace: dict[str, Any], table: Mapping[str, Iterable[str]],
     ``computed`` maps further public names to functions that make their values on first
     use (``__version__``). Returns ``__all__`` (sorted), ``__getattr__`` and ``__dir__``;
     ``namespace["_HOMES"]`` is set to the name -> module mapping, which
-    ``tests/test_imports.py`` reads.
+    ``tests/package/test_imports.py`` reads.
     """
     homes = {name: module for module, names in table.items() for name in names}
     computed = dict(computed or {})

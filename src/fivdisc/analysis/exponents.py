@@ -239,7 +239,8 @@ def lyapunov(
     term is what the random start still does to the estimate: once both sets have
     aligned they are the same vectors and it vanishes, chaotic or not; while they align
     their deficits differ. On three sliders at a stable equilibrium
-    (``tests/test_lyapunov_accuracy.py``, exponents -1.15, -1.15, -1.63, -1.63 1/s)
+    (``tests/analysis/test_lyapunov_against_references.py``, exponents -1.15, -1.15,
+    -1.63, -1.63 1/s)
     with a transient of 0.5 s, far too short to align, the second exponent over 3 s was
     8 of ``sqrt(s^2 + drift^2)`` away from its limit, and is 2.3 of ``u`` away. The
     largest exponent alone is computed from one start: it is what sweeps compute at

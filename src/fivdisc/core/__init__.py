@@ -5,7 +5,7 @@ Integer and boolean constants that the kernels pass to compiled functions are nu
 scalars (``dynamics.RIGHT``, ``switch.MODE_START``, ...), and so are variables that start
 from a constant and are passed on (counters, "none found yet"): numba types a Python
 ``int`` or ``bool`` there as a literal and compiles the callee once per value, which
-made the first compilation about 40 % longer. ``tests/test_kernel_literals.py`` checks
+made the first compilation about 40 % longer. ``tests/core/test_kernel_literals.py`` checks
 the call sites.
 
 Functions of the cold path called from one or two places (the start's phases, a

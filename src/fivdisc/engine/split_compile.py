@@ -25,7 +25,7 @@ sliding equilibrium (``fivdisc stability``) calls from Python.
 A cache entry holds one signature, so each function is compiled for the argument types
 ``run`` passes it, :func:`callee_types`. Every case's arrays have the same types, so the
 default case's stand for any. Were a prediction wrong, ``run`` would compile that
-function once more itself: slower, never wrong (``tests/test_split_compile.py`` checks
+function once more itself: slower, never wrong (``tests/engine/test_split_compile.py`` checks
 that it does not happen).
 """
 
