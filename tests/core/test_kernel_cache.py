@@ -42,7 +42,8 @@ def test_an_edited_kernel_is_recompiled(tmp_path):
     package = Path(fivdisc.__file__).parent
     shutil.copytree(package, tmp_path / "fivdisc",
                     ignore=shutil.ignore_patterns("__pycache__"))
-    layout = tmp_path / "fivdisc" / "_kernels" / "layout.py"
+    sizes = tmp_path / "fivdisc" / "core" / "sizes.py"
+    layout = tmp_path / "fivdisc" / "model" / "layout.py"
 
     first = _probe(tmp_path)
     assert (first["hits"], first["misses"]) == (0, 1)
@@ -50,16 +51,17 @@ def test_an_edited_kernel_is_recompiled(tmp_path):
     assert (again["hits"], again["misses"], again["rows"]) == (1, 0, first["rows"])
 
     # One row more for the auxiliary block's offset: _aux returns one row less.
-    text = layout.read_text()
+    text = sizes.read_text()
     old = "    aux = trig + 2 * n_sliders\n"
     assert text.count(old) == 1
-    layout.write_text(text.replace(old, "    aux = trig + 2 * n_sliders + 1\n"))
+    sizes.write_text(text.replace(old, "    aux = trig + 2 * n_sliders + 1\n"))
     edited = _probe(tmp_path)
     assert edited["hash"] != first["hash"]
     assert (edited["hits"], edited["misses"]) == (0, 1)
     assert edited["rows"] == first["rows"] - 1
 
-    # A comment is an edit too: numba cannot tell, so the kernels recompile.
+    # A comment is an edit too, in the model's layout as in the kernels' own files: numba
+    # cannot tell, so the kernels recompile.
     layout.write_text(layout.read_text() + "# edited\n")
     assert _probe(tmp_path)["misses"] == 1
 

@@ -13,7 +13,8 @@ import sys
 import numpy as np
 import pytest
 
-from fivdisc import Case, simulate, split_compile
+from fivdisc import Case, simulate
+from fivdisc.engine import split_compile
 from fivdisc.engine.integration import Integration
 from fivdisc.engine.simulation import initial_state
 from fivdisc.model.build import build_model
@@ -22,7 +23,8 @@ _CASE = {"simulation": {"duration": 0.01}}
 
 _COLD = """
 import json
-from fivdisc import Case, simulate, split_compile
+from fivdisc import Case, simulate
+from fivdisc.engine import split_compile
 result = simulate(Case(**json.loads({case!r})))
 stats = {{name: [sum(d.stats.cache_hits.values()), sum(d.stats.cache_misses.values())]
          for name, d in split_compile._dispatchers().items()}}
