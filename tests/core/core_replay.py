@@ -28,9 +28,9 @@ import fivdisc
 
 # --- fivdisc internals: the only imports of non-public modules -------------------------
 from fivdisc.analysis.orbits import energy_scales
-from fivdisc.integration import Integration, tangent_step  # noqa: F401  (tangent_step: recorder)
-from fivdisc.result import EVENT_KINDS
-from fivdisc.simulate import initial_state  # noqa: F401  (the recorder's start states)
+from fivdisc.engine.integration import Integration, tangent_step  # noqa: F401  (tangent_step: recorder)
+from fivdisc.engine.result import EVENT_KINDS
+from fivdisc.engine.simulation import initial_state  # noqa: F401  (the recorder's start states)
 
 
 def state_scales(model: fivdisc.Model) -> np.ndarray:
