@@ -9,14 +9,15 @@ from fivdisc.case.disc import Disc
 from fivdisc.case.friction import LAWS
 from fivdisc.case.root import Case
 from fivdisc.case.simulation import Perturbation, Simulation
-from fivdisc.case.slider import Slider
+from fivdisc.case.slider import Slider, SliderPerturbation
 from fivdisc.case.speed import PROFILES
 from fivdisc.case.tree import catalog, template
 
 
 def is_case_key(key: str) -> bool:
-    """Whether ``key`` names a value of some case: a key of :meth:`Case.valid_keys` or
-    ``sliders.J.KEY`` for a slider key (whether slider J exists depends on the case)."""
+    """Whether ``key`` names a value of some case: a key of :meth:`Case.valid_keys`,
+    ``sliders.J.KEY`` for a slider key (whether slider J exists depends on the case) or
+    ``sliders.*.KEY`` (every slider)."""
     return template(key) in catalog(Case).leaves
 
 
@@ -25,7 +26,7 @@ def keys_like(key: str) -> list[str]:
     written ``sliders.J.KEY`` when `key` names slider J that way."""
     parts = key.split(".")
     keys = Case.valid_keys()
-    if parts[0] == "sliders" and len(parts) > 2 and parts[1].isdigit():
+    if parts[0] == "sliders" and len(parts) > 2 and (parts[1].isdigit() or parts[1] == "*"):
         prefix = f"sliders.{parts[1]}."
         return [prefix + k.split(".", 1)[1] if k.startswith("slider.") else k for k in keys]
     return keys
@@ -49,7 +50,8 @@ _TABLE_WORDS = {"disc": "disc", "friction": "friction", "speed": "", "simulation
 def describe_key(key: str) -> KeyInfo:
     """Unit, symbol and description of a dotted case key.
 
-    ``sliders.J.KEY`` is described as ``slider.KEY`` of slider J; the keys of every speed
+    ``sliders.J.KEY`` is described as ``slider.KEY`` of slider J, ``sliders.*.KEY`` as
+    that of every slider; the keys of every speed
     profile and friction law are known (a key of two profiles, ``speed.initial``, takes
     the first one's symbol). An unknown key gives its own words and no unit.
 
@@ -66,6 +68,7 @@ def describe_key(key: str) -> KeyInfo:
         "speed": tuple(PROFILES.values()),
         "simulation": (Simulation,),
         "simulation.perturbation": (Perturbation,),
+        "slider.perturbation": (SliderPerturbation,),
     }.get(table, ())
     extra: dict[str, str] = {}
     for model in models:
@@ -74,13 +77,17 @@ def describe_key(key: str) -> KeyInfo:
             extra = dict(field.json_schema_extra or {})
             break
     words = extra.get("name") or name.replace("_", " ")
-    if table == "slider":
+    if table.split(".")[0] == "slider":
         parts = key.split(".")
-        owner = f"slider {parts[1]}" if parts[0] == "sliders" else "slider"
+        owner = ("every slider" if parts[0] == "sliders" and parts[1] == "*"
+                 else f"slider {parts[1]}" if parts[0] == "sliders" else "slider")
     else:
         owner = _TABLE_WORDS.get(table, table)
     head = owner.split(" ")[0]
-    if head and head in words.split(" "):
+    if owner == "every slider":
+        words = (words.replace("slider", "every slider", 1) if "slider" in words.split(" ")
+                 else f"{words} of every slider")
+    elif head and head in words.split(" "):
         words = words.replace(head, owner, 1)
     elif owner:
         words = f"{owner} {words}"

@@ -21,7 +21,7 @@ from fivdisc.case.simulation import Simulation
 from fivdisc.case.slider import Slider
 from fivdisc.case.speed import SPEED, ConstantSpeed, Speed
 from fivdisc.case.toml import inline_arrays, read_toml
-from fivdisc.case.tree import catalog, template
+from fivdisc.case.tree import EVERY, catalog, template
 from fivdisc.errors import CaseError
 from fivdisc.files import read_text
 from fivdisc.limits import MAX_SLIDERS
@@ -67,17 +67,25 @@ class Case(Table):
     @model_validator(mode="before")
     @classmethod
     def _one_slider_table(cls, data: Any) -> Any:
-        # `[slider]` is the one-slider spelling of `[[sliders]]`.
+        # `[slider]` is the one-slider spelling of `[[sliders]]`; next to `[[sliders]]` it
+        # holds what every slider shares (each `[[sliders]]` table overrides it).
         if isinstance(data, Mapping) and "slider" in data:
+            shared = plain(data["slider"])
             if "sliders" in data:
-                raise rule(
-                    "a case has either one [slider] table or [[sliders]] tables, not both; "
-                    "pick one",
-                    "slider",
-                    data["slider"],
-                )
+                items = plain(data["sliders"])
+                if not isinstance(shared, Mapping) or not isinstance(items, list | tuple):
+                    raise rule(
+                        "must be a table of the keys every [[sliders]] table shares, next "
+                        "to [[sliders]] tables",
+                        "slider",
+                        data["slider"],
+                    )
+                merged = [_merged(shared, item) for item in items]
+                data = {k: v for k, v in data.items() if k != "slider"}
+                data["sliders"] = merged
+                return data
             data = {("sliders" if k == "slider" else k): v for k, v in data.items()}
-            data["sliders"] = [plain(data["sliders"])]
+            data["sliders"] = [shared]
         return data
 
     @property
@@ -190,13 +198,28 @@ class Case(Table):
     def get(self, key: str) -> Any:
         """The value (or table) at a dotted key, e.g. ``case.get("slider.mass")``.
 
+        A key of every slider (``sliders.*.KEY``, or ``slider.KEY`` in a case with several
+        sliders) gives the value they share.
+
         Raises
         ------
         CaseError
-            The key does not exist in this case.
+            The key does not exist in this case, or names every slider and their values
+            differ.
         """
+        values = [self._at(key, path) for path in self._paths(key)]
+        if len(values) > 1 and any(v != values[0] for v in values[1:]):
+            one = key.split(".", 2)[-1] if key.startswith("sliders.") else key.split(".", 1)[1]
+            raise CaseError(
+                f"'{key}' has no single value: the sliders' values differ "
+                f"({', '.join(show(v) for v in values)}); set it, or name one slider "
+                f"(sliders.J.{one}, J from 0 to {len(self.sliders) - 1})"
+            )
+        return values[0]
+
+    def _at(self, key: str, path: list[str | int]) -> Any:
         node: Any = self
-        for name in self._path(key):
+        for name in path:
             if isinstance(node, tuple):
                 node = node[name]
             elif isinstance(node, BaseModel) and name in type(node).model_fields:
@@ -214,28 +237,26 @@ class Case(Table):
         member = type(getattr(self, table)) if table in self._unions else None
         return unknown_key(key, names, member, everything=[*keys.leaves, *keys.tables])
 
-    def _path(self, key: str) -> list[str | int]:
-        """Path of a dotted key through the model: ``slider.X`` and ``sliders.J.X`` lead to
-        ``["sliders", J, "X"]``."""
+    def _paths(self, key: str) -> list[list[str | int]]:
+        """Paths of a dotted key through the model: ``sliders.J.X`` leads to
+        ``["sliders", J, "X"]``; ``sliders.*.X`` to one path per slider, and so does
+        ``slider.X`` (the one slider's, or with several sliders every slider's: the rule
+        of ``docs/model.md``)."""
         parts: list[str | int] = list(key.split("."))
         if parts[0] == "slider":
-            if len(self.sliders) != 1:
-                raise CaseError(
-                    f"'{key}' is ambiguous: the case has {len(self.sliders)} sliders; write "
-                    f"sliders.J.{'.'.join(map(str, parts[1:])) or 'KEY'} with J from 0 to "
-                    f"{len(self.sliders) - 1}"
-                )
-            return ["sliders", 0, *parts[1:]]
+            return [["sliders", j, *parts[1:]] for j in range(len(self.sliders))]
         if parts[0] == "sliders" and len(parts) > 1:
             index = parts[1]
+            if index == EVERY:
+                return [["sliders", j, *parts[2:]] for j in range(len(self.sliders))]
             if not (isinstance(index, str) and index.isdigit()
                     and int(index) < len(self.sliders)):
                 raise CaseError(
                     f"'{key}': slider index {index!r} is invalid: the case has "
-                    f"{len(self.sliders)} slider(s), numbered from 0"
+                    f"{len(self.sliders)} slider(s), numbered from 0 (or * for every slider)"
                 )
-            return ["sliders", int(index), *parts[2:]]
-        return parts
+            return [["sliders", int(index), *parts[2:]]]
+        return [parts]
 
     def replace(self, updates: Mapping[str, Any]) -> Case:
         """A new, validated case with some values changed.
@@ -244,7 +265,8 @@ class Case(Table):
         ----------
         updates
             Dotted key -> new value, e.g. ``{"slider.normal_damping": 2.0}`` or, with
-            several sliders, ``{"sliders.1.preload": 300.0}``. A key may also name a
+            several sliders, ``{"sliders.1.preload": 300.0}``; ``sliders.*.KEY`` (and
+            ``slider.KEY`` with several sliders) sets KEY of every slider. A key may also name a
             whole table (``"speed"``, ``"simulation"``, ``"sliders.1"``,
             ``"simulation.perturbation"``) or the list ``"sliders"``, whose value (a
             dict or model, or a list of them) then replaces it; keys it leaves out take
@@ -272,25 +294,40 @@ class Case(Table):
         for key in sorted(updates, key=lambda k: (k.count("."), k not in tags)):
             if template(key) not in keys.leaves and template(key) not in keys.tables:
                 raise CaseError(self._unknown(key))
-            *path, name = self._path(key)
-            table: Any = data
-            for i, part in enumerate(path):
-                child = table[part] if isinstance(part, int) else table.get(part, {})
-                if isinstance(child, BaseModel):
-                    child = child.model_dump()
-                elif not isinstance(child, Mapping | list | tuple):
-                    raise CaseError(
-                        f"cannot set '{key}': {join(path[: i + 1])} = {show(child)} "
-                        "is not a table"
-                    )
-                table[part] = list(child) if isinstance(child, list | tuple) else dict(child)
-                table = table[part]
-            if key in tags:
-                union = self._unions[key.split(".")[0]]
-                if updates[key] != table.get(union.tag, union.default):
-                    table.clear()
-            table[name] = plain(updates[key])
+            for full in self._paths(key):
+                *path, name = full
+                table: Any = data
+                for i, part in enumerate(path):
+                    child = table[part] if isinstance(part, int) else table.get(part, {})
+                    if isinstance(child, BaseModel):
+                        child = child.model_dump()
+                    elif not isinstance(child, Mapping | list | tuple):
+                        raise CaseError(
+                            f"cannot set '{key}': {join(path[: i + 1])} = {show(child)} "
+                            "is not a table"
+                        )
+                    table[part] = list(child) if isinstance(child, list | tuple) else dict(child)
+                    table = table[part]
+                if key in tags:
+                    union = self._unions[key.split(".")[0]]
+                    if updates[key] != table.get(union.tag, union.default):
+                        table.clear()
+                table[name] = plain(updates[key])
         return _validate(data, source=None)
+
+
+def _merged(shared: Mapping[str, Any], item: Any) -> Any:
+    """A ``[[sliders]]`` table over the ``[slider]`` keys every slider shares (a nested
+    table merged key by key)."""
+    if isinstance(item, BaseModel):
+        item = item.model_dump()
+    if not isinstance(item, Mapping):
+        return item
+    out = dict(shared)
+    for k, v in item.items():
+        out[k] = (_merged(out[k], v) if isinstance(out.get(k), Mapping)
+                  and isinstance(v, Mapping) else v)
+    return out
 
 
 def load_case(path: str | PathLike[str]) -> Case:

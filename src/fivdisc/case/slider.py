@@ -8,6 +8,27 @@ from typing import ClassVar, Literal
 from fivdisc.case.fields import Real, Table, field
 
 
+class SliderPerturbation(Table):
+    """This slider's offsets from the sliding equilibrium when a run starts from it, added
+    to the ``[simulation.perturbation]`` every slider takes (identical pads started
+    identically stay in step until the integration's round-off parts them: an offset of
+    one pad breaks the symmetry on purpose).
+
+    Attributes
+    ----------
+    phi
+        Offset of this slider's angle [rad].
+    phi_dot
+        Offset of this slider's angular velocity [rad/s].
+    """
+
+    _key: ClassVar[tuple[str, ...]] = ("slider", "perturbation")
+
+    phi: Real = field(0.0, "rad", r"\Delta\phi_j", "slider own angle perturbation")
+    phi_dot: Real = field(0.0, "rad/s", r"\Delta\dot\phi_j",
+                          "slider own angular velocity perturbation")
+
+
 class Slider(Table):
     """A slider: a mass on a transverse spring-damper and an in-plane one.
 
@@ -33,6 +54,9 @@ class Slider(Table):
     face
         "top" (the paper's side, on +w, pressed towards -w) or "bottom" (on -w,
         pressed towards +w).
+    perturbation
+        This slider's own offsets from the sliding equilibrium at the start, added to
+        ``simulation.perturbation`` (:class:`SliderPerturbation`).
     """
 
     _key: ClassVar[tuple[str, ...]] = ("slider",)
@@ -46,6 +70,7 @@ class Slider(Table):
     preload: Real = field(500.0, "N", "N_0", ge=0)
     angle: Real = field(0.0, "rad", r"\theta", "slider base angle")
     face: Literal["top", "bottom"] = "top"
+    perturbation: SliderPerturbation = SliderPerturbation()
 
     @property
     def sigma(self) -> float:

@@ -17,10 +17,15 @@ from typing import NamedTuple
 from pydantic import BaseModel
 
 
+#: The slider "index" of a key that names every slider: ``sliders.*.mass``.
+EVERY = "*"
+
+
 def template(key: str) -> str:
-    """The key with a slider index removed: ``sliders.2.mass`` -> ``slider.mass``."""
+    """The key with a slider index removed: ``sliders.2.mass`` -> ``slider.mass``, and
+    ``sliders.*.mass`` (every slider) -> ``slider.mass``."""
     parts = key.split(".")
-    if parts[0] == "sliders" and len(parts) > 1 and parts[1].isdigit():
+    if parts[0] == "sliders" and len(parts) > 1 and (parts[1].isdigit() or parts[1] == EVERY):
         return ".".join(["slider", *parts[2:]])
     return key
 

@@ -223,8 +223,10 @@ def initial_state(model: Model, initial=None) -> np.ndarray:
             return y
         if initial == "equilibrium":
             y = sliding_equilibrium(model).state.copy()
-            y[phi] += sim.perturbation.phi
-            y[phi_dot] += sim.perturbation.phi_dot
+            own = model.case.sliders
+            y[phi] += sim.perturbation.phi + np.array([s.perturbation.phi for s in own])
+            y[phi_dot] += (sim.perturbation.phi_dot
+                           + np.array([s.perturbation.phi_dot for s in own]))
             return _checked(y, phi)
         raise SimulationError(
             f"initial = {initial!r} is invalid: must be 'rest', 'equilibrium', a mapping "

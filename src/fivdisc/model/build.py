@@ -203,8 +203,11 @@ def model_at(base: Model, case: Case, updates: dict[str, float]) -> Model:
         parts = key.split(".")
         if key == "speed.value" and case.speed.profile == "constant":
             model = model.with_speed(SpeedProfile.constant(value))
-        elif parts[0] in ("slider", "sliders") and parts[-1] in _SLIDER_ARRAYS:
-            j = 0 if parts[0] == "slider" else int(parts[1])
+        elif (parts[0] in ("slider", "sliders") and parts[-1] in _SLIDER_ARRAYS
+              and len(parts) == (2 if parts[0] == "slider" else 3)):
+            # slider.KEY and sliders.*.KEY: every slider (the rule of Case.replace)
+            j = (slice(None) if parts[0] == "slider" or parts[1] == "*"
+                 else int(parts[1]))
             name = _SLIDER_ARRAYS[parts[-1]]
             # One slider patch for all the keys (the face-signed rows follow once).
             rows.setdefault(name, model.kernel.row(name).copy())[j] = value
