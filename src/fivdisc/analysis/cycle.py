@@ -62,12 +62,19 @@ class Cycle:
     stick_free : ndarray of bool
         Per interval between the start, the switches and the end: whether no slider
         sticks in it.
+    events : tuple of (float, str, int)
+        Every switch as (time from the orbit's point [s], kind of
+        :data:`~fivdisc.engine.result.EVENT_KINDS`, slider).
+    period : float
+        The period [s].
     """
 
     signature: tuple[str, ...]
     measures: dict[str, np.ndarray]
     switch_times: np.ndarray
     stick_free: np.ndarray
+    events: tuple[tuple[float, str, int], ...] = ()
+    period: float = np.nan
 
     def cyclic(self) -> tuple[str, ...]:
         """The signature as a cycle, independent of where on the orbit it starts: per
@@ -110,7 +117,9 @@ def one_period(model: Model, x0: np.ndarray, phases: np.ndarray, period: float,
         seen = rows.shape[0]
         if run.status_name == "success":
             break
-    times, _ = run.events()
+    times, rows = run.events()
+    events = tuple((float(t), EVENT_KINDS[int(r[0])], int(r[3])) for t, r in zip(times, rows,
+                                                                               strict=True))
     y = run.out_y[: run.n_samples]
     aux = run.out_aux[: run.n_samples]
     columns = {
@@ -123,4 +132,63 @@ def one_period(model: Model, x0: np.ndarray, phases: np.ndarray, period: float,
     for name, values in columns.items():
         measures[f"{name}_max"] = values.max(axis=0)
         measures[f"{name}_min"] = values.min(axis=0)
-    return Cycle(tuple(" > ".join(s) for s in seqs), measures, times, np.array(stick_free))
+    return Cycle(tuple(" > ".join(s) for s in seqs), measures, times, np.array(stick_free),
+                 events, float(period))
+
+
+#: What each event kind is called in words.
+EVENT_WORDS = {"stick": "stick", "slip": "release", "reversal": "reversal",
+               "separation": "separation", "recontact": "re-contact"}
+# Events of different sliders closer than this fraction of the period are simultaneous.
+SIMULTANEOUS = 1e-9
+
+
+def _matched(events: tuple[tuple[float, str, int], ...]) -> dict[tuple[str, int, int], float]:
+    """Each event keyed by (kind, slider, its count among that slider's events of that
+    kind)."""
+    seen: dict[tuple[str, int], int] = {}
+    out = {}
+    for t, kind, j in events:
+        i = seen.get((kind, j), 0)
+        seen[(kind, j)] = i + 1
+        out[(kind, j, i)] = t
+    return out
+
+
+def order_changes(before: Cycle, after: Cycle, limit: int = 3) -> list[str]:
+    """The pairs of events of different sliders whose order (or simultaneity) differs
+    between two runs over (nearly) the same period, in words, nearest pairs first: e.g.
+    ``"pad 2's release: together with pad 0's release -> 171 ns after it"``."""
+    a, b = _matched(before.events), _matched(after.events)
+    common = [key for key in a if key in b]
+    period = before.period if np.isfinite(before.period) else 1.0
+    tol = SIMULTANEOUS * period
+
+    def rel(dt: float) -> float:
+        # the signed time from the first to the second, the nearer way round the cycle
+        return (dt + 0.5 * period) % period - 0.5 * period
+
+    def words(dt: float, first: tuple[str, int, int]) -> str:
+        what = f"pad {first[1]}'s {EVENT_WORDS[first[0]]}"
+        if abs(dt) <= tol:
+            return f"together with {what}"
+        return f"{abs(dt) * 1e9:.3g} ns {'after' if dt > 0 else 'before'} {what}"
+
+    found = []
+    for i, one in enumerate(common):
+        for two in common[i + 1:]:
+            if one[1] == two[1]:
+                continue
+            da, db = rel(a[two] - a[one]), rel(b[two] - b[one])
+            same_a, same_b = abs(da) <= tol, abs(db) <= tol
+            if same_a != same_b or (not same_a and np.sign(da) != np.sign(db)):
+                found.append((min(abs(da), abs(db)),
+                              f"pad {two[1]}'s {EVENT_WORDS[two[0]]}: {words(da, one)} -> "
+                              f"{words(db, one)}"))
+    missing = [k for k in a if k not in b] + [k for k in b if k not in a]
+    lines = [text for _, text in sorted(found)[:limit]]
+    if missing:
+        lines.append("events " + ", ".join(f"pad {k[1]}'s {EVENT_WORDS[k[0]]}"
+                                           for k in missing[:limit])
+                     + " appear or vanish")
+    return lines

@@ -24,6 +24,7 @@ import json
 import time
 from dataclasses import dataclass, field
 from os import PathLike
+from typing import NamedTuple
 
 import numpy as np
 
@@ -33,7 +34,7 @@ from fivdisc.errors import ConvergenceError, FivdiscError
 from fivdisc.model import layout as lay
 from fivdisc.model.build import Model, build_model
 
-__all__ = ["PeriodicOrbit", "Shooting", "periodic_orbit", "saved_start"]
+__all__ = ["PeriodicOrbit", "SavedStart", "Shooting", "periodic_orbit", "saved_start"]
 
 VERDICTS = ("stable", "unstable", "not converged")
 # Halvings of a Newton step that does not reduce the residual before giving up.
@@ -84,6 +85,18 @@ class PeriodicOrbit:
     start : str
         Where the search started (a transient from the case's initial state, a given
         state, a file): coexisting orbits of nearly the same period are told apart by it.
+    accuracy : float
+        Where Newton stalled within the integration's own accuracy: that accuracy (the
+        scaled change of ``phi_T(x0)`` when the integration tolerance is divided by 10),
+        at which the orbit is converged; nan otherwise.
+    symmetry : str
+        The orbit's symmetry in words (``"pads stick in turn, T/3 apart"``, ``"in
+        phase"``, ``"none"``), "" where the case has none.
+    group : str
+        The case's symmetry group in words, "" if none.
+    note : str
+        What else to know about the result (a tightened tolerance, a residual that would
+        not go below the tolerance's level, a T/k solve).
     """
 
     period: float
@@ -97,6 +110,10 @@ class PeriodicOrbit:
     verdict: str
     labels: tuple[str, ...] = field(default=())
     start: str = ""
+    accuracy: float = float("nan")
+    symmetry: str = ""
+    group: str = ""
+    note: str = ""
 
     @property
     def converged(self) -> bool:
@@ -132,6 +149,10 @@ class PeriodicOrbit:
             "residual": self.residual,
             "iterations": self.iterations,
             "start": self.start,
+            "accuracy": None if np.isnan(self.accuracy) else self.accuracy,
+            "symmetry": self.symmetry,
+            "group": self.group,
+            "note": self.note,
         }
 
     def to_json(self) -> str:
@@ -170,7 +191,9 @@ class PeriodicOrbit:
             attrs={"period": self.period, "period_units": "s", "verdict": self.verdict,
                    "residual": self.residual, "iterations": self.iterations,
                    "trivial_multiplier": self.trivial, "converged": int(self.converged),
-                   "start": self.start, "content": "periodic orbit"},
+                   "start": self.start, "content": "periodic orbit",
+                   "accuracy": self.accuracy, "symmetry": self.symmetry,
+                   "group": self.group, "note": self.note},
         )
         return ds
 
@@ -184,6 +207,11 @@ class PeriodicOrbit:
                  f"{self.verdict}, residual {self.residual:.2e} after {self.iterations} "
                  f"Newton iteration{'' if self.iterations == 1 else 's'}",
                  f"started {self.start}" if self.start else "",
+                 (f"converged at the integration's accuracy {self.accuracy:.1e} (Newton "
+                  "stalled there)") if not np.isnan(self.accuracy) else "",
+                 f"symmetry of the case: {self.group}" if self.group else "",
+                 f"symmetry of the orbit: {self.symmetry}" if self.group else "",
+                 f"note: {self.note}" if self.note else "",
                  "Floquet multipliers (modulus, real, imag):"]
         for i, m in enumerate(self.multipliers):
             note = "  flow direction" if i == self.trivial else ""
@@ -258,6 +286,18 @@ class Shooting:
         """The same shooting (phases, tolerances, scales) on another model."""
         return Shooting(model, self.phases, self.rtol, self.atol, self.scale)
 
+    def held(self, x0: np.ndarray) -> np.ndarray:
+        """``x0`` with the rate of every slider that sticks at the start set to the disc
+        speed of this model: the kernel keeps a slider stuck at the start only if it
+        moves exactly with the disc, so a point inside a stick phase stays one when the
+        disc speed is changed (a continuation in the speed)."""
+        stuck = np.flatnonzero(self.phases == lay.STICK)
+        if stuck.size == 0:
+            return x0
+        x0 = np.array(x0, dtype=float)
+        x0[self.model.index("phi_dot") + stuck] = float(self.model.speed.omega(0.0))
+        return x0
+
     def shoot(self, x0: np.ndarray, period: float, tangents: bool = True) -> Shot:
         """The flow map over ``period`` [s] from ``x0``, with its Jacobian if asked.
 
@@ -267,6 +307,7 @@ class Shooting:
             The run did not reach ``period`` (divergence, endless switching, ...).
         """
         nd = self.model.state_size
+        x0 = self.held(x0)
         run = Integration(self.model, x0, duration=period, output_rate=1.0 / period,
                           rtol=self.rtol, atol=self.atol, max_step=self.cap,
                           phases=self.phases)
@@ -336,6 +377,45 @@ class Shooting:
         return mult[order], int(np.flatnonzero(order == mult.size - 1)[0])
 
 
+class SymmetricShooting(Shooting):
+    """Shooting over ``T / k`` with the pads permuted: the fixed points of
+    ``P^-1 phi_{T/k}``, the orbits with ``x(t + T/k) = P x(t)``
+    (:mod:`fivdisc.analysis.symmetry`). :meth:`shoot` takes and returns what
+    :class:`Shooting`'s does for the full period ``T`` (its end mapped back by
+    ``P^-1``, its monodromy ``R = P^-1 d phi_{T/k}``, ``d end / dT`` the vector field
+    over ``k``), so Newton shooting runs unchanged on it; :meth:`full` gives the full
+    period's monodromy ``R^k``.
+
+    Parameters
+    ----------
+    matrix : ndarray
+        ``P`` of the symmetry.
+    k : int
+        The fraction of the period it shifts by.
+    """
+
+    def __init__(self, model: Model, phases: np.ndarray, rtol: float, atol: float,
+                 matrix: np.ndarray, k: int, scale: np.ndarray | None = None) -> None:
+        super().__init__(model, phases, rtol, atol, scale)
+        self.matrix, self.k = matrix, int(k)
+        self.inverse = np.linalg.inv(matrix)
+
+    def at(self, model: Model) -> SymmetricShooting:
+        return SymmetricShooting(model, self.phases, self.rtol, self.atol, self.matrix,
+                                 self.k, self.scale)
+
+    def shoot(self, x0: np.ndarray, period: float, tangents: bool = True) -> Shot:
+        shot = super().shoot(x0, period / self.k, tangents)
+        pinv = self.inverse
+        return Shot(pinv @ shot.end, None if shot.monodromy is None else pinv @ shot.monodromy,
+                    pinv @ shot.rate_end / self.k, shot.rate_start, shot.free)
+
+    def full(self, shot: Shot) -> Shot:
+        """The full period's shot from the reduced one: monodromy ``R^k``."""
+        return Shot(shot.end, np.linalg.matrix_power(shot.monodromy, self.k),
+                    shot.rate_end * self.k, shot.rate_start, shot.free)
+
+
 def verdict_of(mult: np.ndarray, trivial: int) -> str:
     """``"stable"`` if every multiplier but the flow direction's lies inside the unit
     circle, else ``"unstable"``."""
@@ -351,6 +431,119 @@ class _Newton:
     residual: float
     iterations: int
     reason: str
+    # Where no step reduced the residual: the Newton step there (for _stall).
+    step: np.ndarray | None = None
+
+
+# A stall whose residual is within this many times the integration's accuracy is
+# converged at that accuracy.
+_FLOOR = 10.0
+# The tightest tolerance a stall within the integration's accuracy is retried at.
+_TIGHTEST = 1e-14
+STALL = "no Newton step reduces the residual (the guess is too far)"
+
+
+def accuracy_of(shooting: Shooting, x0: np.ndarray, period: float,
+                end: np.ndarray | None = None) -> float:
+    """The integration's accuracy at ``x0``: the scaled change of ``phi_T(x0)`` (relative
+    to the orbit's size, the residual's measure) when the tolerances are divided by 10
+    (at most to 1e-15)."""
+    fine = Shooting(shooting.model, shooting.phases, max(shooting.rtol / 10, 1e-15),
+                    max(shooting.atol / 10, 1e-30), shooting.scale)
+    if isinstance(shooting, SymmetricShooting):
+        fine = SymmetricShooting(shooting.model, shooting.phases, fine.rtol, fine.atol,
+                                 shooting.matrix, shooting.k, shooting.scale)
+    a = shooting.shoot(x0, period, tangents=False) if end is None else None
+    b = fine.shoot(x0, period, tangents=False)
+    end = a.end if a is not None else end
+    size = np.linalg.norm(b.rate_start / shooting.scale) * period
+    return float(np.linalg.norm((end - b.end)[b.free] / shooting.scale[b.free]) / size)
+
+
+@dataclass
+class Stall:
+    """Why Newton shooting stalled: ``kind`` is ``"accuracy"`` (within the integration's
+    accuracy), ``"discontinuous"`` (the shooting map jumps between the iterate and its
+    linear model's fixed point) or ``"far"``; ``text`` says it in words."""
+
+    kind: str
+    text: str
+    accuracy: float
+
+
+def _stall(shooting: Shooting, sol: _Newton) -> Stall:
+    """Classify a stall of Newton shooting at ``sol``'s iterate: within the integration's
+    own accuracy, on a discontinuity of the shooting map (a line search along the Newton
+    step, bisected to where the residual jumps, and the switches whose order flips
+    there), or a guess too far."""
+    from fivdisc.analysis.cycle import one_period, order_changes
+
+    x0, period, r0 = sol.x0, sol.period, sol.residual
+    eps = accuracy_of(shooting, x0, period, sol.shot.end)
+    if r0 <= _FLOOR * eps:
+        return Stall("accuracy", f"the residual {r0:.2e} is within {_FLOOR:g} times the "
+                     f"integration's accuracy {eps:.1e}", eps)
+    step = sol.step
+    if step is None:
+        return Stall("far", STALL, eps)
+    free, sc = sol.shot.free, shooting.scale
+    m = int(free.sum())
+
+    def trial(frac: float) -> tuple[float, np.ndarray, float]:
+        x = x0.copy()
+        x[free] += frac * step[:m] * sc[free]
+        t = period + frac * step[m]
+        try:
+            shot = shooting.shoot(x, t, tangents=False)
+        except FivdiscError:
+            return np.inf, x, t
+        return shooting.residual(shot, x, t), x, t
+
+    def departs(frac: float, res: float) -> bool:
+        # the linear model's residual is (1 - frac) r0; a smooth map stays near it for
+        # small steps, to second order
+        return res > 2.0 * max((1.0 - frac) * r0, _FLOOR * eps)
+
+    good, bad = 0.0, None
+    for k in range(24, -1, -1):
+        frac = 0.5**k
+        res, _, _ = trial(frac)
+        if departs(frac, res):
+            bad = frac
+            break
+        good = frac
+    if bad is None:
+        return Stall("far", STALL, eps)
+    lo_res, lo_x, lo_t = trial(good) if good > 0 else (r0, x0, period)
+    hi_res, hi_x, hi_t = trial(bad)
+    for _ in range(30):
+        if bad - good <= 1e-9 * bad:
+            break
+        mid = 0.5 * (good + bad)
+        res, x, t = trial(mid)
+        if departs(mid, res):
+            bad, hi_res, hi_x, hi_t = mid, res, x, t
+        else:
+            good, lo_res, lo_x, lo_t = mid, res, x, t
+    if not (bad - good <= 1e-9 * bad and hi_res > 3.0 * lo_res):
+        return Stall("far", STALL, eps)
+    model, rtol, atol = shooting.model, shooting.rtol, shooting.atol
+    try:
+        ca = one_period(model, shooting.held(lo_x), shooting.phases, lo_t, rtol, atol)
+        cb = one_period(model, shooting.held(hi_x), shooting.phases, hi_t, rtol, atol)
+        flips = order_changes(ca, cb)
+    except FivdiscError:
+        flips = []
+    where = ("; ".join(flips) if flips else
+             "no switch changes order within the period (a switch at the period's end)")
+    return Stall("discontinuous",
+                 f"the shooting map is discontinuous at the iterate: along the Newton step "
+                 f"the residual jumps from {lo_res:.2e} to {hi_res:.2e} within a relative "
+                 f"{(bad - good) / bad:.0e} of the step (at {bad:.3g} of it), where the "
+                 f"switches of different pads change order ({where}); the residual "
+                 f"{r0:.2e} is {r0 / max(eps, 1e-300):.1e} times the integration's accuracy "
+                 f"{eps:.1e}, so this is no orbit at the integration's accuracy: the "
+                 "motion there may not be periodic (check with a forward run)", eps)
 
 
 def _newton(shooting: Shooting, x0: np.ndarray, period: float, tol: float,
@@ -400,8 +593,8 @@ def _newton(shooting: Shooting, x0: np.ndarray, period: float, tol: float,
                 break
         else:
             if residual >= tol:
-                reason = "no Newton step reduces the residual (the guess is too far)"
-            break
+                reason = STALL
+            return _Newton(x0, period, shot, residual, iterations, reason, step)
         if bar is not None:
             bar.update()
             bar.set_postfix_str(f"residual {residual:.2e}")
@@ -470,6 +663,7 @@ def periodic_orbit(
     time_budget: float = 900.0,
     start: str = "",
     progress: bool = False,
+    symmetric: bool = False,
 ) -> PeriodicOrbit:
     """Find a periodic orbit of a constant-speed case by shooting.
 
@@ -512,18 +706,32 @@ def periodic_orbit(
     progress : bool
         Show the Newton iterations and their residual on a terminal (stderr), and say
         so when the kernel with tangent vectors compiles (first use).
+    symmetric : bool
+        Where the case has a symmetry group (identical pads equally spaced,
+        :func:`fivdisc.analysis.symmetry.case_symmetry`) and the motion from the guess
+        has a spatio-temporal symmetry ``x(t + T/k) = P x(t)`` (the pads in turn), solve
+        ``P^-1 phi_{T/k}(x) = x`` instead of the full period (:class:`SymmetricShooting`):
+        k times shorter runs, the orbit symmetric by construction; its multipliers are
+        the full period's (``R^k``).
 
     Returns
     -------
     PeriodicOrbit
-        A converged orbit at its minimal period.
+        A converged orbit at its minimal period, with its symmetry (``symmetry``,
+        ``group``) when the case has one.
 
     Raises
     ------
     ConvergenceError
         Newton shooting did not converge within its budgets; its ``result`` is the
         last iterate, a :class:`PeriodicOrbit` whose ``converged`` is False and whose
-        ``verdict`` is ``"not converged"``, and its ``reason`` says which budget ran out.
+        ``verdict`` is ``"not converged"``, and its ``reason`` says which budget ran out,
+        or why no step reduces the residual. A stall within the integration's own
+        accuracy is retried once at a tenth of ``rtol`` (not below 1e-14) and, stalling
+        there again, is a converged orbit at that accuracy (its ``accuracy``); a stall
+        where the shooting map is discontinuous (the switches of different pads change
+        order between the iterate and its linear model's fixed point) says so and names
+        the switches.
     FivdiscError
         A case that is not autonomous, or an invalid argument.
     """
@@ -586,8 +794,16 @@ def periodic_orbit(
             period = _first_return(model, *_probe(model, x0, phases, window, rtol, atol_run))
     phases = (np.full(model.n_sliders, lay.SLIP) if phases is None
               else np.asarray(phases, dtype=np.int64))
-    shooting = Shooting(model, phases, rtol, atol_run)
+    shooting: Shooting = Shooting(model, phases, rtol, atol_run)
     deadline = time.monotonic() + time_budget
+    from fivdisc.analysis.symmetry import case_symmetry, orbit_symmetry
+
+    group = case_symmetry(model)
+    notes = []
+    if symmetric:
+        shooting = _symmetric(group, model, x0, phases, period, rtol, atol_run)
+        notes.append(f"solved over T/{shooting.k} with the pads permuted (x(T/{shooting.k}) "
+                     "= P x(0)); multipliers of the full period")
 
     from fivdisc.engine.compilation import tangent_notice
     from fivdisc.engine.progress import progress_bar
@@ -598,55 +814,157 @@ def periodic_orbit(
         shooting.shoot(x0, min(period, 1e-6), tangents=True)
     with progress_bar(max_iterations, "Newton shooting", "iteration", show=progress) as bar:
         sol = _newton(shooting, x0, period, tol, max_iterations, deadline, bar)
-    if not sol.reason:
+    accuracy = float("nan")
+    if sol.reason == STALL:
+        stall = _stall(shooting, sol)
+        if stall.kind == "accuracy" and shooting.rtol > _TIGHTEST:
+            # Once more at a tenth of the tolerance: a residual set by the integration's
+            # error falls with it; one that does not is that accuracy's.
+            tight = max(shooting.rtol / 10, _TIGHTEST)
+            shooting = (shooting.__class__(model, phases, tight, tight * 1e-7, shooting.matrix,
+                                           shooting.k)
+                        if isinstance(shooting, SymmetricShooting)
+                        else Shooting(model, phases, tight, tight * 1e-7))
+            again = _newton(shooting, sol.x0, sol.period, tol, max_iterations, deadline, bar)
+            again.iterations += sol.iterations
+            notes.append(f"Newton stalled within the integration's accuracy "
+                         f"({stall.accuracy:.1e}) at rtol {rtol:g}: solved again at rtol "
+                         f"{tight:g}")
+            sol = again
+            if sol.reason == STALL:
+                stall = _stall(shooting, sol)
+        if sol.reason == STALL and stall.kind == "accuracy":
+            sol.reason = ""
+            accuracy = stall.accuracy
+        elif sol.reason == STALL:
+            sol.reason = stall.text
+    elif not sol.reason and sol.residual > _POLISH * tol and sol.step is not None:
+        stall = _stall(shooting, sol)
+        if stall.kind == "discontinuous":
+            notes.append(f"converged to the tolerance {tol:g} but no further: {stall.text}")
+        elif stall.kind == "accuracy":
+            accuracy = stall.accuracy
+    if not sol.reason and not isinstance(shooting, SymmetricShooting):
         k = _returns_at(shooting, sol.x0, sol.period)
         if k > 1:
             again = _newton(shooting, sol.x0, sol.period / k, tol, max_iterations, deadline)
             if not again.reason and abs(again.period * k / sol.period - 1.0) < 1e-6:
                 again.iterations += sol.iterations
                 sol = again
-    mult, trivial = shooting.stability(sol.shot)
-    orbit = PeriodicOrbit(period=float(sol.period), state=sol.x0, phases=phases.copy(),
-                          monodromy=sol.shot.monodromy, multipliers=mult, trivial=trivial,
+    shot = sol.shot
+    if isinstance(shooting, SymmetricShooting):
+        shot = shooting.full(shot if shot.monodromy is not None
+                             else shooting.shoot(sol.x0, sol.period))
+    mult, trivial = shooting.stability(shot)
+    x_end = shooting.held(sol.x0)
+    symmetry = ""
+    if group and not sol.reason:
+        symmetry = orbit_symmetry(group, model, x_end, phases, sol.period, rtol,
+                                  atol_run).name
+    orbit = PeriodicOrbit(period=float(sol.period), state=x_end, phases=phases.copy(),
+                          monodromy=shot.monodromy, multipliers=mult, trivial=trivial,
                           residual=sol.residual, iterations=sol.iterations,
                           verdict="not converged" if sol.reason else verdict_of(mult, trivial),
-                          labels=state_labels(model), start=start)
+                          labels=state_labels(model), start=start, accuracy=accuracy,
+                          symmetry=symmetry, group=group.description if group else "",
+                          note="; ".join(notes))
     if sol.reason:
+        hint = ("" if sol.reason.startswith("the shooting map is discontinuous")
+                else "; try a longer transient, a period guess, or a start nearer the orbit")
         raise ConvergenceError(
             f"periodic_orbit: not converged: {sol.reason}; residual {sol.residual:.2e} "
-            f"(tolerance {tol:g}) with period {sol.period:.6g} s; try a longer transient, "
-            "a period guess, or a start nearer the orbit", result=orbit, reason=sol.reason)
+            f"(tolerance {tol:g}) with period {sol.period:.6g} s{hint}", result=orbit,
+            reason=sol.reason)
     return orbit
 
 
-def saved_start(path: str | PathLike[str]) -> tuple[Case | None, np.ndarray, np.ndarray,
-                                                     float | None, str]:
-    """A start for :func:`periodic_orbit` from a file fivdisc wrote: an orbit
-    (``fivdisc orbit -o``; its state, phases and period) or a simulation result (its
-    final state and phases).
+def _symmetric(group, model: Model, x0: np.ndarray, phases: np.ndarray, period: float,
+               rtol: float, atol: float) -> SymmetricShooting:
+    """The T/k shooting of the spatio-temporal symmetry the motion from ``x0`` shows
+    (to 1e-2 of its size: it is not converged yet)."""
+    from fivdisc.analysis.symmetry import orbit_symmetry
 
-    Returns
-    -------
-    case : Case or None
-        The case stored in the file.
-    state : ndarray
-    phases : ndarray of int
-    period : float or None
-        The orbit's period [s] (None for a simulation result).
-    start : str
-        Where it came from, for the orbit's ``start``.
+    if not group:
+        raise FivdiscError(f"symmetric: the case has no symmetry ({group.description}): "
+                           "identical pads equally spaced on a face are needed")
+    found = orbit_symmetry(group, model, x0, phases, period, rtol, atol, tol=1e-2)
+    if found.shift is None:
+        raise FivdiscError("symmetric: the motion found has no spatio-temporal symmetry of "
+                           f"the case's group ({group.description}): no x(T/k) = P x(0)"
+                           + (f" (it is {found.name}: solve it over the full period)"
+                              if found else "") + "; leave out --symmetric")
+    return SymmetricShooting(model, phases, rtol, atol, found.shift.matrix, found.k)
+
+
+class SavedStart(NamedTuple):
+    """A start read from a file fivdisc wrote (:func:`saved_start`)."""
+
+    #: The case stored in the file (for a branch point: with its key at the point's
+    #: value), or None.
+    case: Case | None
+    #: The state to start from.
+    state: np.ndarray
+    #: Each slider's phase at that state.
+    phases: np.ndarray
+    #: The orbit's period [s] (None for a simulation result).
+    period: float | None
+    #: Where it came from, for an orbit's ``start``.
+    start: str
+    #: For a branch point: the branch's key and the point's value (else "" and None).
+    key: str = ""
+    value: float | None = None
+
+
+BRANCH_CONTENT = "continuation branch"
+
+
+def saved_start(path: str | PathLike[str], point: int | None = None) -> SavedStart:
+    """A start from a file fivdisc wrote: an orbit (``fivdisc orbit -o``; its state,
+    phases and period), a simulation result (its final state and phases) or a branch
+    point (``fivdisc continue -o``; point ``point``, default its last: the point's state,
+    phases and period, and the case with the branch's key at the point's value).
+
+    Raises
+    ------
+    FivdiscError
+        The file holds none of these, ``point`` is given for a file that is not a
+        branch, or is not one of the branch's points.
     """
     from fivdisc.files import read_dataset
 
     ds = read_dataset(path, "--from")
     text = ds.attrs.get("case")
     case = Case.from_toml(text) if text else None
-    if ds.attrs.get("content") == "periodic orbit" and "state" in ds:
-        return (case, ds["state"].values.astype(float), ds["phase"].values.astype(np.int64),
-                float(ds.attrs["period"]), f"from the orbit in {path}")
+    content = ds.attrs.get("content")
+    if content == BRANCH_CONTENT and "state" in ds:
+        count = int(ds.sizes["point"])
+        k = count - 1 if point is None else point
+        if not (isinstance(k, int | np.integer) and -count <= k < count):
+            raise FivdiscError(f"--point {point} is invalid: the branch in {path} has "
+                               f"{count} point(s), numbered from 0")
+        k = int(k) % count
+        key = str(ds.attrs["key"])
+        value = float(ds["parameter"].values[k])
+        phase = ds["phase"].values
+        phases = (phase[k] if phase.ndim == 2 else phase).astype(np.int64)
+        if case is not None:
+            case = case.replace({key: value})
+        return SavedStart(case, ds["state"].values[k].astype(float), phases,
+                          float(ds["period"].values[k]),
+                          f"from point {k} of the branch in {path} ({key} = {value:.10g})",
+                          key, value)
+    if point is not None:
+        raise FivdiscError(f"--point {point} needs --from a branch (fivdisc continue -o); "
+                           f"{path} holds no branch")
+    if content == "periodic orbit" and "state" in ds:
+        return SavedStart(case, ds["state"].values.astype(float),
+                          ds["phase"].values.astype(np.int64), float(ds.attrs["period"]),
+                          f"from the orbit in {path}")
     if "final_state" in ds.attrs and "final_phase" in ds.attrs:
         state = np.atleast_1d(np.asarray(ds.attrs["final_state"], dtype=float))
         phases = np.atleast_1d(np.asarray(ds.attrs["final_phase"], dtype=np.int64))
-        return case, state, phases, None, f"from the final state of the run in {path}"
-    raise FivdiscError(f"--from {path}: holds neither a periodic orbit (fivdisc orbit -o) "
-                       "nor a simulation result (fivdisc simulate -o)")
+        return SavedStart(case, state, phases, None,
+                          f"from the final state of the run in {path}")
+    raise FivdiscError(f"--from {path}: holds neither a periodic orbit (fivdisc orbit -o), "
+                       "a simulation result (fivdisc simulate -o) nor a branch (fivdisc "
+                       "continue -o)")

@@ -30,11 +30,15 @@ _DEFAULT = ContinuationSettings()
                                                      path_type=Path),
               help="Start from a file instead of the case's orbit: an orbit (fivdisc orbit "
               "-o), a simulation result (its final state) or a branch (fivdisc continue -o; "
-              "its last point, or --bifurcation K). Without CASE_FILE, the case stored in "
-              "the file is used.")
+              "its last point, --point K or --bifurcation K). Without CASE_FILE, the case "
+              "stored in the file is used.")
 @click.option("--bifurcation", "which", type=int,
               help="With --from BRANCH: start at its bifurcation K (from 0); at a period "
-              "doubling, continue the branch of doubled orbits born there.")
+              "doubling, continue the branch of doubled orbits born there, at a symmetry "
+              "breaking the branch of the orbits that break the symmetry.")
+@click.option("--point", type=int,
+              help="With --from BRANCH: start at its point K (from 0; negative from the end; "
+              "default: the last), at the key's value there.")
 @click.option("--from-hopf", "hopf_spec", metavar="START:STOP:N",
               help="Start from the orbits born at a Hopf point of the sliding equilibrium "
               "in --key, searched on N values from START to STOP (the first where the "
@@ -52,6 +56,9 @@ _DEFAULT = ContinuationSettings()
 @click.option("--period", type=float, help="A guess of the first orbit's period [s].")
 @click.option("--rtol", type=float, default=_DEFAULT.rtol, show_default=True,
               help="Integration tolerance of the shooting runs.")
+@click.option("--tol", type=float, default=_DEFAULT.tol, show_default=True,
+              help="Tolerance of the shooting residual (scaled |phi_T(x) - x| over the "
+              "orbit's size), of the first orbit and of every point.")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the points and bifurcations as JSON.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
@@ -60,9 +67,10 @@ _DEFAULT = ContinuationSettings()
               help="Show the Newton iterations and the points on a terminal. A kernel's "
               "first compilation is announced either way.")
 def continuation(case_file: Path | None, key: str, target: float, back_to: float | None,
-                 from_file: Path | None, which: int | None, hopf_spec: str | None,
-                 points: int, step: float, max_step: float,
-                 transient: float | None, period: float | None, rtol: float, as_json: bool,
+                 from_file: Path | None, which: int | None, point: int | None,
+                 hopf_spec: str | None, points: int, step: float, max_step: float,
+                 transient: float | None, period: float | None, rtol: float, tol: float,
+                 as_json: bool,
                  output: Path | None, progress: bool) -> None:
     """Follow a periodic orbit of CASE_FILE (constant speed) as --key goes --to a value.
 
@@ -83,7 +91,8 @@ def continuation(case_file: Path | None, key: str, target: float, back_to: float
     if which is not None and from_file is None:
         raise FivdiscError("--bifurcation needs --from BRANCH (a file of fivdisc continue -o)")
     try:
-        settings = _DEFAULT.replace(max_points=points, step=step, max_step=max_step, rtol=rtol)
+        settings = _DEFAULT.replace(max_points=points, step=step, max_step=max_step, rtol=rtol,
+                                    tol=tol)
     except FivdiscError as exc:
         # The settings name their fields; the message names the option given.
         name, _, rest = str(exc).partition(" = ")
@@ -91,17 +100,17 @@ def continuation(case_file: Path | None, key: str, target: float, back_to: float
         raise FivdiscError(f"{option} = {rest}") from None
     if hopf_spec is not None:
         if (from_file is not None or transient is not None or period is not None
-                or back_to is not None):
+                or back_to is not None or point is not None):
             raise FivdiscError("--from-hopf starts at a Hopf point: leave out --from, "
-                               "--transient, --period and --back-to")
+                               "--point, --transient, --period and --back-to")
         branch = _from_hopf(case_file, key, target, hopf_spec, settings, progress)
         if out is not None:
             branch.to_netcdf(out)
         click.echo(branch.to_json() if as_json else str(branch))
         sys.exit(130 if branch.stop_reason == INTERRUPTED else 1 if branch.lost else 0)
     try:
-        case, orbit, along, search = _start(case_file, from_file, which, key, target, rtol,
-                                            transient, period)
+        case, orbit, along, search = _start(case_file, from_file, which, point, key, target,
+                                            rtol, tol, transient, period)
         if back_to is not None:
             check_window(key, check_key(case, key), target, back_to, "--back-to")
         branch = continue_orbit(case, key, target, orbit=orbit, along=along,
@@ -166,14 +175,14 @@ def _checked(case, key: str, target: float):
     return case
 
 
-def _start(case_file, from_file, which, key, target, rtol, transient, period):
+def _start(case_file, from_file, which, point, key, target, rtol, tol, transient, period):
     """The case, the orbit to start from (None: searched as fivdisc orbit does), the
     branch-switching direction, and the search's options; the key and the target are
     checked before any orbit is computed."""
     from fivdisc.analysis.orbits import periodic_orbit, saved_start
     from fivdisc.case import load_case
     from fivdisc.continuation.branch import CONTENT, open_branch
-    from fivdisc.continuation.starts import doubled_start
+    from fivdisc.continuation.starts import broken_start, doubled_start
     from fivdisc.errors import FivdiscError
 
     case = load_case(case_file) if case_file is not None else None
@@ -181,38 +190,49 @@ def _start(case_file, from_file, which, key, target, rtol, transient, period):
     if from_file is None:
         if case is None:
             raise FivdiscError("continue needs CASE_FILE or --from FILE")
+        if point is not None:
+            raise FivdiscError("--point needs --from BRANCH (a file of fivdisc continue -o)")
         return _checked(case, key, target), None, None, search
     from fivdisc.files import read_dataset
 
     if read_dataset(from_file, "--from").attrs.get("content") == CONTENT:
         br = open_branch(from_file)
-        case = case or br.case
         if br.key != key:
             raise FivdiscError(f"--key {key} differs from the branch's key {br.key}: a branch "
                                "is continued in its own key")
-        phases = br.dataset["phase"].values
         if which is None:
-            value = float(br.parameter[-1])
-            state, per, kind = br.dataset["state"].values[-1], float(br.period[-1]), ""
-        else:
-            bifs = br.bifurcations()
-            if not 0 <= which < len(bifs):
-                raise FivdiscError(f"--bifurcation {which} is invalid: the branch has "
-                                   f"{len(bifs)} bifurcation(s), numbered from 0")
-            b = bifs[which]
-            value, state, per, kind = b["parameter"], b["state"], b["period"], b["kind"]
+            saved = saved_start(from_file, point)
+            case = _checked(case or saved.case, key, target).replace({key: saved.value})
+            orbit = periodic_orbit(case, saved.state, period=saved.period,
+                                   phases=saved.phases, rtol=rtol, tol=tol,
+                                   start=saved.start)
+            return case, orbit, None, {}
+        if point is not None:
+            raise FivdiscError("--point and --bifurcation both name where on the branch to "
+                               "start: give one")
+        case = case or br.case
+        bifs = br.bifurcations()
+        if not 0 <= which < len(bifs):
+            raise FivdiscError(f"--bifurcation {which} is invalid: the branch has "
+                               f"{len(bifs)} bifurcation(s), numbered from 0")
+        b = bifs[which]
+        value, state, per, kind = b["parameter"], b["state"], b["period"], b["kind"]
+        phases = b["phases"]
         case = _checked(case, key, target).replace({key: value})
         if kind == "period doubling":
             orbit, along = doubled_start(case, state, per, phases, rtol=rtol)
             return case, orbit, along, {}
-        orbit = periodic_orbit(case, state, period=per, phases=phases, rtol=rtol,
-                               start=f"from the branch in {from_file}")
+        if kind == "symmetry breaking":
+            orbit, along = broken_start(case, state, per, phases, b, rtol=rtol)
+            return case, orbit, along, {}
+        orbit = periodic_orbit(case, state, period=per, phases=phases, rtol=rtol, tol=tol,
+                               start=f"from bifurcation {which} of the branch in {from_file}")
         return case, orbit, None, {}
-    stored, state, phases, saved_period, start = saved_start(from_file)
-    case = case or stored
+    saved = saved_start(from_file, point)
+    case = case or saved.case
     if case is None:
         raise FivdiscError(f"--from {from_file} stores no case: give CASE_FILE")
     _checked(case, key, target)
-    orbit = periodic_orbit(case, state, period=period or saved_period, phases=phases,
-                           rtol=rtol, start=start)
+    orbit = periodic_orbit(case, saved.state, period=period or saved.period,
+                           phases=saved.phases, rtol=rtol, tol=tol, start=saved.start)
     return case, orbit, None, {}

@@ -34,13 +34,28 @@ def _report(res, case, as_json: bool, out: Path | None) -> None:
 @click.option("--from", "from_file", type=click.Path(dir_okay=False, exists=True,
                                                      path_type=Path),
               help="Start from a saved state instead of a transient: an orbit file "
-              "(fivdisc orbit -o) or a simulation result (its final state). Without "
-              "CASE_FILE, the case stored in the file is used.")
+              "(fivdisc orbit -o), a simulation result (its final state) or a branch "
+              "(fivdisc continue -o; its last point or --point K, at the key's value "
+              "there). Without CASE_FILE, the case stored in the file is used.")
+@click.option("--point", type=int,
+              help="With --from BRANCH: start from its point K (from 0; negative from the "
+              "end).")
 @click.option("--window", type=float, default=1.0, show_default=True,
               help="How long to follow the trajectory for its first return [s].")
 @click.option("--rtol", type=float, default=1e-12, show_default=True,
               help="Integration tolerance of the shooting runs (sets the multipliers' "
               "accuracy).")
+@click.option("--tol", type=float, default=1e-8, show_default=True,
+              help="Tolerance of the shooting residual (scaled |phi_T(x) - x| over the "
+              "orbit's size). A Newton stall within the integration's own accuracy is "
+              "converged at that accuracy (said so); one on a discontinuity of the "
+              "shooting map is not, and names the pads whose switches change order.")
+@click.option("--symmetric", is_flag=True,
+              help="Where the pads are identical and equally spaced (fivdisc orbit prints "
+              "the case's symmetry) and the orbit found has a spatio-temporal symmetry "
+              "(x(t + T/n) = P x(t): the pads in turn), solve it over T/n with the pads "
+              "permuted: n times shorter runs, symmetric by construction; the multipliers "
+              "are the full period's.")
 @click.option("--json", "as_json", is_flag=True,
               help="Print period, multipliers, verdict and residual as JSON.")
 @click.option("-o", "--output", type=_NC, help="Write the orbit to a netCDF file (.nc).")
@@ -48,8 +63,8 @@ def _report(res, case, as_json: bool, out: Path | None) -> None:
               help="Show the Newton iterations on a terminal. A kernel's first compilation "
               "is announced either way.")
 def orbit(case_file: Path | None, period: float | None, transient: float | None,
-          from_file: Path | None, window: float, rtol: float, as_json: bool,
-          output: Path | None, progress: bool) -> None:
+          from_file: Path | None, point: int | None, window: float, rtol: float, tol: float,
+          symmetric: bool, as_json: bool, output: Path | None, progress: bool) -> None:
     """Periodic orbit of CASE_FILE (constant speed) and its Floquet multipliers.
 
     Runs the case for its duration (or --transient), finds the first return of the
@@ -70,16 +85,24 @@ def orbit(case_file: Path | None, period: float | None, transient: float | None,
     guess = phases = None
     start = ""
     case = load_case(case_file) if case_file is not None else None
+    if point is not None and from_file is None:
+        raise FivdiscError("--point needs --from BRANCH (a file of fivdisc continue -o)")
     if from_file is not None:
-        stored, guess, phases, saved_period, start = saved_start(from_file)
-        case = case or stored
-        period = period if period is not None else saved_period
+        saved = saved_start(from_file, point)
+        guess, phases, start = saved.state, saved.phases, saved.start
+        case = case or saved.case
+        if saved.key and case is not saved.case:
+            case = case.replace({saved.key: saved.value})
+        period = period if period is not None else saved.period
     if case is None:
         raise FivdiscError("orbit needs CASE_FILE, or --from a file that stores its case")
     check_orbit_request(case, period=period, transient=transient, window=window, rtol=rtol)
+    if not (tol > 0 and tol < 1):
+        raise FivdiscError(f"--tol = {tol!r} is invalid: must be in (0, 1)")
     try:
         res = periodic_orbit(case, guess, period=period, phases=phases, transient=transient,
-                             window=window, rtol=rtol, start=start, progress=progress)
+                             window=window, rtol=rtol, tol=tol, start=start,
+                             progress=progress, symmetric=symmetric)
     except ConvergenceError as exc:
         if as_json and exc.result is not None:
             click.echo(exc.result.to_json())

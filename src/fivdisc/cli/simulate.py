@@ -12,17 +12,30 @@ from fivdisc.cli._case import CASE, default_output
 
 
 @click.command()
-@click.argument("case_file", type=CASE)
+@click.argument("case_file", type=CASE, required=False)
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               help="netCDF file for the result [default: CASE_FILE with .nc; for an example, "
-              "NAME.nc in the working directory].")
+              "NAME.nc in the working directory; with --from only, FILE's name with "
+              "-continued.nc].")
+@click.option("--from", "from_file", type=click.Path(dir_okay=False, exists=True,
+                                                     path_type=Path),
+              help="Start from a saved state instead of simulation.initial_state: a "
+              "simulation result (its final state), an orbit (fivdisc orbit -o) or a branch "
+              "(fivdisc continue -o; its last point or --point K, at the key's value "
+              "there). Without CASE_FILE, the case stored in the file is used.")
+@click.option("--point", type=int,
+              help="With --from BRANCH: start from its point K (from 0; negative from the "
+              "end).")
 @click.option("--progress/--no-progress", default=True, show_default=True,
               help="Show a progress bar in simulated time.")
-def simulate(case_file: Path, output: Path | None, progress: bool) -> None:
+def simulate(case_file: Path | None, output: Path | None, from_file: Path | None,
+             point: int | None, progress: bool) -> None:
     """Simulate CASE_FILE and write the time histories and events as netCDF.
 
     CASE_FILE is a TOML case file or the name of a packaged example (``fivdisc examples``),
-    e.g. ``fivdisc simulate fig10 -o fig10.nc``.
+    e.g. ``fivdisc simulate fig10 -o fig10.nc``. With --from FILE the run starts from the
+    state FILE holds (its case's simulation.initial_state is not used; the output says
+    so), and CASE_FILE may be left out.
 
     A failed run (non-finite state, step-size underflow, endless switching) still
     writes what was computed, marked as failed, and exits with status 1. If the output
@@ -32,16 +45,35 @@ def simulate(case_file: Path, output: Path | None, progress: bool) -> None:
     from fivdisc.case import load_case
     from fivdisc.engine.preload import warm_up
     from fivdisc.engine.simulation import simulate as run
+    from fivdisc.errors import FivdiscError
     from fivdisc.files import NETCDF, check_output
 
-    case = load_case(case_file)
-    out = check_output(output or default_output(case_file, ".nc"), "-o", NETCDF,
-                       inputs=[case_file])
+    if point is not None and from_file is None:
+        raise FivdiscError("--point needs --from BRANCH (a file of fivdisc continue -o)")
+    case = load_case(case_file) if case_file is not None else None
+    initial = phases = None
+    if from_file is not None:
+        from fivdisc.analysis.orbits import saved_start
+
+        saved = saved_start(from_file, point)
+        if case is None:
+            case = saved.case
+        elif saved.key:
+            case = case.replace({saved.key: saved.value})
+        initial, phases = saved.state, saved.phases
+    if case is None:
+        raise FivdiscError("simulate needs CASE_FILE, or --from a file that stores its case")
+    inputs = [p for p in (case_file, from_file) if p is not None]
+    name = case_file if case_file is not None else from_file.with_name(
+        from_file.stem + "-continued.nc")
+    out = check_output(output or default_output(name, ".nc"), "-o", NETCDF, inputs=inputs)
     imported = warm_up("netcdf")
-    result = run(case, progress=progress).named(case_file.stem)
+    result = run(case, initial=initial, phases=phases, progress=progress).named(name.stem)
     imported()
     _save(result, out)
     click.echo(f"wrote {out}")
+    if from_file is not None:
+        click.echo(f"started {saved.start} (simulation.initial_state is not used)")
     for line in result.summary().lines()[1:]:
         click.echo(line)
     if not result.ok:

@@ -35,6 +35,7 @@ def simulate(
     speed: SpeedProfile | tuple[Callable, Callable] | None = None,
     stop_on: tuple[str, ...] = (),
     progress: bool = False,
+    phases=None,
 ) -> Result:
     """Integrate the slider-on-disc system of ``case``.
 
@@ -54,6 +55,11 @@ def simulate(
     progress : bool
         Show a progress bar in simulated time, and a notice while the kernel compiles
         (the first run of a fresh installation).
+    phases : array of int, optional
+        Each slider's phase at the start (``layout.SLIP``, ``STICK``, ``SEPARATION``), for
+        a state saved mid-run (a result's ``final_phase``): a slider given as separated
+        starts flying from its own ``z``, ``zdot``; the others take the phase their state
+        allows. Default: all in contact.
 
     Returns
     -------
@@ -97,8 +103,13 @@ def simulate(
             f"more than {limit.DIVERGED:g} times disc.thickness, where the run would end as "
             "diverged"
         )
+    if phases is not None:
+        phases = np.asarray(phases, dtype=np.int64)
+        if phases.shape != (model.n_sliders,):
+            raise SimulationError(f"phases has shape {phases.shape}: must be "
+                                  f"({model.n_sliders},), one phase per slider")
     run = Integration(model, y0, duration=sim.duration, output_rate=sim.output_rate,
-                      stop_on=stop_on, energy=sim.energy_balance)
+                      stop_on=stop_on, energy=sim.energy_balance, phases=phases)
 
     # A first call with target 0 only sets up the start: it compiles or loads the kernel
     # before the progress bar starts, so the bar's rate and estimate are the integrator's
