@@ -89,15 +89,18 @@ class Cycle:
 
 
 def one_period(model: Model, x0: np.ndarray, phases: np.ndarray, period: float,
-               rtol: float, atol: float) -> Cycle:
+               rtol: float, atol: float, max_step: float | None = None) -> Cycle:
     """Follow the orbit through ``x0`` (phases ``phases``) over one ``period`` [s].
 
     The run stops at every switch to read each slider's new phase and slip direction,
-    so that a phase however short is in the signature.
+    so that a phase however short is in the signature. ``max_step`` [s] caps the steps
+    as the shooting runs do (:meth:`fivdisc.analysis.orbits.Shooting.cycle`): next to a
+    border where switches of different sliders change order, runs with other steps may
+    fall on its other side.
     """
     ns = model.n_sliders
     run = Integration(model, x0, duration=period, output_rate=_SAMPLES / period, rtol=rtol,
-                      atol=atol, phases=phases, stop_on=EVENT_KINDS)
+                      atol=atol, phases=phases, stop_on=EVENT_KINDS, max_step=max_step)
     run.advance(0.0)
     seqs = [[phase_label(run.ph[j], run.sg[j])] for j in range(ns)]
     stick_free = [not np.any(run.ph == lay.STICK)]

@@ -286,6 +286,15 @@ class Shooting:
         """The same shooting (phases, tolerances, scales) on another model."""
         return Shooting(model, self.phases, self.rtol, self.atol, self.scale)
 
+    def cycle(self, x0: np.ndarray, period: float):
+        """One period of the orbit through ``x0`` (:func:`fivdisc.analysis.cycle.one_period`)
+        with this shooting's phases, tolerances and step cap: its events are those of
+        :meth:`shoot`'s run."""
+        from fivdisc.analysis.cycle import one_period
+
+        return one_period(self.model, self.held(x0), self.phases, period, self.rtol,
+                          self.atol, max_step=self.cap)
+
     def held(self, x0: np.ndarray) -> np.ndarray:
         """``x0`` with the rate of every slider that sticks at the start set to the disc
         speed of this model: the kernel keeps a slider stuck at the start only if it
@@ -476,7 +485,7 @@ def _stall(shooting: Shooting, sol: _Newton) -> Stall:
     own accuracy, on a discontinuity of the shooting map (a line search along the Newton
     step, bisected to where the residual jumps, and the switches whose order flips
     there), or a guess too far."""
-    from fivdisc.analysis.cycle import one_period, order_changes
+    from fivdisc.analysis.cycle import order_changes
 
     x0, period, r0 = sol.x0, sol.period, sol.residual
     eps = accuracy_of(shooting, x0, period, sol.shot.end)
@@ -529,9 +538,8 @@ def _stall(shooting: Shooting, sol: _Newton) -> Stall:
         return Stall("far", STALL, eps)
     model, rtol, atol = shooting.model, shooting.rtol, shooting.atol
     try:
-        ca = one_period(model, shooting.held(lo_x), shooting.phases, lo_t, rtol, atol)
-        cb = one_period(model, shooting.held(hi_x), shooting.phases, hi_t, rtol, atol)
-        flips = order_changes(ca, cb)
+        base = Shooting(model, shooting.phases, rtol, atol, shooting.scale)
+        flips = order_changes(base.cycle(lo_x, lo_t), base.cycle(hi_x, hi_t))
     except FivdiscError:
         flips = []
     where = ("; ".join(flips) if flips else
@@ -838,7 +846,13 @@ def periodic_orbit(
             accuracy = stall.accuracy
         elif sol.reason == STALL:
             sol.reason = stall.text
-    elif not sol.reason and sol.residual > _POLISH * tol and sol.step is not None:
+    elif not sol.reason and sol.residual > _POLISH * tol:
+        # Converged, but the polishing step did not take the residual below the
+        # tolerance's level: why not, from a fresh Newton step.
+        if sol.step is None:
+            sol.step = np.linalg.lstsq(shooting.jacobian(sol.shot),
+                                       np.r_[-shooting.gap(sol.shot, sol.x0), 0.0],
+                                       rcond=None)[0]
         stall = _stall(shooting, sol)
         if stall.kind == "discontinuous":
             notes.append(f"converged to the tolerance {tol:g} but no further: {stall.text}")
