@@ -67,6 +67,13 @@ class Cycle:
         :data:`~fivdisc.engine.result.EVENT_KINDS`, slider).
     period : float
         The period [s].
+    dips : tuple of (int, str, float, float)
+        Interior minima of the phases' margins, as (slider, ``"stick"`` or ``"slip"``,
+        value, time [s]): inside a stick phase the static margin ``(mu_s N - |f|) /
+        (mu_s N)``, inside a slip phase the slip speed ``|Omega - phidot| / Omega``
+        (parabola through the samples at the minimum). One that reaches zero is where a
+        phase appears inside another (a stick phase splits, a slip phase grazes the disc
+        speed).
     """
 
     signature: tuple[str, ...]
@@ -75,6 +82,7 @@ class Cycle:
     stick_free: np.ndarray
     events: tuple[tuple[float, str, int], ...] = ()
     period: float = np.nan
+    dips: tuple[tuple[int, str, float, float], ...] = ()
 
     def cyclic(self) -> tuple[str, ...]:
         """The signature as a cycle, independent of where on the orbit it starts: per
@@ -135,8 +143,38 @@ def one_period(model: Model, x0: np.ndarray, phases: np.ndarray, period: float,
     for name, values in columns.items():
         measures[f"{name}_max"] = values.max(axis=0)
         measures[f"{name}_min"] = values.min(axis=0)
+    dips = _dips(model, y, aux, period / _SAMPLES)
     return Cycle(tuple(" > ".join(s) for s in seqs), measures, times, np.array(stick_free),
-                 events, float(period))
+                 events, float(period), dips)
+
+
+def _dips(model: Model, y: np.ndarray, aux: np.ndarray, dt: float
+          ) -> tuple[tuple[int, str, float, float], ...]:
+    """Interior minima of each phase's margin over the samples (see :class:`Cycle`)."""
+    ns = model.n_sliders
+    mus = float(model.kernel.opts[lay.O_MUS])
+    omega = abs(float(model.speed.omega(0.0))) or 1.0
+    out = []
+    for j in range(ns):
+        phase = aux[:, 2 * ns + j]
+        normal, force = aux[:, j], aux[:, ns + j]
+        rate = y[:, model.index("phi_dot", j)]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            stick = (mus * normal - np.abs(force)) / (mus * normal)
+        slip = np.abs(omega - rate) / omega
+        for label, code, values in (("stick", lay.STICK, stick), ("slip", lay.SLIP, slip)):
+            inside = phase == code
+            for i in range(2, phase.size - 2):
+                if not (inside[i - 2:i + 3].all() and values[i] <= values[i - 1]
+                        and values[i] < values[i + 1]):
+                    continue
+                a, b, c = values[i - 1], values[i], values[i + 1]
+                curve = a - 2 * b + c
+                shift = 0.5 * (a - c) / curve if curve > 0 else 0.0
+                low = b - 0.25 * (a - c) * shift
+                if np.isfinite(low):
+                    out.append((j, label, float(low), float((i + shift) * dt)))
+    return tuple(out)
 
 
 #: What each event kind is called in words.

@@ -421,13 +421,14 @@ def classify_reduced(mu: complex, k: int) -> Crossing | None:
                         f"without the T/{k} symmetry branch off (a pitchfork of the "
                         "symmetry)")
     turns = abs(k * delta)
+    every = 1 / max(turns, 1e-300)
     return Crossing("symmetry breaking",
                     f"a pair of the T/{k} map crosses the unit circle at the angle "
                     f"2 pi ({m}/{k} {'+' if delta >= 0 else '-'} {abs(delta):.2g}): near the "
                     f"{m}:{k} resonance, a Neimark-Sacker bifurcation of the T/{k} map that "
                     f"breaks the T/{k} symmetry (the period's multipliers at "
                     f"+-{turns:.2g} turns: the motion beyond is nearly of period T without "
-                    f"the symmetry, drifting through its {k} images every ~{1 / max(turns, 1e-300):.3g} "
+                    f"the symmetry, drifting through its {k} images every ~{every:.3g} "
                     "periods)")
 
 

@@ -16,7 +16,6 @@ from typing import NamedTuple
 
 from pydantic import BaseModel
 
-
 #: The slider "index" of a key that names every slider: ``sliders.*.mass``.
 EVERY = "*"
 

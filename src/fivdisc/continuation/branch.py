@@ -86,6 +86,18 @@ class Branch:
         """Whether the continuation stopped because the orbit was lost."""
         return bool(self.dataset.attrs["lost"])
 
+    def phases(self, point: int) -> np.ndarray:
+        """Each slider's phase at a point's state (files of fivdisc 0.x before issue 36
+        have one set of phases for every point)."""
+        phase = self.dataset["phase"].values
+        return (phase[point] if phase.ndim == 2 else phase).astype(np.int64)
+
+    def symmetries(self) -> list[str]:
+        """Each point's orbit symmetry in words ("" where the case has none)."""
+        if "symmetry" not in self.dataset:
+            return [""] * len(self)
+        return [str(s) for s in self.dataset["symmetry"].values]
+
     def signature(self, point: int) -> tuple[str, ...]:
         """The event signature of a point, per slider."""
         return tuple(str(s) for s in self.dataset["signature"].values[point])
@@ -112,6 +124,11 @@ class Branch:
                 "point": int(ds["bifurcation_point"].values[i]),
                 "note": str(ds["note"].values[i]),
                 "state": ds["bifurcation_state"].values[i].copy(),
+                "period_after": (float(ds["bifurcation_period_after"].values[i])
+                                 if "bifurcation_period_after" in ds else math.nan),
+                "phases": (ds["bifurcation_phase"].values[i].astype(np.int64)
+                           if "bifurcation_phase" in ds else self.phases(
+                               int(ds["bifurcation_point"].values[i]))),
             })
         return out
 
@@ -145,13 +162,12 @@ class Branch:
         pts = walk.points
         model = problem.base
         ns = model.n_sliders
-        unpacked = [problem.unpack(p.z) for p in pts]
-        params = np.array([u[2] for u in unpacked])
+        params = np.array([p.value for p in pts])
         info = describe_key(problem.key)
         mults = np.array([p.multipliers for p in pts])
         nd = model.state_size
         data: dict[str, Any] = {
-            "period": ("point", np.array([u[1] for u in unpacked]),
+            "period": ("point", np.array([p.period for p in pts]),
                        {"long_name": "period", "units": "s"}),
             "state": (("point", "coordinate"), np.array([p.x for p in pts]),
                       {"long_name": "point on the orbit (state layout)"}),
@@ -169,9 +185,27 @@ class Branch:
                        {"long_name": "orbit is stable (1) or unstable (0)"}),
             "residual": ("point", np.array([p.residual for p in pts]),
                          {"long_name": "scaled shooting residual", "units": "1"}),
-            "phase": ("slider", problem.shooting.phases,
+            "phase": (("point", "slider"), np.array([p.phases for p in pts], dtype=np.int64),
                       {"long_name": "phase at the point (0 slip, 1 stick, 2 separation)"}),
+            "symmetry": ("point", np.array([p.symmetry for p in pts], dtype=str),
+                         {"long_name": "the orbit's symmetry (\"\" where the case has none)"}),
+            "near_border": ("point", np.array([p.near_border for p in pts], dtype=np.int8),
+                            {"long_name": "d phi_T / dp taken one-sided: the held flow map "
+                             "jumps within 1e-6 of the key"}),
         }
+        reduced = [p.reduced for p in pts]
+        if any(r is not None for r in reduced):
+            width = max(r.size for r in reduced if r is not None)
+            table_r = np.full((len(pts), width), np.nan + 0j)
+            for i, r in enumerate(reduced):
+                if r is not None:
+                    table_r[i, : r.size] = r[np.argsort(-np.abs(r), kind="stable")]
+            for part in ("real", "imag"):
+                data[f"reduced_multiplier_{part}"] = (
+                    ("point", "reduced"), getattr(table_r, part),
+                    {"long_name": "eigenvalue of the reduced map P^-1 d phi_{T/k} of an orbit "
+                     f"with a spatio-temporal symmetry (nan: none), {part} part",
+                     "units": "1"})
         for name, (long_name, unit) in MEASURES.items():
             for end, word in (("max", "largest"), ("min", "smallest")):
                 data[f"{name}_{end}"] = (
@@ -203,6 +237,15 @@ class Branch:
                           "units": "1"}),
             "note": ("bifurcation", np.array([b.note for b in bif], dtype=str),
                      {"long_name": "what happens there"}),
+            "bifurcation_period_after": ("bifurcation",
+                                         table([b.period_after for b in bif], 0),
+                                         {"long_name": "period on the other side of a jump",
+                                          "units": "s"}),
+            "bifurcation_phase": (("bifurcation", "slider"),
+                                  np.array([b.phases if b.phases is not None
+                                            else np.zeros(ns, dtype=np.int64) for b in bif],
+                                           dtype=np.int64).reshape(-1, ns),
+                                  {"long_name": "phase at the bifurcation's state"}),
             "signature_before": (("bifurcation", "slider"),
                                  np.array([list(b.signature_before) for b in bif],
                                           dtype=str).reshape(-1, ns),
@@ -233,7 +276,9 @@ class Branch:
             },
             attrs={"content": CONTENT, "key": problem.key, "case": problem.case.to_toml(),
                    "stop_reason": walk.stop.reason, "lost": int(walk.stop.lost),
-                   "start": start, "rtol": problem.rtol, "tol": problem.tol},
+                   "start": start, "rtol": problem.rtol, "tol": problem.tol,
+                   "symmetry_group": problem.group.description if problem.group else "none",
+                   "end_check": " | ".join(walk.checks)},
         )
         return cls(ds)
 
@@ -252,20 +297,27 @@ class Branch:
             return [{"real": float(m.real), "imag": float(m.imag), "modulus": float(abs(m))}
                     for m in values]
 
+        syms = self.symmetries()
         points = [{"parameter": float(p), "period": float(t), "stable": bool(s),
-                   "signature": list(self.signature(i)), "multipliers": cplx(m)}
+                   "signature": list(self.signature(i)), "multipliers": cplx(m),
+                   "symmetry": syms[i]}
                   for i, (p, t, s, m) in enumerate(zip(self.parameter, self.period, self.stable,
                                                        self.multipliers, strict=True))]
         bifs = []
         for b in self.bifurcations():
-            entry = {k: v for k, v in b.items() if k not in ("state", "before", "after")}
+            entry = {k: v for k, v in b.items() if k not in ("state", "before", "after",
+                                                             "phases")}
             entry["rotation"] = None if math.isnan(b["rotation"]) else b["rotation"]
+            entry["period_after"] = (None if math.isnan(b["period_after"])
+                                     else b["period_after"])
             entry["before"], entry["after"] = cplx(b["before"]), cplx(b["after"])
             entry["signature_before"] = list(b["signature_before"])
             entry["signature_after"] = list(b["signature_after"])
             bifs.append(entry)
         return {"key": self.key, "points": points, "bifurcations": bifs,
                 "stop_reason": self.stop_reason, "lost": self.lost,
+                "symmetry_group": str(self.dataset.attrs.get("symmetry_group", "none")),
+                "end_check": str(self.dataset.attrs.get("end_check", "")),
                 "start": str(self.dataset.attrs.get("start", "")),
                 **({"hopf": {**hopf, "bistable": [None if math.isnan(b) else b
                                                   for b in hopf["bistable"]]}}
@@ -311,11 +363,28 @@ class Branch:
             else:
                 reach = f"{low:.9g} to {high:.9g}{unit}"
             lines.append("bistable range (stable sliding and a stable vibration): " + reach)
+        group = str(self.dataset.attrs.get("symmetry_group", "none"))
+        if group != "none":
+            syms = self.symmetries()
+            runs = []
+            for i, sym in enumerate(syms):
+                if runs and runs[-1][0] == sym:
+                    runs[-1][2] = i
+                else:
+                    runs.append([sym, i, i])
+            lines.append(f"symmetry of the case: {group}; of the orbits: " + "; ".join(
+                f"{sym or 'none'} (points {a}-{b})" if a != b else f"{sym or 'none'} (point {a})"
+                for sym, a, b in runs))
         bifs = self.bifurcations()
         lines.append(f"bifurcations: {len(bifs) or 'none'}")
         for b in bifs:
+            after = (f" -> {b['period_after']:.9g} s" if not math.isnan(b["period_after"])
+                     else "")
             lines.append(f"  {b['kind']} at {self.key} = {b['parameter']:.9g}{unit}, "
-                         f"T = {b['period']:.9g} s: {b['note']}")
+                         f"T = {b['period']:.9g} s{after}: {b['note']}")
+        check = str(self.dataset.attrs.get("end_check", ""))
+        if check:
+            lines.append(f"end confirmed by: {check}")
         return "\n".join(lines)
 
 

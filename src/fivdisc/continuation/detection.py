@@ -4,15 +4,13 @@ location along the arclength, and their records."""
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
 
-from fivdisc.analysis.cycle import Cycle, one_period
+from fivdisc.analysis.symmetry import classify_reduced, isotypic
 from fivdisc.continuation.problem import OrbitProblem, Point
 from fivdisc.continuation.settings import LOCATE, REAL
-from fivdisc.errors import ConvergenceError, FivdiscError
 
 
 @dataclass
@@ -23,9 +21,18 @@ class Bifurcation:
     ----------
     kind : str
         ``"fold"``, ``"period doubling"``, ``"torus"``, ``"branch point"`` (a real
-        multiplier through +1 without a fold), ``"signature change"``
-        (discontinuity-induced) or ``"grazing"`` (the branch ends where its slip speed
-        touches zero, at its last point).
+        multiplier through +1 without a fold), ``"symmetry breaking"`` (a multiplier
+        crossing whose eigenvector breaks the orbit's symmetry: see
+        :mod:`fivdisc.analysis.symmetry`), the discontinuity-induced ones:
+        ``"signature change"`` (a phase of a slider appears or vanishes),
+        ``"switching order"`` (switches of different sliders change order, the flow map
+        continuous), ``"discontinuity"`` (they change order and the flow map jumps: the
+        branch jumps with it to the orbit of the other side), and the ends:
+        ``"discontinuity end"`` and ``"cascade end"`` (the flow map jumps and no orbit
+        lies past the border), ``"grazing"`` (the branch ends where its slip speed
+        touches zero, at its last point), ``"end"`` (the branch is lost there, no border
+        found), and ``"gap"`` (the corrector could not follow, a forward run found the
+        orbit again past it).
     parameter : float
         The key's value there [its unit].
     period : float
@@ -44,6 +51,10 @@ class Bifurcation:
         Index of the branch point before it.
     note : str
         What happens there in words.
+    period_after : float
+        Where the branch jumps: the period on the other side [s]; else nan.
+    phases : ndarray of int
+        Each slider's phase at ``state``.
     """
 
     kind: str
@@ -57,6 +68,8 @@ class Bifurcation:
     rotation: float = math.nan
     point: int = 0
     note: str = ""
+    period_after: float = math.nan
+    phases: np.ndarray | None = None
 
 
 def outside_counts(mult: np.ndarray, trivial: int) -> tuple[int, int, int]:
@@ -170,7 +183,7 @@ def locate(problem: OrbitProblem, a: Point, b: Point, s_ab: float, kind: str,
     multiplier's, followed from its straight-line guess."""
     from scipy.optimize import brentq
 
-    p_tol = LOCATE * max(abs(problem.unpack(a.z)[2]), 1e-12) / problem.ps
+    p_tol = LOCATE * max(abs(a.value), 1e-12) / problem.ps
     if kind == "signature change":
         lo, hi, s_lo, s_hi = a, b, 0.0, s_ab
         key = a.cycle.cyclic()
@@ -200,14 +213,13 @@ def locate(problem: OrbitProblem, a: Point, b: Point, s_ab: float, kind: str,
 
 
 def bifurcation_record(problem: OrbitProblem, kind: str, lo: Point, hi: Point, index: int,
-                 sides: tuple[Point, Point] | None = None) -> Bifurcation:
+                       sides: tuple[Point, Point] | None = None) -> Bifurcation:
     """The record of a bifurcation located at ``lo`` (a smooth one, ``hi`` the same) or
     between ``lo`` and ``hi`` (a signature change). Its multipliers before and after are
     those of ``sides`` if given (the branch's points either side of a smooth one, where
-    the passing multiplier shows), else of ``lo`` and ``hi``."""
+    the passing multiplier shows), else of ``lo`` and ``hi``. A smooth one on a symmetric
+    orbit is classified by its critical eigenvector's symmetry (:func:`symmetric_kind`)."""
     before, after = sides if sides is not None else (lo, hi)
-    _, t_lo, p_lo = problem.unpack(lo.z)
-    _, t_hi, p_hi = problem.unpack(hi.z)
     at = hi if kind == "signature change" else lo
     rotation = math.nan
     note = ""
@@ -222,13 +234,75 @@ def bifurcation_record(problem: OrbitProblem, kind: str, lo: Point, hi: Point, i
     elif kind == "branch point":
         note = "a real multiplier crosses +1 without a fold"
     else:
-        sides = [f"slider {j}: {u} -> {v}" for j, (u, v) in
-                 enumerate(zip(lo.cycle.signature, hi.cycle.signature, strict=True)) if u != v]
-        note = "the event signature changes (" + "; ".join(sides) + ")"
-    return Bifurcation(kind=kind, parameter=0.5 * (p_lo + p_hi), period=0.5 * (t_lo + t_hi),
-                       state=at.x.copy(), before=before.multipliers, after=after.multipliers,
+        sides_ = [f"slider {j}: {u} -> {v}" for j, (u, v) in
+                  enumerate(zip(lo.cycle.signature, hi.cycle.signature, strict=True)) if u != v]
+        note = "the event signature changes (" + "; ".join(sides_) + ")"
+    if kind in ("torus", "period doubling", "branch point"):
+        found = symmetric_kind(kind, at, before, after)
+        if found is not None:
+            new_kind, extra = found
+            if new_kind != kind:
+                kind, note = new_kind, extra
+            else:
+                note = f"{note}; {extra}"
+    return Bifurcation(kind=kind, parameter=0.5 * (lo.value + hi.value),
+                       period=0.5 * (lo.period + hi.period), state=at.x.copy(),
+                       before=before.multipliers, after=after.multipliers,
                        signature_before=lo.cycle.signature, signature_after=hi.cycle.signature,
-                       rotation=rotation, point=index, note=note)
+                       rotation=rotation, point=index, note=note, phases=at.phases.copy())
+
+
+def _reduced_crossings(a: Point, b: Point) -> list[tuple[complex, complex]]:
+    """The eigenvalues of the reduced map R (flow direction's left out) that cross the
+    unit circle between ``a`` and ``b``, as their values at each (matched by nearness)."""
+    from scipy.optimize import linear_sum_assignment
+
+    def others(mu: np.ndarray) -> np.ndarray:
+        return np.delete(mu, np.argmin(np.abs(mu - 1.0)))
+
+    ra, rb = others(a.reduced), others(b.reduced)
+    rows, cols = linear_sum_assignment(np.abs(ra[:, None] - rb[None, :]))
+    return [(complex(ra[i]), complex(rb[j])) for i, j in zip(rows, cols, strict=True)
+            if (abs(ra[i]) - 1.0) * (abs(rb[j]) - 1.0) < 0 and ra[i].imag >= -1e-12]
+
+
+def symmetric_kind(kind: str, at: Point, before: Point, after: Point
+                   ) -> tuple[str, str] | None:
+    """What a smooth bifurcation of a symmetric orbit is: ``("symmetry breaking",
+    note)`` when its critical eigenvector breaks the orbit's symmetry (on the reduced map
+    of a spatio-temporal symmetry, a crossing at the angle ``2 pi m / k``, ``m != 0``, or
+    near it: :func:`fivdisc.analysis.symmetry.classify_reduced`; on an in-phase orbit, an
+    eigenvector in a non-trivial eigenspace of ``P``), ``(kind, note)`` with what the
+    symmetry says of it otherwise, None for an orbit without symmetry."""
+    if (before.reduced is not None and after.reduced is not None
+            and before.k == after.k > 1):
+        k = before.k
+        passing = _reduced_crossings(before, after)
+        for mu_a, mu_b in passing:
+            mu = 0.5 * (mu_a + mu_b)
+            found = classify_reduced(mu, k)
+            if found is not None:
+                return found.kind, f"{found.note} ({at.symmetry} on both sides)"
+        if passing:
+            mu = 0.5 * (passing[0][0] + passing[0][1])
+            theta = abs(math.atan2(mu.imag, mu.real)) / (2 * math.pi)
+            return kind, (f"the orbit keeps its symmetry ({at.symmetry}): the T/{k} map's "
+                          f"multiplier crosses at the angle 2 pi x {theta:.6f}")
+    if at.sym is not None and at.sym.spatial:
+        mult, vecs = np.linalg.eig(at.shot.monodromy)
+        crit = nearest_multiplier(at.multipliers, at.trivial, kind) if kind != "branch point" \
+            else 1.0 + 0j
+        i = int(np.argmin(np.abs(mult - crit)))
+        for el in at.sym.spatial:
+            m = isotypic(vecs[:, i], el)
+            if m != 0:
+                forced = " (the symmetry makes it a double multiplier)" if el.order > 2 else ""
+                return ("symmetry breaking",
+                        f"the critical multiplier {mult[i]:.6f}{forced} has an eigenvector "
+                        f"that the {el.label} does not map to itself (the orbit is "
+                        f"{at.symmetry}): orbits without that symmetry branch off")
+        return kind, f"the orbit keeps its symmetry ({at.symmetry})"
+    return None
 
 
 def without_fold_echoes(found: list[Bifurcation]) -> list[Bifurcation]:
@@ -263,7 +337,7 @@ def slip_margin(problem: OrbitProblem, a: Point) -> float:
     """The smallest slip speed ``|Omega - phidot|`` over ``a``'s orbit, relative to the
     disc speed, over the sliders that slip throughout (infinite if none does: a lost
     stick-slip orbit has not grazed)."""
-    _, _, p = problem.unpack(a.z)
+    p = a.value
     speed = p if problem.key == "speed.value" else problem.case.speed.value
     speed = abs(speed)
     margins = []
@@ -277,7 +351,7 @@ def slip_margin(problem: OrbitProblem, a: Point) -> float:
 
 def grazing(problem: OrbitProblem, a: Point, index: int) -> Bifurcation:
     """The end of a branch of slipping orbits lost where its slip speed touches zero."""
-    _, period, p = problem.unpack(a.z)
+    period, p = a.period, a.value
     return Bifurcation(kind="grazing", parameter=p, period=period, state=a.x.copy(),
                        before=a.multipliers, after=a.multipliers,
                        signature_before=a.cycle.signature, signature_after=a.cycle.signature,
@@ -285,77 +359,3 @@ def grazing(problem: OrbitProblem, a: Point, index: int) -> Bifurcation:
                        note=f"the slip speed touches zero (smallest {slip_margin(problem, a):.1e}"
                        " of the disc speed): a stick phase appears and the slipping orbits "
                        "end (the stick-slip orbits leave from here)")
-
-
-def vanishing(problem: OrbitProblem, a: Point, index: int) -> Bifurcation | None:
-    """Where the branch is lost just after ``a``: if the flow from ``a``'s point changes
-    its event signature within a relative change of the key of 1e-3 ahead, the orbit
-    ends at that change (the flow map jumps there, as where a stick phase splits). It is
-    bracketed with ``a``'s point held, then located to 1e-6 by bisection on the orbits
-    themselves: the last value at which the corrector finds the orbit with ``a``'s
-    signature. None if the signature does not change."""
-    x, period, p = problem.unpack(a.z)
-    ahead = np.sign(a.tangent[-1]) or 1.0
-    key = a.cycle.cyclic()
-    scale = max(abs(p), problem.ps * 1e-3)
-
-    def cycle(q: float) -> Cycle:
-        return one_period(problem.model(q), x, problem.shooting.phases, period, problem.rtol,
-                          problem.atol)
-
-    lo, hi, far = p, None, None
-    for k in range(11):
-        q = p + ahead * scale * 1e-6 * 2.0**k
-        try:
-            c = cycle(q)
-        except FivdiscError:
-            continue
-        if c.cyclic() != key:
-            hi, far = q, c
-            break
-        lo = q
-    if hi is None:
-        return None
-    # Refined on the orbits themselves: the last value at which the corrector still finds
-    # the orbit with its signature, the flow from that orbit's point changing its
-    # signature at the upper end of the bracket (where the corrector fails short of the
-    # change, the held point decides).
-    deadline = time.monotonic() + 600.0
-    last, lo = a, p
-
-    def beyond(q: float) -> Cycle | None:
-        x_last, period_last, _ = problem.unpack(last.z)
-        c = one_period(problem.model(q), x_last, problem.shooting.phases, period_last,
-                       problem.rtol, problem.atol)
-        return c if c.cyclic() != key else None
-
-    far = beyond(hi)
-    if far is None:
-        return None
-    while abs(hi - lo) > LOCATE * scale:
-        mid = 0.5 * (lo + hi)
-        try:
-            pt = problem.at_value(last, mid, deadline)
-        except ConvergenceError:
-            pt = None
-        if pt is not None and pt.cycle.cyclic() == key:
-            last, lo = pt, mid
-            far = beyond(hi) or far
-            continue
-        changed = beyond(mid)
-        if changed is not None:
-            hi, far = mid, changed
-        else:
-            lo = mid
-    x, period, _ = problem.unpack(last.z)
-    shot = problem.shooter(hi).shoot(x, period)
-    after, _ = problem.shooting.stability(shot)
-    sides = [f"slider {j}: {u} -> {v}" for j, (u, v) in
-             enumerate(zip(last.cycle.signature, far.signature, strict=True)) if u != v]
-    return Bifurcation(kind="signature change", parameter=0.5 * (lo + hi), period=period,
-                       state=x.copy(), before=last.multipliers, after=after,
-                       signature_before=last.cycle.signature, signature_after=far.signature,
-                       point=index,
-                       note="the event signature changes (" + "; ".join(sides) + ") and the "
-                       "orbit does not persist past it (multipliers after: of the flow map "
-                       "from the last orbit's point)")

@@ -17,6 +17,24 @@ MIN_COSINE = 0.5
 MAX_NEWTON = 10
 # Relative step of the central difference d phi_T / dp.
 DP_STEP = 1e-6
+# The two one-sided differences of d phi_T / dp agree to this (relative) on a smooth
+# piece; where they do not, the held flow map jumps within DP_STEP of the point (two pads'
+# switches change order there) and the difference is taken on one side.
+DP_CONSISTENT = 1e-2
+# A point is moved along its orbit when a switch has come within this fraction of the
+# switch-free interval it lies in.
+REANCHOR = 0.25
+# A point that did not polish is refused when switches of different pads lie within this
+# fraction of the period of each other (next to a border where they change order).
+NEAR_SWITCHES = 1e-5
+# The orbit found past a border where the flow map jumps is the branch's continuation if
+# its point lies within this (scaled, relative to the orbit's size) of the border orbit's.
+OTHER_PIECE = 1e-3
+# Where the forward run that confirms an end starts: this fraction past the end.
+PAST = 2e-3
+# A forward run has settled on a periodic orbit when its returns to the section come
+# back within this (scaled, relative to the orbit's size).
+SETTLES = 1e-6
 # Relative accuracy in the parameter to which bifurcations are located.
 LOCATE = 1e-7
 # A converged point is refined while its residual falls, to below this fraction of the
@@ -61,6 +79,9 @@ class ContinuationSettings:
         :func:`~fivdisc.analysis.orbits.periodic_orbit`.
     time_budget : float
         Wall time after which the continuation stops [s].
+    confirm_periods : int
+        Length of the forward run that confirms each end of the branch, in periods
+        (from the last orbit's point, :data:`PAST` past the end); 0: none.
 
     Examples
     --------
@@ -77,6 +98,7 @@ class ContinuationSettings:
     atol: float | None = None
     tol: float = 1e-8
     time_budget: float = 3600.0
+    confirm_periods: int = 400
 
     def __post_init__(self) -> None:
         for name in ("step", "max_step", "min_step", "time_budget", "tol", "rtol"):
@@ -95,6 +117,10 @@ class ContinuationSettings:
                                                      and self.max_points >= 1):
             raise FivdiscError(f"max_points = {self.max_points!r} is invalid: must be an "
                                "integer >= 1")
+        if isinstance(self.confirm_periods, bool) or not (
+                isinstance(self.confirm_periods, int) and 0 <= self.confirm_periods <= 10**6):
+            raise FivdiscError(f"confirm_periods = {self.confirm_periods!r} is invalid: must "
+                               "be an integer in [0, 1000000]")
 
     @property
     def atol_run(self) -> float:

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from fivdisc.analysis.cycle import one_period
 from fivdisc.analysis.orbits import (
     PeriodicOrbit,
     Shooting,
@@ -14,54 +13,37 @@ from fivdisc.analysis.orbits import (
 from fivdisc.case import Case
 from fivdisc.continuation.problem import OrbitProblem, Point
 from fivdisc.continuation.settings import DOUBLED_AMPLITUDE
-from fivdisc.engine.integration import Integration
 from fivdisc.errors import FivdiscError
 from fivdisc.model.build import build_model
 
 
 def start_point(problem: OrbitProblem, orbit: PeriodicOrbit, direction: float,
-                 along: np.ndarray | None, deadline: float) -> Point:
+                along: np.ndarray | None, deadline: float) -> Point:
     """The first point: the orbit moved to the middle of its longest interval without a
-    switch in which no slider sticks (so that the point stays away from switches along
-    the branch, and no coordinate of it is held by a sticking slider).
+    switch (so that the point stays away from switches along the branch; inside a stick
+    phase the stuck sliders' rates are held at the disc speed, whatever the key's
+    value).
 
-    With ``along`` (branch switching at a period doubling: ``orbit`` is the orbit at the
-    point traversed twice, ``along`` the eigenvector of its multiplier -1) the first
-    point is a doubled orbit itself, of amplitude 1e-4 of the orbit's size along
-    ``along``. At the period-doubling point the doubled orbits leave the twice-traversed
-    one with the parameter changing only at second order: there two branches cross and
-    the Jacobian is singular in both their directions, so no corrector converges from
-    it. At a small amplitude, held while the parameter is free (as from a Hopf point),
-    it is regular."""
+    With ``along`` (branch switching at a period doubling or a symmetry breaking:
+    ``orbit`` is the orbit at the point, traversed twice for a period doubling, ``along``
+    the critical eigenvector) the first point is an orbit of the new branch itself, of
+    amplitude 1e-4 of the orbit's size along ``along``. At the bifurcation point the new
+    orbits leave the old one with the parameter changing only at second order: there two
+    branches cross and the Jacobian is singular in both their directions, so no
+    corrector converges from it. At a small amplitude, held while the parameter is free
+    (as from a Hopf point), it is regular."""
     model = problem.base
     x, phases = orbit.state, orbit.phases
-    if along is None:
-        cyc = one_period(model, x, phases, orbit.period, problem.rtol, problem.atol)
-        times = np.r_[0.0, cyc.switch_times, orbit.period]
-        gaps = np.where(cyc.stick_free, np.diff(times), -1.0)
-        i = int(np.argmax(gaps))
-        shift = times[i] + 0.5 * gaps[i]
-        if shift > 0:
-            run = Integration(model, x, duration=shift, output_rate=1.0 / shift,
-                              rtol=problem.rtol, atol=problem.atol, phases=phases)
-            run.run_to(shift)
-            x, phases = run.out_y[1, : model.state_size].copy(), run.ph.copy()
-    problem.shooting = Shooting(model, phases, problem.rtol, problem.atol, problem.scale)
     if along is not None:
+        problem.shooting = Shooting(model, phases, problem.rtol, problem.atol, problem.scale)
         problem.set_free(problem.shooting.shoot(x, orbit.period, tangents=False), x)
         unit = along / np.linalg.norm(along[problem.free] / problem.scale[problem.free]
                                       / problem.xs)
         return hopf_start(problem, x, unit, DOUBLED_AMPLITUDE, DOUBLED_AMPLITUDE,
-                           deadline)
-    shot = problem.shooting.shoot(x, orbit.period)
-    problem.set_free(shot, x)
-    z = problem.pack(x, orbit.period, problem.p0)
-    dp = problem.dgap_dp(x, orbit.period, problem.p0)
-    jac = problem.jacobian(shot, problem.shooting, dp, problem.phase_row(shot))
-    mult, trivial = problem.shooting.stability(shot)
-    residual = problem.shooting.residual(shot, x, orbit.period)
-    pt = Point(z, x, shot, jac, np.zeros_like(z), mult, trivial, residual, 0)
-    return problem.finish(pt, None, direction)
+                          deadline)
+    x, phases = problem.anchored(x, orbit.period, problem.p0, phases)
+    return problem.point_at(x, orbit.period, problem.p0, phases, direction,
+                            residual=orbit.residual)
 
 
 def hopf_start(problem: OrbitProblem, state: np.ndarray, direction: np.ndarray, eps: float,
@@ -80,7 +62,7 @@ def hopf_start(problem: OrbitProblem, state: np.ndarray, direction: np.ndarray, 
     z0 = problem.pack(x0, problem.period0, problem.p0)
     row = z0 - problem.pack(state, problem.period0, problem.p0)
     row /= np.linalg.norm(row)
-    dp = problem.dgap_dp(x0, problem.period0, problem.p0)
+    dp, _ = problem.dgap_dp(x0, problem.period0, problem.p0, shot.end)
     jac = problem.jacobian(shot, problem.shooting, dp, problem.phase_row(shot))
     ref = Point(z0, x0, shot, jac, np.zeros_like(z0), np.zeros(0), 0, np.inf, 0)
     pt = problem.correct(z0, row, float(row @ z0), ref, 1.0, deadline)
@@ -119,4 +101,54 @@ def doubled_start(case: Case, state: np.ndarray, period: float, phases: np.ndarr
                           residual=shooting.residual(double, state, 2.0 * period),
                           iterations=0, verdict=verdict_of(dmult, trivial),
                           start="at a period-doubling point, twice its period")
+    return orbit, along
+
+
+def broken_start(case: Case, state: np.ndarray, period: float, phases: np.ndarray,
+                 bifurcation: dict, rtol: float = 1e-12, atol: float | None = None
+                 ) -> tuple[PeriodicOrbit, np.ndarray]:
+    """The start of the branch of orbits that break a symmetric orbit's symmetry, at a
+    symmetry-breaking point (:func:`fivdisc.analysis.symmetry.classify_reduced`): the
+    orbit's point, and the direction in which the orbits without the symmetry leave it
+    (the real part of the eigenvector of the monodromy's critical multiplier, the one
+    nearest +1 other than the flow direction's: at the bifurcation it is +1).
+
+    Where the crossing is a Neimark-Sacker bifurcation of the reduced map near, not at,
+    an m:k resonance, the motions that bifurcate are tori drifting slowly through the
+    orbit's k images, not orbits: the branch exists only if the corrector converges
+    from here (it says so when it does not).
+
+    Returns
+    -------
+    orbit : PeriodicOrbit
+        The orbit at the point (period ``period``).
+    along : ndarray
+        The direction, for :func:`continue_orbit`'s ``along``.
+    """
+    atol = atol if atol is not None else rtol * 1e-7
+    model = build_model(case)
+    shooting = Shooting(model, phases, rtol, atol)
+    shot = shooting.shoot(state, period)
+    mult, trivial = shooting.stability(shot)
+    values, vecs = np.linalg.eig(shot.monodromy)
+    f = shot.rate_start / shooting.scale
+    f /= np.linalg.norm(f)
+    # the flow direction's eigenvector is f; the critical one is the other nearest +1
+    scores = np.abs(values - 1.0)
+    flow = int(np.argmax([abs(np.vdot(f, vecs[:, i] / shooting.scale)) /
+                          np.linalg.norm(vecs[:, i] / shooting.scale)
+                          for i in range(values.size)]))
+    scores[flow] = np.inf
+    i = int(np.argmin(scores))
+    if scores[i] > 0.05:
+        raise FivdiscError(f"the point is no symmetry-breaking point: no multiplier but the "
+                           f"flow direction's is near +1 (the nearest is {values[i]:.4f})")
+    along = np.real(vecs[:, i])
+    if np.linalg.norm(along) < 1e-6 * np.linalg.norm(vecs[:, i]):
+        along = np.imag(vecs[:, i])
+    orbit = PeriodicOrbit(period=period, state=state.copy(), phases=phases.copy(),
+                          monodromy=shot.monodromy, multipliers=mult, trivial=trivial,
+                          residual=shooting.residual(shot, state, period), iterations=0,
+                          verdict=verdict_of(mult, trivial),
+                          start=f"at the symmetry breaking at {bifurcation['parameter']:.10g}")
     return orbit, along

@@ -26,10 +26,25 @@ event signature, by bisection, each to a relative accuracy of 1e-6 in the parame
 * fold: the tangent's parameter component changes sign;
 * period doubling: a real multiplier crosses -1;
 * torus (Neimark-Sacker): a complex pair crosses the unit circle;
-* discontinuity-induced: the event signature (:mod:`fivdisc.analysis.cycle`) changes;
-  the multipliers on either side are reported, since they may jump there.
+* symmetry breaking: on a symmetric orbit of identical pads, a multiplier crossing
+  whose eigenvector breaks the symmetry (:mod:`fivdisc.analysis.symmetry`: classified on
+  the reduced map ``P^-1 d phi_{T/k}``, with the resonance it lies near);
+* discontinuity-induced: the event signature (:mod:`fivdisc.analysis.cycle`) changes
+  (a phase of a slider appears or vanishes), or the switches of different sliders
+  change order (:mod:`fivdisc.continuation.borders`): where the flow map is continuous
+  there the branch goes on (``switching order``); where it jumps, the branch jumps to
+  the orbit of the other side (``discontinuity``, both periods recorded) or, if there
+  is none, ends (``discontinuity end``, ``cascade end``). The multipliers on either side
+  are reported, since they may jump there.
 * grazing: a branch of slipping orbits lost where its slip speed touches zero ends
   there (the stick-slip orbits turn back from it).
+
+Between two converged points the per-slider cyclic signatures and the order of all
+switches are compared; a change is bisected on converged orbits to 1e-7 of the key. No
+held point is ever tested. Where the corrector fails, the step is halved down to
+``min_step`` (which is tried itself), the last orbit's border is located and named by
+its test functions, and every end is confirmed by a forward run 0.2 % past it
+(:func:`fivdisc.continuation.borders.forward_run`).
 
 A branch may also start at a Hopf point of the equilibrium
 (:func:`fivdisc.continuation.from_hopf.hopf_cycles`): the first point is corrected with its
@@ -38,6 +53,7 @@ amplitude along the critical eigenvector held and the parameter free.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -45,11 +61,20 @@ from typing import Any
 
 import numpy as np
 
+from fivdisc.analysis.cycle import order_changes
 from fivdisc.analysis.orbits import (
     PeriodicOrbit,
     periodic_orbit,
 )
 from fivdisc.case import Case
+from fivdisc.continuation.borders import (
+    border_ahead,
+    forward_run,
+    order_key,
+    other_piece,
+    same_piece,
+    switch_tests,
+)
 from fivdisc.continuation.branch import Branch
 from fivdisc.continuation.checks import check_target, check_window
 from fivdisc.continuation.detection import (
@@ -61,13 +86,20 @@ from fivdisc.continuation.detection import (
     located,
     slip_margin,
     smooth_kinds,
-    vanishing,
     without_fold_echoes,
 )
 from fivdisc.continuation.problem import OrbitProblem, Point
-from fivdisc.continuation.settings import GRAZING, INTERRUPTED, MIN_COSINE, ContinuationSettings
+from fivdisc.continuation.settings import (
+    GRAZING,
+    INTERRUPTED,
+    LOCATE,
+    MIN_COSINE,
+    OTHER_PIECE,
+    PAST,
+    ContinuationSettings,
+)
 from fivdisc.continuation.starts import start_point
-from fivdisc.errors import ConvergenceError
+from fivdisc.errors import ConvergenceError, FivdiscError
 
 __all__ = ["continue_orbit"]
 
@@ -83,6 +115,8 @@ class Walk:
     points: list[Point] = field(default_factory=list)
     bifurcations: list[Bifurcation] = field(default_factory=list)
     stop: Stop = field(default_factory=Stop)
+    # The forward runs that confirmed the branch's ends, in words.
+    checks: list[str] = field(default_factory=list)
 
 
 def continue_orbit(
@@ -152,8 +186,11 @@ def continue_orbit(
     -----
     The method is in the module's docstring and on the documentation's continuation
     page. Step control: after a point that took at most 3 corrector iterations the step
-    grows by 1.5, after 7 or more it halves; a refused or failed step is halved, and a
-    step below ``min_step`` ends the branch as lost.
+    grows by 1.5 (not right after a failed step), after 7 or more it halves; a refused or
+    failed step is halved down to ``min_step``, which is tried itself; a failure there
+    ends the branch where the last orbit's border is (located and named, a jump to the
+    other side's orbit taken where there is one) or, if none is found, as lost. Each end
+    is confirmed by a forward run 0.2 % past it (``confirm_periods``).
     """
     settings = ContinuationSettings.of(settings, options)
     p0 = check_target(case, key, to)
@@ -214,48 +251,45 @@ def walk_on(problem: OrbitProblem, walk: Walk, to: float, back_to: float | None,
     # Once the branch has turned at a fold, it stops where the key comes back past
     # `began` away from `to`, as AUTO stops at the far end of its window; the walk
     # covers the range from there to `to` and no more.
-    began = problem.unpack(walk.points[0].z)[2] if back_to is None else back_to
+    began = walk.points[0].value if back_to is None else back_to
     lo_period, hi_period = problem.period0 / 100.0, problem.period0 * 100.0
+    failed = False
     while len(walk.points) < max_points:
-        a = walk.points[-1]
         if time.monotonic() > deadline:
             walk.stop = Stop("the time budget ran out")
             return
+        # The point away from its switches, which drift along the branch.
+        a = walk.points[-1] = problem.reanchored(walk.points[-1])
         # A predictor past the target goes to the target itself: beyond it the key may
         # leave its allowed range (a damping continued to zero).
         landing = np.sign(target - (a.z[-1] + ds * a.tangent[-1])) != side
         try:
             b = problem.at_value(a, to, deadline) if landing else problem.step_from(a, ds,
                                                                                  deadline)
-            if float(b.tangent @ a.tangent) < MIN_COSINE:
+            if (float(b.tangent @ a.tangent) < MIN_COSINE
+                    and order_key(b.cycle) == order_key(a.cycle)):
                 reason = "the tangent turned by more than 60 degrees"
                 raise ConvergenceError(reason, reason=reason)
         except ConvergenceError as exc:
-            ds *= 0.5
-            if ds < min_step:
-                _, _, p = problem.unpack(a.z)
-                end = vanishing(problem, a, len(walk.points) - 1)
-                if end is None and slip_margin(problem, a) < GRAZING:
-                    walk.bifurcations.append(grazing(problem, a, len(walk.points) - 1))
-                    walk.stop = Stop(f"the orbit grazes the stick boundary at {problem.key} "
-                                      f"= {p:.9g} and does not persist past it")
-                elif end is None:
-                    walk.stop = Stop(f"the orbit is lost at {problem.key} = {p:.9g}: "
-                                      f"{exc.reason}", lost=True)
-                else:
-                    walk.bifurcations.append(end)
-                    walk.stop = Stop(f"the orbit does not persist past the signature change "
-                                      f"at {problem.key} = {end.parameter:.9g}")
+            failed = True
+            if ds > min_step:
+                # halved down to min_step, which is tried itself
+                ds = max(0.5 * ds, min_step)
+                continue
+            restart = end_of_branch(problem, walk, a, exc.reason, ds, settings, deadline)
+            if restart is None:
                 return
+            walk.points.append(restart)
+            bar.update()
+            ds = max(min_step, min(settings.step, 0.1 * max_step))
             continue
-        _, period, _ = problem.unpack(b.z)
-        if not lo_period < period < hi_period:
+        if not lo_period < b.period < hi_period:
             walk.stop = Stop(f"the period left [{lo_period:.3g}, {hi_period:.3g}] s "
                               "(a period growing without bound: a homoclinic orbit?)")
             return
         passed = landing or np.sign(target - b.z[-1]) != side
         turned = any(f.kind == "fold" for f in walk.bifurcations)
-        back = turned and away(problem, b, began, to) and not away(problem, a, began, to)
+        back = turned and away(b, began, to) and not away(a, began, to)
         if (passed and not landing) or back:
             try:
                 b = problem.at_value(a, began if back else to, deadline)
@@ -263,41 +297,105 @@ def walk_on(problem: OrbitProblem, walk: Walk, to: float, back_to: float | None,
                 ds *= 0.5
                 continue
         found = len(walk.bifurcations)
-        record_between(problem, walk, a, b, float(np.linalg.norm(b.z - a.z)), deadline)
-        walk.points.append(b)
+        nxt = record_between(problem, walk, a, b, float(np.linalg.norm(b.z - a.z)),
+                             settings, deadline)
+        if nxt is None:
+            return
+        walk.points.append(nxt)
+        bar.update()
+        if nxt is not b:
+            # the branch jumped at a border: go on from the other side's orbit
+            ds = max(min_step, min(ds, settings.step))
+            failed = False
+            continue
         folds = [f for f in walk.bifurcations if f.kind == "fold"]
-        if back or (not turned and folds and away(problem, b, began, to)):
+        if back or (not turned and folds and away(b, began, to)):
             walk.stop = Stop(f"the branch turned at the fold at {problem.key} = "
                               f"{folds[-1].parameter:.9g} and came back to {problem.key} = "
                               f"{began:.9g}, the other end of its window")
-            bar.update()
             return
         again = closed_on(walk.bifurcations, found)
         if again is not None:
             walk.stop = Stop(f"the branch closed on itself (an isola): it passed the fold at "
                               f"{problem.key} = {again.parameter:.9g} a second time")
             return
-        bar.update()
-        _, _, p = problem.unpack(b.z)
-        bar.set_postfix_str(f"{problem.key} = {p:.6g}, T = {period:.6g} s")
+        bar.set_postfix_str(f"{problem.key} = {b.value:.6g}, T = {b.period:.6g} s")
         if passed:
             walk.stop = Stop(f"reached {problem.key} = {to:.9g}")
             return
-        if b.iterations <= 3:
+        if b.iterations <= 3 and not failed:
             ds = min(ds * 1.5, max_step)
         elif b.iterations >= 7:
             ds = max(ds * 0.5, min_step)
+        failed = False
     walk.stop = Stop(f"the largest number of points ({max_points}) is reached")
 
 
-def away(problem: OrbitProblem, point: Point, began: float, to: float) -> bool:
+def away(point: Point, began: float, to: float) -> bool:
     """Whether ``point``'s key lies past ``began`` on the side away from ``to``."""
-    return (problem.unpack(point.z)[2] - began) * (to - began) < 0
+    return (point.value - began) * (to - began) < 0
+
+
+def _piece(pt: Point) -> tuple:
+    """What one smooth piece of the flow map shares: the per-slider cyclic signatures and
+    the order of all switches."""
+    return pt.cycle.cyclic(), order_key(pt.cycle)
+
+
+def _bisect(problem: OrbitProblem, a: Point, s_hi: float, deadline: float,
+            same: Any, hi: Point | None = None) -> tuple[Point, float, Point | None, float]:
+    """Bisection in the arclength from ``a`` on converged orbits: the last one ``lo`` for
+    which ``same(point)`` holds and the first value of the key ``p_hi`` past it (with its
+    orbit if one converged there), to :data:`LOCATE` of the key. Returns (lo, s_lo, hi,
+    p_hi)."""
+    lo, s_lo = a, 0.0
+    p_hi = hi.value if hi is not None else a.value + s_hi * a.tangent[-1] * problem.ps
+    p_tol = LOCATE * max(abs(a.value), 1e-12)
+    for _ in range(60):
+        if abs(p_hi - lo.value) <= p_tol or s_hi - s_lo <= 1e-14:
+            break
+        s = 0.5 * (s_lo + s_hi)
+        try:
+            mid = problem.step_from(a, s, deadline)
+        except (ConvergenceError, FivdiscError):
+            mid = None
+        if mid is not None and same(mid):
+            lo, s_lo = mid, s
+        else:
+            s_hi = s
+            hi = mid
+            p_hi = mid.value if mid is not None else a.value + s * a.tangent[-1] * problem.ps
+    return lo, s_lo, hi, p_hi
+
+
+def _jump_note(problem: OrbitProblem, lo: Point, other: Point) -> str:
+    """What happens at a border where the branch jumps: the switches that change order,
+    the margins involved (and their jumps), the period's jump."""
+    flips = order_changes(lo.cycle, other.cycle)
+    pads = set()
+    for line in flips:
+        pads.update(int(w) for w in line.replace("'s", " ").split() if w.isdigit())
+    tests = []
+    for pt in (lo, other):
+        try:
+            for t in switch_tests(problem, pt):
+                if t.kind in ("margin", "cascade") and t.key[2] in pads and t.key[1][1] in pads:
+                    tests.append(t.text)
+        except FivdiscError:
+            pass
+    text = "switches of different pads change order: " + ("; ".join(flips) or "(none seen)")
+    if tests:
+        text += " [" + "; ".join(dict.fromkeys(tests)) + "]"
+    return (f"{text}; the flow map jumps there: the period jumps from {lo.period:.10g} to "
+            f"{other.period:.10g} s ({other.period - lo.period:+.3e} s), and the branch goes "
+            f"on from the other side's orbit ({other.verdict}, {other.symmetry or 'no symmetry'})")
 
 
 def record_between(problem: OrbitProblem, walk: Walk, a: Point, b: Point, s_ab: float,
-            deadline: float) -> None:
-    """Locate and record the bifurcations between consecutive points ``a`` and ``b``."""
+                   settings: ContinuationSettings, deadline: float) -> Point | None:
+    """Locate and record the bifurcations between consecutive points ``a`` and ``b``; the
+    point the branch goes on from (``b``, or where it jumps at a border the other side's
+    orbit), or None where it ends at a border between them (``walk.stop`` says so)."""
     index = len(walk.points) - 1
     if a.cycle.cyclic() != b.cycle.cyclic():
         try:
@@ -305,7 +403,21 @@ def record_between(problem: OrbitProblem, walk: Walk, a: Point, b: Point, s_ab: 
         except ConvergenceError:
             lo, hi = a, b
         walk.bifurcations.append(bifurcation_record(problem, "signature change", lo, hi, index))
-        return
+        return b
+    if order_key(a.cycle) != order_key(b.cycle):
+        piece = _piece(a)
+        lo, _, hi, p_hi = _bisect(problem, a, s_ab, deadline,
+                                     lambda pt: _piece(pt) == piece, b)
+        width = abs(p_hi - lo.value) / problem.ps
+        if hi is not None and float(np.linalg.norm(hi.z - lo.z)) <= 10.0 * width + 1e-9:
+            bif = bifurcation_record(problem, "switching order", lo, hi, index)
+            bif.note = ("switches of different pads change order, the flow map continuous "
+                        "there (its derivative jumps): " + "; ".join(order_changes(lo.cycle,
+                                                                                   hi.cycle)))
+            walk.bifurcations.append(bif)
+            return b
+        return _across(problem, walk, lo, hi, p_hi, index, settings, deadline,
+                       "the corrector")
     for kind in smooth_kinds(a, b):
         try:
             found = located(problem, a, b, s_ab, kind, deadline)
@@ -313,3 +425,200 @@ def record_between(problem: OrbitProblem, walk: Walk, a: Point, b: Point, s_ab: 
             found = [(a, b)]
         walk.bifurcations.extend(bifurcation_record(problem, kind, lo, hi, index, sides=(a, b))
                                  for lo, hi in found)
+    return b
+
+
+def _across(problem: OrbitProblem, walk: Walk, lo: Point, hi: Point | None, p_hi: float,
+            index: int, settings: ContinuationSettings, deadline: float,
+            found_by: str) -> Point | None:
+    """At a border where the flow map jumps (``lo`` the last orbit before it, ``p_hi``
+    the first value past it, ``hi`` an orbit found there if any): the other side's orbit
+    near ``lo``'s, recorded as a discontinuity and returned, or the end of the branch
+    (recorded and confirmed; None)."""
+    other = None
+    if hi is not None and _near(problem, lo, hi):
+        other = hi
+    else:
+        cand = other_piece(problem, lo, p_hi)
+        if cand is not None and _near_state(problem, lo, cand[0], cand[1]):
+            x, period, phases, residual = cand
+            try:
+                x, phases = problem.anchored(x, period, p_hi, phases)
+                pt = problem.point_at(x, period, p_hi, phases, float(np.sign(lo.tangent[-1])),
+                                      along=lo.tangent, residual=residual)
+            except (ConvergenceError, FivdiscError):
+                pt = None
+            if pt is not None and _piece(pt) != _piece(lo):
+                other = pt
+    if other is not None:
+        bif = Bifurcation(kind="discontinuity", parameter=0.5 * (lo.value + p_hi),
+                          period=lo.period, state=lo.x.copy(), before=lo.multipliers,
+                          after=other.multipliers, signature_before=lo.cycle.signature,
+                          signature_after=other.cycle.signature, point=index,
+                          note=_jump_note(problem, lo, other), period_after=other.period,
+                          phases=lo.phases.copy())
+        walk.bifurcations.append(bif)
+        if other is hi:
+            # re-made in the current layout as a first point, oriented as lo
+            x, phases = problem.anchored(hi.x, hi.period, hi.value, hi.phases, hi.cycle)
+            other = problem.point_at(x, hi.period, hi.value, phases,
+                                     float(np.sign(lo.tangent[-1])), along=lo.tangent,
+                                     residual=hi.residual)
+        return other
+    return _end(problem, walk, lo, p_hi, index, settings, deadline,
+                f"{found_by} found no orbit of the branch past it")
+
+
+def _near(problem: OrbitProblem, lo: Point, other: Point) -> bool:
+    """Whether ``other`` (an orbit past a border, its point found from ``lo``'s with the
+    phase condition) lies within :data:`OTHER_PIECE` of ``lo``'s orbit."""
+    return _near_state(problem, lo, other.x, other.period)
+
+
+def _near_state(problem: OrbitProblem, lo: Point, x: np.ndarray, period: float) -> bool:
+    if abs(period / lo.period - 1.0) > OTHER_PIECE:
+        return False
+    sc = problem.scale
+    size = float(np.linalg.norm(lo.shot.rate_start / sc) * lo.period)
+    return float(np.linalg.norm((x - lo.x) / sc)) / size < OTHER_PIECE
+
+
+def end_of_branch(problem: OrbitProblem, walk: Walk, a: Point, reason: str, ds: float,
+                  settings: ContinuationSettings, deadline: float) -> Point | None:
+    """The corrector failed at the smallest step from ``a``: locate where the branch ends
+    (bisection on converged orbits of ``a``'s piece), and there either jump to the other
+    side's orbit (returned) or end the branch (None, ``walk.stop`` set)."""
+    index = len(walk.points) - 1
+    piece = _piece(a)
+    lo, _, hi, p_hi = _bisect(problem, a, ds, deadline, lambda pt: _piece(pt) == piece)
+    if hi is not None and _piece(hi) != piece:
+        # past the border the corrector finds another piece: a border crossed
+        if hi.cycle.cyclic() != lo.cycle.cyclic():
+            walk.bifurcations.append(bifurcation_record(problem, "signature change", lo, hi,
+                                                        index))
+            x, phases = problem.anchored(hi.x, hi.period, hi.value, hi.phases, hi.cycle)
+            return problem.point_at(x, hi.period, hi.value, phases,
+                                    float(np.sign(lo.tangent[-1])), along=lo.tangent)
+        return _across(problem, walk, lo, hi, p_hi, index, settings, deadline,
+                       "the corrector")
+    return _across(problem, walk, lo, None, p_hi, index, settings, deadline,
+                   f"the corrector ({reason}, the step halved to {ds:.1e})")
+
+
+def _predicted(signature: tuple[str, ...], test) -> tuple[str, ...]:
+    """The per-slider signature past a border named by a dip or a phase test."""
+    out = list(signature)
+    kind = test.key[0]
+    if kind == "dip":
+        j, phase = test.key[1], test.key[2]
+        if phase == "stick":
+            out[j] = out[j].replace("stick", "stick > slip+ > stick", 1)
+        else:
+            out[j] = out[j].replace("slip+", "slip+ > stick > slip+", 1)
+    return tuple(out)
+
+
+def _end(problem: OrbitProblem, walk: Walk, lo: Point, p_hi: float, index: int,
+         settings: ContinuationSettings, deadline: float, why: str) -> Point | None:
+    """The branch ends at ``lo`` (the first value past it ``p_hi``): the border named by
+    the test function that vanishes there, confirmed by a forward run past it; a forward
+    run that finds the branch's own orbit again goes on from it (returned)."""
+    earlier = None
+    for pt in reversed(walk.points[:-1] if walk.points[-1] is lo else walk.points):
+        if pt is not lo and _piece(pt) == _piece(lo) and pt.value != lo.value:
+            earlier = pt
+            break
+    if earlier is None and walk.points and walk.points[-1] is not lo:
+        earlier = walk.points[-1]
+    ahead = None
+    if earlier is not None:
+        try:
+            ahead = border_ahead(problem, lo, earlier, p_hi)
+        except FivdiscError:
+            ahead = None
+    at = 0.5 * (lo.value + p_hi)
+    key = problem.key
+    fwd = None
+    if settings.confirm_periods > 0:
+        direction = np.sign(p_hi - lo.value) or np.sign(lo.tangent[-1]) or 1.0
+        past = at + direction * PAST * max(abs(at), problem.ps * 1e-3)
+        try:
+            fwd = forward_run(problem, lo, past, settings.confirm_periods)
+        except (ConvergenceError, FivdiscError) as exc:
+            walk.checks.append(f"no forward run past {key} = {at:.9g}: {exc}")
+        if fwd is not None:
+            walk.checks.append(fwd.text)
+            if same_piece(problem, lo, fwd):
+                restart = other_piece_at(problem, lo, fwd)
+                if restart is not None:
+                    walk.bifurcations.append(Bifurcation(
+                        kind="gap", parameter=at, period=lo.period, state=lo.x.copy(),
+                        before=lo.multipliers, after=restart.multipliers,
+                        signature_before=lo.cycle.signature,
+                        signature_after=restart.cycle.signature, point=index,
+                        note=f"{why}, but {fwd.text}: the same orbit; the branch goes on "
+                        "from it", period_after=restart.period, phases=lo.phases.copy()))
+                    return restart
+    confirm = f"; {fwd.text}" if fwd is not None else ""
+    sig_after = lo.cycle.signature
+    if ahead is not None and ahead.test.kind in ("margin", "gap"):
+        kind = "discontinuity end"
+        jump = ahead.test.jump
+        what = (f"{ahead.test.text}: it reaches zero at {key} = {ahead.at:.9g}, where the "
+                "switches of different pads change order"
+                + (f" and the flow map jumps (a relief of {jump:.3g} at the switch)"
+                   if np.isfinite(jump) and jump > 0 else ""))
+        stop = f"the orbit does not persist past the discontinuity at {key} = {at:.9g}"
+    elif ahead is not None and ahead.test.kind == "cascade":
+        kind = "cascade end"
+        what = (f"{ahead.test.text}: it reaches zero at {key} = {ahead.at:.9g}, where the "
+                "load turns into a relief and the pads no longer switch together")
+        stop = (f"the orbit does not persist past the end of its release cascade at {key} = "
+                f"{at:.9g}")
+    elif ahead is not None:
+        kind = "signature change"
+        sig_after = _predicted(lo.cycle.signature, ahead.test)
+        what = (f"{ahead.test.text}: it reaches zero at {key} = {ahead.at:.9g}, where a phase "
+                "appears or vanishes")
+        stop = f"the orbit does not persist past the signature change at {key} = {at:.9g}"
+    elif slip_margin(problem, lo) < GRAZING:
+        walk.bifurcations.append(grazing(problem, lo, index))
+        walk.bifurcations[-1].note += confirm
+        walk.stop = Stop(f"the orbit grazes the stick boundary at {key} = {lo.value:.9g} and "
+                         f"does not persist past it{confirm}")
+        return None
+    else:
+        walk.bifurcations.append(Bifurcation(
+            kind="end", parameter=at, period=lo.period, state=lo.x.copy(),
+            before=lo.multipliers, after=lo.multipliers, signature_before=lo.cycle.signature,
+            signature_after=lo.cycle.signature, point=index,
+            note=f"{why}; no test function of the orbit vanishes there{confirm}",
+            phases=lo.phases.copy()))
+        walk.stop = Stop(f"the orbit is lost at {key} = {lo.value:.9g}: {why}{confirm}",
+                         lost=True)
+        return None
+    walk.bifurcations.append(Bifurcation(
+        kind=kind, parameter=at, period=lo.period, state=lo.x.copy(), before=lo.multipliers,
+        after=lo.multipliers, signature_before=lo.cycle.signature, signature_after=sig_after,
+        point=index, note=f"{what}; {why}{confirm}", phases=lo.phases.copy()))
+    walk.stop = Stop(f"{stop}{confirm}")
+    return None
+
+
+def other_piece_at(problem: OrbitProblem, lo: Point, fwd) -> Point | None:
+    """The orbit a settled forward run found, as a branch point (Newton at its value)."""
+    from fivdisc.analysis.orbits import Shooting, _newton
+
+    shooting = Shooting(problem.model(fwd.value), fwd.phases, problem.rtol, problem.atol,
+                        problem.scale)
+    try:
+        sol = _newton(shooting, fwd.state, fwd.period, problem.tol, 20, math.inf)
+        if sol.reason:
+            return None
+        x, phases = problem.anchored(shooting.held(sol.x0), sol.period, fwd.value,
+                                     fwd.phases)
+        return problem.point_at(x, sol.period, fwd.value, phases,
+                                float(np.sign(lo.tangent[-1])), along=lo.tangent,
+                                residual=sol.residual)
+    except (ConvergenceError, FivdiscError):
+        return None

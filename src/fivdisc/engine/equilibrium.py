@@ -65,6 +65,23 @@ def _evaluate(model: Model, y: np.ndarray) -> tuple[np.ndarray, tuple]:
     return dy, wk[aux : aux + lay.N_AUX, : model.n_sliders]
 
 
+def contact_forces(model: Model, y: np.ndarray, phases: np.ndarray, signs: np.ndarray,
+                   t: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Each slider's normal force and friction force (on the slider, along +phi) [N] at
+    state ``y`` in the given phases and slip signs, as they are: no phase is chosen
+    again (a stuck slider beyond its static limit stays stuck, its friction force the
+    reaction that would hold it)."""
+    mdl = model.kernel_args
+    wk = dyn.new_work(mdl, y)
+    dy = np.empty(model.state_size)
+    dyn.evaluate(float(t), np.asarray(y, dtype=float)[: model.state_size].copy(),
+                 np.asarray(phases, dtype=np.int64), np.asarray(signs, dtype=np.int64), True,
+                 mdl, wk, dy)
+    aux = work_rows(model.n_sliders)[3]
+    ns = model.n_sliders
+    return wk[aux + lay.A_N, :ns].copy(), wk[aux + lay.A_F, :ns].copy()
+
+
 def _unknowns(model: Model) -> np.ndarray:
     """State indices of the equilibrium's unknowns (q, phi) and of their accelerations."""
     n, ns = model.n, model.n_sliders
