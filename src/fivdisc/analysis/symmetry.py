@@ -54,7 +54,7 @@ RESONANT = 1e-3
 _PLACE = {"angle", "face", "perturbation"}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Element:
     """One element of a case's symmetry group.
 
@@ -76,7 +76,7 @@ class Element:
     label: str
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CaseSymmetry:
     """The symmetry group of a case (:func:`case_symmetry`).
 
@@ -98,7 +98,7 @@ class CaseSymmetry:
         return bool(self.elements)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class OrbitSymmetry:
     """The symmetry of one periodic orbit (:func:`orbit_symmetry`).
 

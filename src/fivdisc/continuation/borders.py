@@ -261,19 +261,32 @@ def border_ahead(problem: OrbitProblem, lo: Point, earlier: Point, p_hi: float
 
 
 def other_piece(problem: OrbitProblem, lo: Point, p: float
-                ) -> tuple[np.ndarray, float, np.ndarray, float] | None:
-    """An orbit at ``p`` by Newton shooting from ``lo``'s point and period (the key held):
-    (state, period, phases, residual), or None if Newton does not converge."""
-    shooting = Shooting(problem.model(p), lo.phases, problem.rtol, problem.atol,
-                        problem.scale)
-    try:
-        sol = _newton(shooting, shooting.held(lo.x), lo.period, problem.tol, 20,
-                      math.inf)
-    except FivdiscError:
-        return None
-    if sol.reason:
-        return None
-    return shooting.held(sol.x0), float(sol.period), lo.phases.copy(), float(sol.residual)
+                ) -> list[tuple[np.ndarray, float, np.ndarray, float]]:
+    """The orbits at ``p`` that Newton shooting finds from ``lo``'s point and period (the
+    key held): first over ``T/k`` with the pads permuted if ``lo`` has a spatio-temporal
+    symmetry (at a border of a symmetric orbit every image of a junction flips at once,
+    and the symmetric orbit past it is the one to go on with), then over the full period.
+    Each as (state, period, phases, residual); those that converged."""
+    from fivdisc.analysis.orbits import SymmetricShooting
+
+    model = problem.model(p)
+    plain = Shooting(model, lo.phases, problem.rtol, problem.atol, problem.scale)
+    tries: list[Shooting] = []
+    if lo.sym is not None and lo.sym.shift is not None:
+        tries.append(SymmetricShooting(model, lo.phases, problem.rtol, problem.atol,
+                                       lo.sym.shift.matrix, lo.sym.k, problem.scale))
+    tries.append(plain)
+    found = []
+    for shooting in tries:
+        try:
+            sol = _newton(shooting, shooting.held(lo.x), lo.period, problem.tol, 20,
+                          math.inf)
+        except FivdiscError:
+            continue
+        if not sol.reason:
+            found.append((shooting.held(sol.x0), float(sol.period), lo.phases.copy(),
+                          float(sol.residual)))
+    return found
 
 
 @dataclass
@@ -299,8 +312,10 @@ def forward_run(problem: OrbitProblem, lo: Point, value: float, periods: int) ->
     its disc speed) for ``periods`` of ``lo``'s periods, and tell whether the motion
     settles on a periodic orbit: the states at the switches of one kind of one slider (a
     section the orbit crosses once per period) come back, ``k`` returns apart (k <= 12),
-    to within :data:`SETTLES` of the orbit's size over the last returns, with their
-    return times agreeing to ``SETTLES`` of the period."""
+    to within :data:`SETTLES` of the orbit's size over the last returns, closing in (the
+    largest distance of the last half of the window below 0.9 of the first half's, as a
+    periodic orbit's returns converge geometrically, unlike a torus's), with their return
+    times agreeing to ``SETTLES`` of the period."""
     model = problem.model(value)
     shooting = Shooting(model, lo.phases, problem.rtol, problem.atol, problem.scale)
     ev = lo.cycle.events
@@ -341,23 +356,28 @@ def forward_run(problem: OrbitProblem, lo: Point, value: float, periods: int) ->
                     f"crosses its section only {n} times in {periods} periods: no orbit of "
                     "the branch's kind there")
         return out
-    window = max(4, min(60, n // 4))
+    window = max(8, min(80, n // 4))
+    half = window // 2
     best = None
     for k in range(1, 13):
         if n < window + k + 1:
             break
-        last = range(n - window, n)
-        dist = max(float(np.linalg.norm((states[i] - states[i - k]) / sc)) / size
-                   for i in last)
-        spans = [times[i] - times[i - k] for i in last]
-        spread = float(max(spans) - min(spans))
-        if best is None or dist < best[1]:
-            best = (k, dist, spread, float(np.mean(spans)))
-        if dist < SETTLES and spread < SETTLES * np.mean(spans):
+        d = [float(np.linalg.norm((states[i] - states[i - k]) / sc)) / size
+             for i in range(n - window, n)]
+        spans = [times[i] - times[i - k] for i in range(n - window, n)]
+        recent, before = max(d[half:]), max(d[:half])
+        spread = float(max(spans[half:]) - min(spans[half:]))
+        # a periodic orbit's returns close in geometrically; a torus's or a drifting
+        # motion's come back near, and no nearer
+        closing = recent < 1e-10 or recent < 0.9 * before
+        ok = recent < SETTLES and spread < SETTLES * np.mean(spans) and closing
+        if best is None or (ok and not best[4]) or (ok == best[4] and recent < best[1]):
+            best = (k, recent, spread, float(np.mean(spans[half:])), ok)
+        if ok:
             break
-    k, dist, spread, mean = best
+    k, dist, spread, mean, ok = best
     out.k, out.closest, out.spread, out.period = k, dist, spread, mean
-    out.settled = dist < SETTLES and spread < SETTLES * mean
+    out.settled = ok
     out.state, out.phases = states[-1], phases[-1]
     out.sticks = tuple(int(v) for v in (sticks_at[-1] - sticks_at[-1 - k]))
     where = f"a forward run {PAST:.1%} past the end (at {problem.key} = {value:.9g})"
@@ -367,8 +387,9 @@ def forward_run(problem: OrbitProblem, lo: Point, value: float, periods: int) ->
                     f"sticks per pad {list(out.sticks)}; returns within {dist:.1e})")
     else:
         out.text = (f"{where} does not settle within {periods} periods: its returns to the "
-                    f"section come back no closer than {dist:.1e} of the orbit's size and "
-                    f"their times spread by {spread:.2e} s (over {k} crossing"
+                    f"section come back no closer than {dist:.1e} of the orbit's size, and "
+                    f"no closer over time, and their times spread by {spread:.2e} s (over "
+                    f"{k} crossing"
                     f"{'s' if k > 1 else ''}, mean {mean:.9g} s; sticks per pad "
                     f"{list(out.sticks)}): no periodic orbit there")
     return out

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fivdisc.analysis.cycle import SIMULTANEOUS, Cycle
+from fivdisc.analysis.cycle import Cycle
 from fivdisc.analysis.orbits import (
     Shooting,
     Shot,
@@ -474,11 +474,12 @@ class OrbitProblem:
 
 def close_switches(cycle: Cycle) -> bool:
     """Whether switches of different sliders fall within :data:`NEAR_SWITCHES` of a period
-    of each other without being simultaneous."""
+    of each other (simultaneous ones included: at a release cascade the shooting map
+    jumps as soon as the cascade breaks)."""
     period = cycle.period
     ev = sorted(cycle.events)
     for (t1, _, j1), (t2, _, j2) in zip(ev, ev[1:] + ev[:1], strict=True):
         gap = (t2 - t1) % period
-        if j1 != j2 and SIMULTANEOUS * period < gap < NEAR_SWITCHES * period:
+        if j1 != j2 and gap < NEAR_SWITCHES * period:
             return True
     return False

@@ -88,7 +88,7 @@ from fivdisc.continuation.detection import (
     smooth_kinds,
     without_fold_echoes,
 )
-from fivdisc.continuation.problem import OrbitProblem, Point
+from fivdisc.continuation.problem import OrbitProblem, Point, close_switches
 from fivdisc.continuation.settings import (
     GRAZING,
     INTERRUPTED,
@@ -96,6 +96,7 @@ from fivdisc.continuation.settings import (
     MIN_COSINE,
     OTHER_PIECE,
     PAST,
+    POLISH,
     ContinuationSettings,
 )
 from fivdisc.continuation.starts import start_point
@@ -342,30 +343,47 @@ def _piece(pt: Point) -> tuple:
     return pt.cycle.cyclic(), order_key(pt.cycle)
 
 
+@dataclass
+class Bracket:
+    """A border located by bisection on converged orbits: ``lo`` the last orbit of the
+    piece, ``p_hi`` the first value of the key past it (the predictor's, along the
+    tangent), ``hi`` an orbit found there if one was, ``earlier`` the orbit of the piece
+    found before ``lo`` (or None)."""
+
+    lo: Point
+    p_hi: float
+    hi: Point | None
+    earlier: Point | None
+
+
 def _bisect(problem: OrbitProblem, a: Point, s_hi: float, deadline: float,
-            same: Any, hi: Point | None = None) -> tuple[Point, float, Point | None, float]:
-    """Bisection in the arclength from ``a`` on converged orbits: the last one ``lo`` for
-    which ``same(point)`` holds and the first value of the key ``p_hi`` past it (with its
-    orbit if one converged there), to :data:`LOCATE` of the key. Returns (lo, s_lo, hi,
-    p_hi)."""
-    lo, s_lo = a, 0.0
-    p_hi = hi.value if hi is not None else a.value + s_hi * a.tangent[-1] * problem.ps
+            same: Any, hi: Point | None = None) -> Bracket:
+    """Bisection on converged orbits, to :data:`LOCATE` of the key: the last orbit for
+    which ``same(point)`` holds and the first value past it. Each try is a step from the
+    last orbit found (``a`` at first) along its tangent, at half the arclength left to the
+    first failure (``s_hi`` from ``a``)."""
+    lo, earlier = a, None
+    left = s_hi
     p_tol = LOCATE * max(abs(a.value), 1e-12)
-    for _ in range(60):
-        if abs(p_hi - lo.value) <= p_tol or s_hi - s_lo <= 1e-14:
+
+    def past(base: Point, s: float) -> float:
+        return base.value + s * base.tangent[-1] * problem.ps
+
+    for _ in range(80):
+        if abs(past(lo, left) - lo.value) <= p_tol or left <= 1e-14:
             break
-        s = 0.5 * (s_lo + s_hi)
+        s = 0.5 * left
         try:
-            mid = problem.step_from(a, s, deadline)
+            mid = problem.step_from(lo, s, deadline)
         except (ConvergenceError, FivdiscError):
             mid = None
         if mid is not None and same(mid):
-            lo, s_lo = mid, s
+            # the arclength left, from the new point: what is left beyond it
+            left = max(left - float(np.linalg.norm(mid.z - lo.z)), 0.5 * s)
+            lo, earlier = mid, lo
         else:
-            s_hi = s
-            hi = mid
-            p_hi = mid.value if mid is not None else a.value + s * a.tangent[-1] * problem.ps
-    return lo, s_lo, hi, p_hi
+            left, hi = s, mid
+    return Bracket(lo, past(lo, left), hi, earlier)
 
 
 def _jump_note(problem: OrbitProblem, lo: Point, other: Point) -> str:
@@ -406,8 +424,8 @@ def record_between(problem: OrbitProblem, walk: Walk, a: Point, b: Point, s_ab: 
         return b
     if order_key(a.cycle) != order_key(b.cycle):
         piece = _piece(a)
-        lo, _, hi, p_hi = _bisect(problem, a, s_ab, deadline,
-                                     lambda pt: _piece(pt) == piece, b)
+        br = _bisect(problem, a, s_ab, deadline, lambda pt: _piece(pt) == piece, b)
+        lo, hi, p_hi = br.lo, br.hi, br.p_hi
         width = abs(p_hi - lo.value) / problem.ps
         if hi is not None and float(np.linalg.norm(hi.z - lo.z)) <= 10.0 * width + 1e-9:
             bif = bifurcation_record(problem, "switching order", lo, hi, index)
@@ -416,8 +434,7 @@ def record_between(problem: OrbitProblem, walk: Walk, a: Point, b: Point, s_ab: 
                                                                                    hi.cycle)))
             walk.bifurcations.append(bif)
             return b
-        return _across(problem, walk, lo, hi, p_hi, index, settings, deadline,
-                       "the corrector")
+        return _across(problem, walk, br, index, settings, deadline, "the corrector")
     for kind in smooth_kinds(a, b):
         try:
             found = located(problem, a, b, s_ab, kind, deadline)
@@ -428,28 +445,33 @@ def record_between(problem: OrbitProblem, walk: Walk, a: Point, b: Point, s_ab: 
     return b
 
 
-def _across(problem: OrbitProblem, walk: Walk, lo: Point, hi: Point | None, p_hi: float,
-            index: int, settings: ContinuationSettings, deadline: float,
-            found_by: str) -> Point | None:
-    """At a border where the flow map jumps (``lo`` the last orbit before it, ``p_hi``
-    the first value past it, ``hi`` an orbit found there if any): the other side's orbit
-    near ``lo``'s, recorded as a discontinuity and returned, or the end of the branch
-    (recorded and confirmed; None)."""
+def _across(problem: OrbitProblem, walk: Walk, br: Bracket, index: int,
+            settings: ContinuationSettings, deadline: float, found_by: str) -> Point | None:
+    """At a border where the flow map jumps (``br``): the other side's orbit near the last
+    orbit's, recorded as a discontinuity and returned, or the end of the branch (recorded
+    and confirmed; None). The last orbit of the piece joins the branch."""
+    lo, hi, p_hi = br.lo, br.hi, br.p_hi
+    if lo is not walk.points[-1]:
+        walk.points.append(lo)
+        index = len(walk.points) - 1
     other = None
     if hi is not None and _near(problem, lo, hi):
         other = hi
     else:
-        cand = other_piece(problem, lo, p_hi)
-        if cand is not None and _near_state(problem, lo, cand[0], cand[1]):
+        for cand in other_piece(problem, lo, p_hi):
+            if not _near_state(problem, lo, cand[0], cand[1]):
+                continue
             x, period, phases, residual = cand
             try:
                 x, phases = problem.anchored(x, period, p_hi, phases)
                 pt = problem.point_at(x, period, p_hi, phases, float(np.sign(lo.tangent[-1])),
                                       along=lo.tangent, residual=residual)
             except (ConvergenceError, FivdiscError):
-                pt = None
-            if pt is not None and _piece(pt) != _piece(lo):
+                continue
+            if (_piece(pt) != _piece(lo)
+                    and not (pt.residual > POLISH * problem.tol and close_switches(pt.cycle))):
                 other = pt
+                break
     if other is not None:
         bif = Bifurcation(kind="discontinuity", parameter=0.5 * (lo.value + p_hi),
                           period=lo.period, state=lo.x.copy(), before=lo.multipliers,
@@ -465,7 +487,7 @@ def _across(problem: OrbitProblem, walk: Walk, lo: Point, hi: Point | None, p_hi
                                      float(np.sign(lo.tangent[-1])), along=lo.tangent,
                                      residual=hi.residual)
         return other
-    return _end(problem, walk, lo, p_hi, index, settings, deadline,
+    return _end(problem, walk, br, index, settings, deadline,
                 f"{found_by} found no orbit of the branch past it")
 
 
@@ -490,18 +512,22 @@ def end_of_branch(problem: OrbitProblem, walk: Walk, a: Point, reason: str, ds: 
     side's orbit (returned) or end the branch (None, ``walk.stop`` set)."""
     index = len(walk.points) - 1
     piece = _piece(a)
-    lo, _, hi, p_hi = _bisect(problem, a, ds, deadline, lambda pt: _piece(pt) == piece)
-    if hi is not None and _piece(hi) != piece:
-        # past the border the corrector finds another piece: a border crossed
-        if hi.cycle.cyclic() != lo.cycle.cyclic():
-            walk.bifurcations.append(bifurcation_record(problem, "signature change", lo, hi,
-                                                        index))
-            x, phases = problem.anchored(hi.x, hi.period, hi.value, hi.phases, hi.cycle)
-            return problem.point_at(x, hi.period, hi.value, phases,
-                                    float(np.sign(lo.tangent[-1])), along=lo.tangent)
-        return _across(problem, walk, lo, hi, p_hi, index, settings, deadline,
-                       "the corrector")
-    return _across(problem, walk, lo, None, p_hi, index, settings, deadline,
+    br = _bisect(problem, a, ds, deadline, lambda pt: _piece(pt) == piece)
+    if br.earlier is None and len(walk.points) > 1:
+        br.earlier = walk.points[-2]
+    lo, hi = br.lo, br.hi
+    if hi is not None and hi.cycle.cyclic() != lo.cycle.cyclic() and _near(problem, lo, hi):
+        # past the border the corrector finds the orbit with another signature: the
+        # branch goes on through the signature change
+        if lo is not walk.points[-1]:
+            walk.points.append(lo)
+            index += 1
+        walk.bifurcations.append(bifurcation_record(problem, "signature change", lo, hi,
+                                                    index))
+        x, phases = problem.anchored(hi.x, hi.period, hi.value, hi.phases, hi.cycle)
+        return problem.point_at(x, hi.period, hi.value, phases,
+                                float(np.sign(lo.tangent[-1])), along=lo.tangent)
+    return _across(problem, walk, br, index, settings, deadline,
                    f"the corrector ({reason}, the step halved to {ds:.1e})")
 
 
@@ -518,18 +544,19 @@ def _predicted(signature: tuple[str, ...], test) -> tuple[str, ...]:
     return tuple(out)
 
 
-def _end(problem: OrbitProblem, walk: Walk, lo: Point, p_hi: float, index: int,
+def _end(problem: OrbitProblem, walk: Walk, br: Bracket, index: int,
          settings: ContinuationSettings, deadline: float, why: str) -> Point | None:
-    """The branch ends at ``lo`` (the first value past it ``p_hi``): the border named by
-    the test function that vanishes there, confirmed by a forward run past it; a forward
-    run that finds the branch's own orbit again goes on from it (returned)."""
-    earlier = None
-    for pt in reversed(walk.points[:-1] if walk.points[-1] is lo else walk.points):
-        if pt is not lo and _piece(pt) == _piece(lo) and pt.value != lo.value:
-            earlier = pt
-            break
-    if earlier is None and walk.points and walk.points[-1] is not lo:
-        earlier = walk.points[-1]
+    """The branch ends at ``br.lo`` (the first value past it ``br.p_hi``): the border
+    named by the test function that vanishes there, confirmed by a forward run past it;
+    a forward run that finds the branch's own orbit again goes on from it (returned)."""
+    lo, p_hi = br.lo, br.p_hi
+    earlier = br.earlier
+    if earlier is None or _piece(earlier) != _piece(lo) or earlier.value == lo.value:
+        earlier = None
+        for pt in reversed(walk.points):
+            if pt is not lo and _piece(pt) == _piece(lo) and pt.value != lo.value:
+                earlier = pt
+                break
     ahead = None
     if earlier is not None:
         try:
