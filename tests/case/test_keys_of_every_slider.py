@@ -110,6 +110,7 @@ def test_the_speed_and_pad_stiffness_boundary_of_three_pads_is_one_command(tmp_p
     import xarray as xr
 
     from fivdisc.analysis.stability import linear_stability
+
     from support.cli import run_cli
 
     path = tmp_path / "three.toml"

@@ -611,13 +611,23 @@ def _newton(shooting: Shooting, x0: np.ndarray, period: float, tol: float,
 
 def _returns_at(shooting: Shooting, x0: np.ndarray, period: float) -> int:
     """The largest k <= 12 at which the orbit through ``x0`` closes after T/k (1 if none):
-    T is then k times the minimal period."""
+    T is then k times the minimal period. The return is measured on every coordinate
+    free at the start and the stuck sliders' rates too: a point inside a stick phase
+    has its slider's rate held, and a slider slipping back through its stick angle half
+    a period later would otherwise look like a return."""
+    x0 = shooting.held(x0)
+    stuck = np.zeros(x0.size, dtype=bool)
+    rates = shooting.model.index("phi_dot")
+    stuck[rates + np.flatnonzero(shooting.phases == lay.STICK)] = True
+    sc = shooting.scale
     for k in range(_MAX_DIVISOR, 1, -1):
         try:
             shot = shooting.shoot(x0, period / k, tangents=False)
         except FivdiscError:
             continue
-        if shooting.residual(shot, x0, period / k) < _CLOSES:
+        keep = shot.free | stuck
+        size = np.linalg.norm(shot.rate_start / sc) * period / k
+        if np.linalg.norm(((shot.end - x0) / sc)[keep]) < _CLOSES * size:
             return k
     return 1
 def _probe(model: Model, x0: np.ndarray, phases: np.ndarray | None, window: float,

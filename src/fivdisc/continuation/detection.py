@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fivdisc.analysis.symmetry import classify_reduced, isotypic
+from fivdisc.analysis.symmetry import RESONANT, classify_reduced, isotypic
 from fivdisc.continuation.problem import OrbitProblem, Point
 from fivdisc.continuation.settings import LOCATE, REAL
 
@@ -286,8 +286,12 @@ def symmetric_kind(kind: str, at: Point, before: Point, after: Point
         if passing:
             mu = 0.5 * (passing[0][0] + passing[0][1])
             theta = abs(math.atan2(mu.imag, mu.real)) / (2 * math.pi)
+            m = round(theta * k)
+            where = (f" ({m}/{k} {'+' if theta >= m / k else '-'} {abs(theta - m / k):.2g}: "
+                     f"outside the {RESONANT:g}-turn window of the {m}:{k} resonance)"
+                     if m % k else "")
             return kind, (f"the orbit keeps its symmetry ({at.symmetry}): the T/{k} map's "
-                          f"multiplier crosses at the angle 2 pi x {theta:.6f}")
+                          f"multiplier crosses at the angle 2 pi x {theta:.6f}{where}")
     if at.sym is not None and at.sym.spatial:
         mult, vecs = np.linalg.eig(at.shot.monodromy)
         crit = nearest_multiplier(at.multipliers, at.trivial, kind) if kind != "branch point" \
