@@ -40,7 +40,7 @@ import numpy as np
 from fivdisc.analysis.cycle import EVENT_WORDS, SIMULTANEOUS, Cycle
 from fivdisc.analysis.orbits import Shooting, _newton
 from fivdisc.continuation.problem import OrbitProblem, Point
-from fivdisc.continuation.settings import PAST, SETTLES
+from fivdisc.continuation.settings import NEAR_SWITCHES, PAST, SETTLES
 from fivdisc.engine.equilibrium import contact_forces
 from fivdisc.engine.integration import Integration
 from fivdisc.engine.result import EVENT_KINDS
@@ -82,14 +82,52 @@ def groups(cycle: Cycle) -> list[tuple[float, list[Label]]]:
     return out
 
 
-def order_key(cycle: Cycle) -> tuple:
+def order_key(cycle: Cycle, classes: dict[int, int] | None = None) -> tuple:
     """The cyclic order of the switches of all sliders, simultaneous ones as a set:
     independent of where on the orbit its point lies. Two orbits of one smooth piece of
-    the flow map have the same."""
-    seq = [tuple(sorted((k, j) for k, j, _ in g)) for _, g in groups(cycle)]
+    the flow map have the same.
+
+    ``classes`` (slider -> class) merges the sliders an orbit's spatial symmetry maps onto
+    each other (``x = P x``: in phase): their switches are simultaneous by the symmetry,
+    and which of them the integration makes first, and a fraction of a nanosecond
+    earlier, is round-off, no order; within :data:`NEAR_SWITCHES` of the period, one
+    switch of a class stands for all."""
+    if not classes:
+        seq = [tuple(sorted((k, j) for k, j, _ in g)) for _, g in groups(cycle)]
+    else:
+        tol = NEAR_SWITCHES * cycle.period
+        merged: list[tuple[float, set]] = []
+        for t, (kind, j, _) in labelled(cycle):
+            label = (kind, classes.get(j, j))
+            if merged and t - merged[-1][0] <= tol and label in merged[-1][1]:
+                continue
+            if merged and t - merged[-1][0] <= SIMULTANEOUS * cycle.period:
+                merged[-1][1].add(label)
+            else:
+                merged.append((t, {label}))
+        seq = [tuple(sorted(labels)) for _, labels in merged]
     if not seq:
         return ()
     return min(tuple(seq[i:] + seq[:i]) for i in range(len(seq)))
+
+
+def pad_classes(point: Point) -> dict[int, int] | None:
+    """The sliders ``point``'s spatial symmetry maps onto each other, as slider -> the
+    least slider of its class; None without a spatial symmetry."""
+    if point.sym is None or not point.sym.spatial:
+        return None
+    parent = list(range(point.phases.size))
+
+    def root(j: int) -> int:
+        while parent[j] != j:
+            j = parent[j]
+        return j
+
+    for el in point.sym.spatial:
+        for j, i in enumerate(el.pads):
+            a, b = root(j), root(int(i))
+            parent[max(a, b)] = min(a, b)
+    return {j: root(j) for j in range(len(parent))}
 
 
 def name(label: Label) -> str:
@@ -407,4 +445,4 @@ def same_piece(problem: OrbitProblem, lo: Point, fwd: Forward) -> bool:
     except FivdiscError:
         return False
     return (cyc.cyclic() == lo.cycle.cyclic()
-            and order_key(cyc) == order_key(lo.cycle))
+            and order_key(cyc, pad_classes(lo)) == order_key(lo.cycle, pad_classes(lo)))

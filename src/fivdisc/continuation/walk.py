@@ -72,6 +72,7 @@ from fivdisc.continuation.borders import (
     forward_run,
     order_key,
     other_piece,
+    pad_classes,
     same_piece,
     switch_tests,
 )
@@ -267,8 +268,9 @@ def walk_on(problem: OrbitProblem, walk: Walk, to: float, back_to: float | None,
         try:
             b = problem.at_value(a, to, deadline) if landing else problem.step_from(a, ds,
                                                                                  deadline)
+            classes = pad_classes(a) or pad_classes(b)
             if (float(b.tangent @ a.tangent) < MIN_COSINE
-                    and order_key(b.cycle) == order_key(a.cycle)):
+                    and _piece(b, classes) == _piece(a, classes)):
                 reason = "the tangent turned by more than 60 degrees"
                 raise ConvergenceError(reason, reason=reason)
         except ConvergenceError as exc:
@@ -337,10 +339,14 @@ def away(point: Point, began: float, to: float) -> bool:
     return (point.value - began) * (to - began) < 0
 
 
-def _piece(pt: Point) -> tuple:
+def _piece(pt: Point, classes: dict[int, int] | None = None) -> tuple:
     """What one smooth piece of the flow map shares: the per-slider cyclic signatures and
-    the order of all switches."""
-    return pt.cycle.cyclic(), order_key(pt.cycle)
+    the order of all switches (of an in-phase orbit, those of the sliders its symmetry
+    relates taken as one: :func:`~fivdisc.continuation.borders.order_key`; ``classes``
+    default: ``pt``'s own)."""
+    if classes is None:
+        classes = pad_classes(pt)
+    return pt.cycle.cyclic(), order_key(pt.cycle, classes)
 
 
 @dataclass
@@ -422,9 +428,10 @@ def record_between(problem: OrbitProblem, walk: Walk, a: Point, b: Point, s_ab: 
             lo, hi = a, b
         walk.bifurcations.append(bifurcation_record(problem, "signature change", lo, hi, index))
         return b
-    if order_key(a.cycle) != order_key(b.cycle):
-        piece = _piece(a)
-        br = _bisect(problem, a, s_ab, deadline, lambda pt: _piece(pt) == piece, b)
+    classes = pad_classes(a) or pad_classes(b)
+    if _piece(a, classes) != _piece(b, classes):
+        piece = _piece(a, classes)
+        br = _bisect(problem, a, s_ab, deadline, lambda pt: _piece(pt, classes) == piece, b)
         lo, hi, p_hi = br.lo, br.hi, br.p_hi
         width = abs(p_hi - lo.value) / problem.ps
         if hi is not None and float(np.linalg.norm(hi.z - lo.z)) <= 10.0 * width + 1e-9:
@@ -468,7 +475,7 @@ def _across(problem: OrbitProblem, walk: Walk, br: Bracket, index: int,
                                       along=lo.tangent, residual=residual)
             except (ConvergenceError, FivdiscError):
                 continue
-            if (_piece(pt) != _piece(lo)
+            if (_piece(pt, pad_classes(lo)) != _piece(lo)
                     and not (pt.residual > POLISH * problem.tol and close_switches(pt.cycle))):
                 other = pt
                 break
@@ -511,8 +518,9 @@ def end_of_branch(problem: OrbitProblem, walk: Walk, a: Point, reason: str, ds: 
     (bisection on converged orbits of ``a``'s piece), and there either jump to the other
     side's orbit (returned) or end the branch (None, ``walk.stop`` set)."""
     index = len(walk.points) - 1
-    piece = _piece(a)
-    br = _bisect(problem, a, ds, deadline, lambda pt: _piece(pt) == piece)
+    classes = pad_classes(a)
+    piece = _piece(a, classes)
+    br = _bisect(problem, a, ds, deadline, lambda pt: _piece(pt, classes) == piece)
     if br.earlier is None and len(walk.points) > 1:
         br.earlier = walk.points[-2]
     lo, hi = br.lo, br.hi
@@ -551,10 +559,12 @@ def _end(problem: OrbitProblem, walk: Walk, br: Bracket, index: int,
     a forward run that finds the branch's own orbit again goes on from it (returned)."""
     lo, p_hi = br.lo, br.p_hi
     earlier = br.earlier
-    if earlier is None or _piece(earlier) != _piece(lo) or earlier.value == lo.value:
+    classes = pad_classes(lo)
+    if (earlier is None or _piece(earlier, classes) != _piece(lo)
+            or earlier.value == lo.value):
         earlier = None
         for pt in reversed(walk.points):
-            if pt is not lo and _piece(pt) == _piece(lo) and pt.value != lo.value:
+            if pt is not lo and _piece(pt, classes) == _piece(lo) and pt.value != lo.value:
                 earlier = pt
                 break
     ahead = None

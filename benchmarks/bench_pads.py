@@ -1,0 +1,121 @@
+"""Cost of the three-pad branch of issue 36, side by side with one orbit solve in one process.
+
+Run ``python benchmarks/bench_pads.py [--points 40] [--rounds 1]``. On the issue's case
+(three identical pads at 0, 120 and 240 degrees, Stribeck friction, four disc modes;
+kernels cached: a warm-up compiles them first) it times
+
+1. the baseline: one ``periodic_orbit`` call as ``fivdisc orbit bist-22-large.toml
+   --transient 10`` makes it (a 10 s transient, the first return, Newton shooting, the
+   minimal-period check, the orbit's symmetry), and
+2. ``continue_orbit`` of that orbit in the disc speed, downwards from 22 rad/s, for
+   ``--points`` points: every point's multipliers, event signature, measures and symmetry
+   (with its reduced map's multipliers), the anchor kept away from the switches, and the
+   bifurcations met on the way located, the jump at the border at 11.838233 rad/s (where
+   the pads' releases meet the next pads' sticks) included when the branch gets there,
+
+and prints both wall times, the points per second of the branch and the ratio of the
+branch's time per point to the single solve. Each figure is the fastest of ``--rounds``
+runs (the work is deterministic). ``--confirm`` sets the forward run that confirms an end
+(periods; 0: none).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import time
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+from fivdisc.analysis.orbits import periodic_orbit
+from fivdisc.case import Case
+from fivdisc.continuation.walk import continue_orbit
+
+#: The issue's three-pad case at 22 rad/s (``bist-22-large.toml``).
+CASE = """
+[disc]
+modes = [[0, 0], [0, 1], [0, 2], [0, 3]]
+damping_ratio = 0.003
+damping_frame = "material"
+[slider]
+face = "top"
+track_radius = 0.1
+mass = 0.1
+normal_stiffness = 3e4
+normal_damping = 0.1
+rotational_stiffness = 2e3
+rotational_damping = 0.1
+preload = 500.0
+[[sliders]]
+angle = 0.0
+[[sliders]]
+angle = 2.0943951023931953
+[[sliders]]
+angle = 4.1887902047863905
+[friction]
+law = "stribeck"
+static = 0.8
+kinetic_max = 0.6
+kinetic_min = 0.35
+stribeck_velocity = 1.0
+stribeck_exponent = 2.0
+viscous = 0.0
+[speed]
+profile = "constant"
+value = 22.0
+[simulation]
+duration = 3.0
+initial_state = "equilibrium"
+output_rate = 10000.0
+[simulation.perturbation]
+phi = 0.0
+phi_dot = 14.0
+"""
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--points", type=int, default=40)
+    parser.add_argument("--rounds", type=int, default=1)
+    parser.add_argument("--to", type=float, default=1.0,
+                        help="disc speed the branch heads for [rad/s]")
+    parser.add_argument("--confirm", type=int, default=400,
+                        help="periods of the forward run that confirms an end")
+    args = parser.parse_args()
+    case = Case.from_toml(CASE)
+    print(f"python {platform.python_version()}, {platform.processor() or platform.machine()}, "
+          f"{os.cpu_count()} cores")
+    start = time.perf_counter()
+    orbit = periodic_orbit(case, transient=10.0)
+    print(f"warm-up (transient, first return, Newton; kernels loaded or compiled): "
+          f"{time.perf_counter() - start:.1f} s; T = {orbit.period * 1e3:.6f} ms, "
+          f"{orbit.symmetry}")
+    solves, branches = [], []
+    branch = None
+    for _ in range(args.rounds):
+        start = time.perf_counter()
+        periodic_orbit(case, transient=10.0)
+        solves.append(time.perf_counter() - start)
+        start = time.perf_counter()
+        branch = continue_orbit(case, "speed.value", args.to, orbit=orbit,
+                                max_points=args.points, confirm_periods=args.confirm)
+        branches.append(time.perf_counter() - start)
+    assert branch is not None
+    one, whole = min(solves), min(branches)
+    per_point = whole / len(branch)
+    print(f"one orbit call (fivdisc orbit bist-22-large.toml --transient 10): {one:.2f} s")
+    print(f"branch of {len(branch)} points, {len(branch.bifurcations())} bifurcations "
+          f"located, from {branch.parameter[0]:.6g} to {branch.parameter[-1]:.6g} rad/s: "
+          f"{whole:.1f} s, {len(branch) / whole:.2f} points per second "
+          f"({per_point:.2f} s per point)")
+    print(f"ratio of a point to one orbit call: {per_point / one:.3f} "
+          f"(a branch point costs {per_point / one:.1%} of an orbit solve)")
+    for b in branch.bifurcations():
+        print(f"  {b['kind']} at {b['parameter']:.9g} rad/s")
+    print(f"stopped: {branch.stop_reason}")
+
+
+if __name__ == "__main__":
+    main()
