@@ -246,7 +246,7 @@ def test_an_orbit_that_does_not_converge_is_no_result():
     period, _ = rigid_disc_closed_form()
     first = periodic_orbit(RIGID, transient=4.0)
     guess = first.state.copy()
-    guess[RIGID_PHI_DOT] += 0.05
+    guess[RIGID_PHI] += 0.05
     with pytest.raises(ConvergenceError, match="iteration budget") as info:
         periodic_orbit(RIGID, guess, period=period, phases=first.phases, max_iterations=0)
     orbit = info.value.result
@@ -257,6 +257,7 @@ def test_an_orbit_that_does_not_converge_is_no_result():
 
 
 RIGID_PHI_DOT = 4  # q, phi, z, qdot, phidot, zdot for one mode and one slider
+RIGID_PHI = 1  # free in every phase (a stuck slider's rate is held at the disc speed)
 
 
 def test_orbit_command_exits_1_when_not_converged(tmp_path):
@@ -462,7 +463,7 @@ def test_fig13_branch_ends_where_its_stick_phase_splits():
     assert end["signature_before"] == ("slip+ > stick > slip+",)
     assert end["signature_after"][0].count("stick") == 2
     x, period = end["state"], end["period"]
-    phases = br.dataset["phase"].values
+    phases = end["phases"]
     for factor, sticks in ((1 - 2e-6, 1), (1 + 2e-6, 2)):
         model = build_model(case.replace({"speed.value": end["parameter"] * factor}))
         cyc = one_period(_capped(model), x, phases, period, 1e-12, 1e-19)

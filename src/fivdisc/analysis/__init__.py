@@ -1,5 +1,5 @@
 """Analyses of the slider-on-disc system: equilibrium, stability, Hopf points, spectra,
-trajectories, energy, periodic orbits, Lyapunov exponents.
+trajectories, energy, periodic orbits and their symmetry, Lyapunov exponents.
 
 The names below are imported on first use, so that importing one analysis module (say
 :mod:`fivdisc.analysis.spectra`) does not import the others.
@@ -20,6 +20,8 @@ _API = {
                                       "separation_intervals", "separation_stats"),
     "fivdisc.analysis.energy": ("energy_balance",),
     "fivdisc.analysis.orbits": ("PeriodicOrbit", "periodic_orbit"),
+    "fivdisc.analysis.symmetry": ("CaseSymmetry", "OrbitSymmetry", "case_symmetry",
+                                  "orbit_symmetry"),
     "fivdisc.analysis.cycle": ("Cycle", "one_period"),
     "fivdisc.analysis.exponents": ("LyapunovSpectrum", "lyapunov"),
     "fivdisc.analysis.regimes": ("Regime", "cross_check"),

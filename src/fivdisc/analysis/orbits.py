@@ -880,7 +880,12 @@ def periodic_orbit(
         shot = shooting.full(shot if shot.monodromy is not None
                              else shooting.shoot(sol.x0, sol.period))
     mult, trivial = shooting.stability(shot)
+    # The coordinates the contact holds (a slider's z, zdot in contact) and the stuck
+    # sliders' rates are not unknowns: the state kept has them as the flow gives them.
     x_end = shooting.held(sol.x0)
+    if not sol.reason and not isinstance(shooting, SymmetricShooting):
+        held = ~sol.shot.free
+        x_end[held] = sol.shot.end[held]
     symmetry = ""
     if group and not sol.reason:
         symmetry = orbit_symmetry(group, model, x_end, phases, sol.period, rtol,

@@ -332,6 +332,10 @@ def orbit_symmetry(group: CaseSymmetry, model: Model, x0: np.ndarray, phases: np
     atol = rtol * 1e-7 if atol is None else atol
     shooting = Shooting(model, phases, rtol, atol)
     scale = shooting.scale
+    # the coordinates held by the contact as the flow sets them (a guess may not have)
+    x0 = shooting.held(x0)
+    whole = shooting.shoot(x0, period, tangents=False)
+    x0[~whole.free] = whole.end[~whole.free]
     ends: dict[int, np.ndarray] = {}
     size = np.nan
     for k in sorted({el.order for el in group.elements}, reverse=True):

@@ -29,7 +29,7 @@ from fivdisc.case.friction import (
 from fivdisc.case.keys import KeyInfo, describe_key, is_case_key, keys_like, unit_of
 from fivdisc.case.root import Case, load_case
 from fivdisc.case.simulation import Perturbation, Simulation
-from fivdisc.case.slider import Slider
+from fivdisc.case.slider import Slider, SliderPerturbation
 from fivdisc.case.speed import (
     AcceleratingSpeed,
     ConstantSpeed,
@@ -57,6 +57,7 @@ __all__ = [
     "Perturbation",
     "Simulation",
     "Slider",
+    "SliderPerturbation",
     "Speed",
     "StribeckFriction",
     "TableFriction",

@@ -33,6 +33,7 @@ from fivdisc.continuation.settings import (
     MAX_NEWTON,
     NEAR_SWITCHES,
     POLISH,
+    PREFER_FREE,
     REANCHOR,
     SETTLED,
     ContinuationSettings,
@@ -405,17 +406,13 @@ class OrbitProblem:
     def anchored(self, x: np.ndarray, period: float, p: float, phases: np.ndarray,
                  cycle: Cycle | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The orbit through ``x`` (phases ``phases``) moved to the middle of its longest
-        interval without a switch: its point there and the phases."""
+        interval without a switch (one where no slider sticks if that is at least
+        :data:`PREFER_FREE` as long): its point there and the phases."""
         model = self.model(p)
         shooting = Shooting(model, phases, self.rtol, self.atol, self.scale)
         if cycle is None:
             cycle = shooting.cycle(x, period)
-        times = np.r_[0.0, cycle.switch_times, period]
-        gaps = np.diff(times)
-        # the interval across the anchor (the first and the last are one)
-        gaps[0] += gaps[-1]
-        gaps[-1] = -1.0
-        i = int(np.argmax(gaps))
+        times, gaps, i = _intervals(cycle, period)
         shift = (times[i] + 0.5 * gaps[i]) if i > 0 else 0.5 * gaps[0] - (period - times[-2])
         shift %= period
         if not shift > 0:
@@ -456,7 +453,8 @@ class OrbitProblem:
     def reanchored(self, a: Point) -> Point:
         """``a`` moved along its orbit to the middle of its longest interval without a
         switch, if its switches have drifted to within :data:`REANCHOR` of the interval
-        it lies in from it; else ``a``. The unknowns' layout (free coordinates, phases,
+        it lies in from it, or that interval has shrunk below ``REANCHOR`` of the
+        longest; else ``a``. The unknowns' layout (free coordinates, phases,
         template) follows; the scales stay, so that a step keeps its meaning, and the
         tangent keeps its orientation in the period and the key (which do not depend on
         where the point lies)."""
@@ -464,12 +462,31 @@ class OrbitProblem:
         if t.size == 0:
             return a
         here = t[0] + (a.period - t[-1])
-        if min(t[0], a.period - t[-1]) >= REANCHOR * here:
+        _, gaps, i = _intervals(a.cycle, a.period)
+        if min(t[0], a.period - t[-1]) >= REANCHOR * here and here >= REANCHOR * gaps[i]:
             return a
         x, phases = self.anchored(a.x, a.period, a.value, a.phases, a.cycle)
         self.reanchors += 1
         return self.point_at(x, a.period, a.value, phases, float(np.sign(a.tangent[-1])),
                              along=a.tangent, residual=a.residual, iterations=a.iterations)
+
+
+def _intervals(cycle: Cycle, period: float) -> tuple[np.ndarray, np.ndarray, int]:
+    """The start, the switches and the end of one period, the lengths of the intervals
+    between them (the first, across the point, holding the last too; the last -1), and
+    the interval the point belongs in: the longest in which no slider sticks if it is at
+    least :data:`PREFER_FREE` of the longest of all (there every coordinate of the point
+    is free, and one slider's branches keep their points where they always were), else
+    the longest."""
+    times = np.r_[0.0, cycle.switch_times, period]
+    gaps = np.diff(times)
+    gaps[0] += gaps[-1]
+    gaps[-1] = -1.0
+    free = np.where(np.asarray(cycle.stick_free, dtype=bool)[: gaps.size], gaps, -1.0)
+    i = int(np.argmax(gaps))
+    if free.max() >= PREFER_FREE * gaps[i]:
+        i = int(np.argmax(free))
+    return times, gaps, i
 
 
 def close_switches(cycle: Cycle) -> bool:

@@ -22,8 +22,11 @@ DP_STEP = 1e-6
 # switches change order there) and the difference is taken on one side.
 DP_CONSISTENT = 1e-2
 # A point is moved along its orbit when a switch has come within this fraction of the
-# switch-free interval it lies in.
+# switch-free interval it lies in, or that interval is this fraction of the longest.
 REANCHOR = 0.25
+# The point lies in an interval where no slider sticks if there is one at least this
+# fraction as long as the longest interval without a switch.
+PREFER_FREE = 0.05
 # A point that did not polish is refused when switches of different pads lie within this
 # fraction of the period of each other (next to a border where they change order).
 NEAR_SWITCHES = 1e-5

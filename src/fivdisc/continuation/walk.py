@@ -606,6 +606,12 @@ def _end(problem: OrbitProblem, walk: Walk, br: Bracket, index: int,
                 + (f" and the flow map jumps (a relief of {jump:.3g} at the switch)"
                    if np.isfinite(jump) and jump > 0 else ""))
         stop = f"the orbit does not persist past the discontinuity at {key} = {at:.9g}"
+    elif slip_margin(problem, lo) < GRAZING:
+        walk.bifurcations.append(grazing(problem, lo, index))
+        walk.bifurcations[-1].note += confirm
+        walk.stop = Stop(f"the orbit grazes the stick boundary at {key} = {lo.value:.9g} and "
+                         f"does not persist past it{confirm}")
+        return None
     elif ahead is not None and ahead.test.kind == "cascade":
         kind = "cascade end"
         what = (f"{ahead.test.text}: it reaches zero at {key} = {ahead.at:.9g}, where the "
@@ -618,12 +624,6 @@ def _end(problem: OrbitProblem, walk: Walk, br: Bracket, index: int,
         what = (f"{ahead.test.text}: it reaches zero at {key} = {ahead.at:.9g}, where a phase "
                 "appears or vanishes")
         stop = f"the orbit does not persist past the signature change at {key} = {at:.9g}"
-    elif slip_margin(problem, lo) < GRAZING:
-        walk.bifurcations.append(grazing(problem, lo, index))
-        walk.bifurcations[-1].note += confirm
-        walk.stop = Stop(f"the orbit grazes the stick boundary at {key} = {lo.value:.9g} and "
-                         f"does not persist past it{confirm}")
-        return None
     else:
         walk.bifurcations.append(Bifurcation(
             kind="end", parameter=at, period=lo.period, state=lo.x.copy(),
