@@ -132,7 +132,7 @@ def _check_point(branch, i):
     change of the last Richardson step; and the branch's sorted multiplier moduli."""
     case = branch.case.replace({KEY: float(branch.parameter[i])})
     x = np.asarray(branch.dataset["state"].values[i], float)
-    phases = np.atleast_1d(branch.dataset["phase"].values).astype(int)
+    phases = branch.phases(i).astype(int)
     period = float(branch.period[i])
     blk = _blocks(x.size, phases.size)
     assert np.all(phases == 0), "the continuation's points lie in slip"

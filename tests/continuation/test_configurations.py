@@ -12,8 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fivdisc.analysis.orbits import energy_scales, periodic_orbit
+from fivdisc.analysis.orbits import Shooting, energy_scales, periodic_orbit
 from fivdisc.case import Case
+from fivdisc.continuation.borders import groups
 from fivdisc.continuation.walk import continue_orbit
 from fivdisc.engine.integration import Integration
 from fivdisc.engine.result import EVENT_KINDS
@@ -100,6 +101,14 @@ def check_point(case: Case, state, phases, period: float, multipliers, trivial: 
         assert late < early
     else:
         assert late > early
+    shooting = Shooting(model, phases, 1e-12, 1e-19)
+    if any(len({j for _, j, _ in g}) > 1 for _, g in groups(shooting.cycle(state, period))):
+        # switches of different pads coincide: the orbit lies where pieces of the flow map
+        # meet, its multipliers are one side's (the integration's order of the
+        # coinciding switches), and a perturbation, which parts them, decays or grows at
+        # another side's rate (on the four pads in phase, 0.9963 per period against
+        # 0.9914)
+        return
     assert rate == pytest.approx(math.log(largest), rel=0.3, abs=2e-4)
 
 

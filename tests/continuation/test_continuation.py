@@ -92,7 +92,7 @@ def test_continuation_in_a_slider_key_matches_independent_solves():
 
     model = build_model(LIGHT.replace({"slider.normal_damping": 40.0}))
     x = br.dataset["state"].values[-1]
-    shot = Shooting(model, br.dataset["phase"].values, 1e-12, 1e-19).shoot(
+    shot = Shooting(model, br.phases(len(br) - 1), 1e-12, 1e-19).shoot(
         x, float(br.period[-1]), tangents=False)
     scale = energy_scales(model)
     size = np.linalg.norm(shot.rate_start / scale) * br.period[-1]
@@ -206,8 +206,7 @@ def test_the_doubled_orbits_are_born_at_the_period_doubling():
     primary = continue_orbit(case, "disc.damping_ratio", 2e-6, orbit=start, max_points=120)
     (pd,) = [b for b in primary.bifurcations() if b["kind"] == "period doubling"]
     at = case.replace({"disc.damping_ratio": pd["parameter"]})
-    phases = primary.dataset["phase"].values
-    orbit, along = doubled_start(at, pd["state"], pd["period"], phases)
+    orbit, along = doubled_start(at, pd["state"], pd["period"], pd["phases"])
     doubled = continue_orbit(at, "disc.damping_ratio", 0.0, orbit=orbit, along=along,
                              max_points=8)
     assert len(doubled) == 8
@@ -219,7 +218,7 @@ def test_the_doubled_orbits_are_born_at_the_period_doubling():
         model = build_model(at.replace({"disc.damping_ratio": float(doubled.parameter[i])}))
         scale = energy_scales(model)
         x = doubled.dataset["state"].values[i]
-        half = Shooting(model, doubled.dataset["phase"].values, 1e-12, 1e-19, scale).shoot(
+        half = Shooting(model, doubled.phases(i), 1e-12, 1e-19, scale).shoot(
             x, 0.5 * float(doubled.period[i]), tangents=False)
         size = np.linalg.norm(half.rate_start / scale) * doubled.period[i]
         gap = np.linalg.norm(((half.end - x) / scale)[half.free]) / size

@@ -77,8 +77,8 @@ def test_the_pads_in_turn_pass_the_false_end_and_jump_where_releases_meet_sticks
     Second routes: the border is where the gap between pad 0's release and the next stick
     vanishes, extrapolated (a parabola) from the orbits at 11.85, 11.846 and 11.843
     rad/s (solved apart, over T/3 with the pads permuted), the gaps measured in plain
-    runs from them (to 1e-6 rad/s); the orbit past the jump, run forward, keeps its period to 1e-7 and has
-    the next pad stick before pad 0 releases (an overlap)."""
+    runs from them (to 1e-6 rad/s); the orbit past the jump, run forward, keeps its
+    period to 1e-7 and has the next pad stick before pad 0 releases (an overlap)."""
     case, orbit = start("S11.9")
     br = continue_orbit(case, "speed.value", 11.6, orbit=orbit, max_points=12,
                         confirm_periods=0)
@@ -123,8 +123,8 @@ def test_the_pads_in_turn_pass_the_false_end_and_jump_where_releases_meet_sticks
 def _no_silent_jumps(case: Case, br) -> None:
     """Consecutive points share the order of all switches unless a bifurcation is
     recorded between them."""
-    from fivdisc.continuation.problem import Point
     from fivdisc.analysis.symmetry import case_symmetry, orbit_symmetry
+    from fivdisc.continuation.problem import Point
 
     marked = {b["point"] for b in br.bifurcations()}
     keys = []

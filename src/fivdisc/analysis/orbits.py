@@ -20,6 +20,7 @@ slip-to-stick, by a plastic impact) or a coordinate that is not free at x0 (``z`
 
 from __future__ import annotations
 
+import itertools
 import json
 import time
 from dataclasses import dataclass, field
@@ -890,6 +891,14 @@ def periodic_orbit(
     if group and not sol.reason:
         symmetry = orbit_symmetry(group, model, x_end, phases, sol.period, rtol,
                                   atol_run).name
+    if not sol.reason and model.n_sliders > 1:
+        together = _coinciding(shooting, x_end, sol.period)
+        if together:
+            notes.append(f"switches of different pads coincide ({together}): the orbit lies "
+                         "where pieces of the flow map meet, and its multipliers are those "
+                         "of the order in which the integration makes the coinciding "
+                         "switches; a perturbation, which parts them, may decay or grow at "
+                         "another rate")
     orbit = PeriodicOrbit(period=float(sol.period), state=x_end, phases=phases.copy(),
                           monodromy=shot.monodromy, multipliers=mult, trivial=trivial,
                           residual=sol.residual, iterations=sol.iterations,
@@ -905,6 +914,24 @@ def periodic_orbit(
             f"(tolerance {tol:g}) with period {sol.period:.6g} s{hint}", result=orbit,
             reason=sol.reason)
     return orbit
+
+
+def _coinciding(shooting: Shooting, x0: np.ndarray, period: float) -> str:
+    """The switches of different sliders at one instant on the orbit through ``x0``, in
+    words ("" if none)."""
+    from fivdisc.analysis.cycle import EVENT_WORDS, SIMULTANEOUS
+
+    base = Shooting(shooting.model, shooting.phases, shooting.rtol, shooting.atol,
+                    shooting.scale)
+    try:
+        events = base.cycle(x0, period).events
+    except FivdiscError:
+        return ""
+    out = []
+    for (t1, k1, j1), (t2, k2, j2) in itertools.pairwise(events):
+        if j1 != j2 and t2 - t1 <= SIMULTANEOUS * period:
+            out.append(f"pad {j1}'s {EVENT_WORDS[k1]} and pad {j2}'s {EVENT_WORDS[k2]}")
+    return ", ".join(dict.fromkeys(out))
 
 
 def _symmetric(group, model: Model, x0: np.ndarray, phases: np.ndarray, period: float,
