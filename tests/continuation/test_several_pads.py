@@ -123,7 +123,8 @@ def test_the_pads_in_turn_pass_the_false_end_and_jump_where_releases_meet_sticks
 def _no_silent_jumps(case: Case, br) -> None:
     """Consecutive points share the order of all switches unless a bifurcation is
     recorded between them."""
-    from fivdisc.analysis.symmetry import case_symmetry, orbit_symmetry
+    from fivdisc.analysis.orbits import orbit_symmetry
+    from fivdisc.analysis.symmetry import case_symmetry
     from fivdisc.continuation.problem import Point
 
     marked = {b["point"] for b in br.bifurcations()}
@@ -249,3 +250,42 @@ def test_the_pads_in_turn_solved_over_a_third_of_the_period():
     assert sorted(sliders[(kinds == 0) & (times > full.period)
                           & (times <= 2 * full.period)]) == [0, 1, 2]
     np.testing.assert_allclose(np.diff(np.sort(first)), full.period / 3, atol=1e-9)
+
+
+@pytest.mark.slow
+def test_the_torus_of_the_hopf_branch_is_a_symmetry_breaking():
+    """The issue's "torus" at 19.7231 rad/s, on the orbits born at the subcritical Hopf
+    point at 19.5731: the orbits have the pads moving in turn, T/3 apart, and the pair
+    that leaves the unit circle is one of the T/3 map at 5.7e-6 turns from the 1:3
+    resonance: a symmetry breaking, not a torus.
+
+    Second route: at the located point, the reduced map computed apart (a run over T/3
+    with tangents, mapped back by P) has a pair on the unit circle (to 1e-4) at that
+    angle, whose cube is the full period's pair at +-1.7e-5 turns (to 1e-6)."""
+    import cmath
+
+    from fivdisc.analysis.hopf import hopf_points
+    from fivdisc.analysis.orbits import orbit_symmetry
+    from fivdisc.analysis.symmetry import case_symmetry
+    from fivdisc.continuation.from_hopf import hopf_cycles
+
+    found = hopf_points(CASE, "speed.value", np.linspace(1.0, 30.0, 59))
+    hopf = next(h for h in found if h.on_boundary)
+    assert hopf.value == pytest.approx(19.5731, abs=1e-3)
+    br = hopf_cycles(hopf, 30.0, max_points=60, confirm_periods=0)
+    kinds = [b["kind"] for b in br.bifurcations()]
+    assert "torus" not in kinds
+    (sb,) = [b for b in br.bifurcations() if b["kind"] == "symmetry breaking"]
+    assert sb["parameter"] == pytest.approx(19.72305, abs=2e-5)
+    assert "2 pi (1/3 - 5.7e-06)" in sb["note"] and "1:3 resonance" in sb["note"]
+    assert set(br.symmetries()) == {"pads move in turn, T/3 apart"}
+    case = CASE.replace({"speed.value": sb["parameter"]})
+    model = build_model(case)
+    sym = orbit_symmetry(case_symmetry(model), model, sb["state"], sb["phases"],
+                         sb["period"], reduced=True)
+    assert sym.k == 3
+    mu = np.linalg.eigvals(sym.reduced)
+    near = mu[np.argmin(np.abs(np.abs(mu) - 1.0) + np.abs(np.abs(np.angle(mu)) - 2 * np.pi / 3))]
+    assert abs(abs(near) - 1.0) < 1e-4
+    assert abs(np.angle(near)) / (2 * np.pi) == pytest.approx(1 / 3 - 5.7e-6, abs=5e-7)
+    assert abs(cmath.phase(near**3)) / (2 * np.pi) == pytest.approx(1.7e-5, abs=1e-6)

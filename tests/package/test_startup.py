@@ -46,7 +46,7 @@ def _run(code: str, *args: str) -> subprocess.CompletedProcess:
 @pytest.mark.parametrize(("code", "args", "shows"), [
     ("    import fivdisc", (), ""),
     (_CLI, ("--help",), "Usage: fivdisc [OPTIONS] COMMAND"),
-    (_CLI, ("simulate", "--help"), "Usage: fivdisc simulate [OPTIONS] CASE_FILE"),
+    (_CLI, ("simulate", "--help"), "Usage: fivdisc simulate [OPTIONS] [CASE_FILE]"),
 ], ids=["import fivdisc", "fivdisc --help", "fivdisc simulate --help"])
 def test_start_imports_no_heavy_module(code, args, shows):
     out = _run(_PROBE.format(code=code, heavy=HEAVY), *args)

@@ -29,13 +29,21 @@ from typing import NamedTuple
 
 import numpy as np
 
+from fivdisc.analysis.symmetry import (
+    ORBIT_SYMMETRY,
+    CaseSymmetry,
+    Element,
+    OrbitSymmetry,
+    case_symmetry,
+)
 from fivdisc.case import Case
 from fivdisc.engine.integration import Integration, tangent_step
 from fivdisc.errors import ConvergenceError, FivdiscError
 from fivdisc.model import layout as lay
 from fivdisc.model.build import Model, build_model
 
-__all__ = ["PeriodicOrbit", "SavedStart", "Shooting", "periodic_orbit", "saved_start"]
+__all__ = ["PeriodicOrbit", "SavedStart", "Shooting", "SymmetricShooting", "orbit_symmetry",
+           "periodic_orbit", "saved_start"]
 
 VERDICTS = ("stable", "unstable", "not converged")
 # Halvings of a Newton step that does not reduce the residual before giving up.
@@ -815,8 +823,6 @@ def periodic_orbit(
               else np.asarray(phases, dtype=np.int64))
     shooting: Shooting = Shooting(model, phases, rtol, atol_run)
     deadline = time.monotonic() + time_budget
-    from fivdisc.analysis.symmetry import case_symmetry, orbit_symmetry
-
     group = case_symmetry(model)
     notes = []
     if symmetric:
@@ -938,8 +944,6 @@ def _symmetric(group, model: Model, x0: np.ndarray, phases: np.ndarray, period: 
                rtol: float, atol: float) -> SymmetricShooting:
     """The T/k shooting of the spatio-temporal symmetry the motion from ``x0`` shows
     (to 1e-2 of its size: it is not converged yet)."""
-    from fivdisc.analysis.symmetry import orbit_symmetry
-
     if not group:
         raise FivdiscError(f"symmetric: the case has no symmetry ({group.description}): "
                            "identical pads equally spaced on a face are needed")
@@ -950,6 +954,101 @@ def _symmetric(group, model: Model, x0: np.ndarray, phases: np.ndarray, period: 
                            + (f" (it is {found.name}: solve it over the full period)"
                               if found else "") + "; leave out --symmetric")
     return SymmetricShooting(model, phases, rtol, atol, found.shift.matrix, found.k)
+
+
+def orbit_symmetry(group: CaseSymmetry, model: Model, x0: np.ndarray, phases: np.ndarray,
+                   period: float, rtol: float = 1e-12, atol: float | None = None,
+                   tol: float = ORBIT_SYMMETRY, sticks: bool | None = None,
+                   reduced: bool = False) -> OrbitSymmetry:
+    """The symmetry of the orbit through ``x0`` (phases ``phases``, period ``period``)
+    under the elements of ``group``.
+
+    Parameters
+    ----------
+    tol : float
+        A symmetry holds where ``|x(T/k) - P x(0)|`` (scaled, relative to the orbit's size
+        ``|f(x0)| T``) is below this.
+    sticks : bool, optional
+        Whether the pads stick on the orbit (for the name); default: ``phases`` says.
+    reduced : bool
+        Also compute ``R = P^-1 d phi_{T/k}`` of a spatio-temporal symmetry (its
+        ``reduced``).
+    """
+    if not group:
+        return OrbitSymmetry("none")
+    atol = rtol * 1e-7 if atol is None else atol
+    shooting = Shooting(model, phases, rtol, atol)
+    scale = shooting.scale
+    # the coordinates held by the contact as the flow sets them (a guess may not have)
+    x0 = shooting.held(x0)
+    whole = shooting.shoot(x0, period, tangents=False)
+    x0[~whole.free] = whole.end[~whole.free]
+    ends: dict[int, np.ndarray] = {}
+    size = np.nan
+    for k in sorted({el.order for el in group.elements}, reverse=True):
+        try:
+            shot = shooting.shoot(x0, period / k, tangents=False)
+        except FivdiscError:
+            continue
+        ends[k] = shot.end
+        size = float(np.linalg.norm(shot.rate_start / scale) * period)
+
+    def dist(a: np.ndarray, b: np.ndarray) -> float:
+        return float(np.linalg.norm((a - b) / scale) / size)
+
+    spatial = tuple(el for el in group.elements if dist(el.matrix @ x0, x0) < tol)
+    worst = max((dist(el.matrix @ x0, x0) for el in spatial), default=0.0)
+    best: tuple[int, Element, float] | None = None
+    for k, end in ends.items():
+        for el in group.elements:
+            if el.order != k or el in spatial:
+                continue
+            d = dist(end, el.matrix @ x0)
+            if d < tol:
+                best = (k, el, d)
+                break
+        if best is not None:
+            break
+    if sticks is None:
+        sticks = _sticks(model, x0, phases, period, rtol, atol)
+    verb = "stick" if sticks else "move"
+    parts = []
+    if best is not None:
+        k, el, d = best
+        worst = max(worst, d)
+        parts.append(f"pads {verb} in turn, T/{k} apart" if "turn" in el.label
+                     and "mirror" not in el.label else
+                     f"the faces {verb} in turn, T/{k} apart" if el.label.startswith("mirror")
+                     else f"pads {verb} in turn, T/{k} apart, mirrored")
+    if spatial:
+        if len(spatial) == len(group.elements):
+            parts.append("in phase")
+        else:
+            parts.append(" and ".join(
+                ("the faces in mirror image" if el.label.startswith("mirror") else
+                 f"alike after a {el.label}") for el in spatial))
+    name = "; ".join(parts) if parts else "none"
+    if best is None:
+        return OrbitSymmetry(name, spatial, None, 1, worst)
+    k, el, _ = best
+    red = None
+    if reduced:
+        shot = shooting.shoot(x0, period / k)
+        red = np.linalg.solve(el.matrix, shot.monodromy)
+    return OrbitSymmetry(name, spatial, el, k, worst, red)
+
+
+def _sticks(model: Model, x0: np.ndarray, phases: np.ndarray, period: float, rtol: float,
+            atol: float) -> bool:
+    """Whether a pad sticks on the orbit through ``x0`` over one period."""
+    from fivdisc.engine.integration import Integration
+
+    if np.any(phases == lay.STICK):
+        return True
+    run = Integration(model, x0, duration=period, rtol=rtol, atol=atol, phases=phases)
+    run.run_to(period)
+    _, rows = run.events()
+    return bool(np.any(rows[:, 2] == lay.STICK)) if rows.size else False
 
 
 class SavedStart(NamedTuple):

@@ -37,10 +37,9 @@ import numpy as np
 
 from fivdisc.case import Case
 from fivdisc.errors import FivdiscError
-from fivdisc.model import layout as lay
 from fivdisc.model.build import Model
 
-__all__ = ["CaseSymmetry", "Element", "OrbitSymmetry", "case_symmetry", "orbit_symmetry"]
+__all__ = ["CaseSymmetry", "Element", "OrbitSymmetry", "case_symmetry", "classify_reduced"]
 
 # Relative change of two angles taken as the same place on the disc [rad].
 _ANGLE = 1e-9
@@ -182,11 +181,15 @@ def equivariance_error(model: Model, matrix: np.ndarray, samples: int = 3,
                        seed: int = 36) -> float:
     """The largest ``|f(P x) - P f(x)| / |f(x)|`` (scaled by the energy scales) over
     random states near the sliding equilibrium with every pad slipping."""
-    from fivdisc.analysis.orbits import energy_scales
     from fivdisc.engine.equilibrium import sliding_equilibrium
 
     rng = np.random.default_rng(seed)
-    scale = energy_scales(model)
+    # each coordinate's size: 1/sqrt of its stiffness or inertia (the energy scales of
+    # fivdisc.analysis.orbits, written out here to keep this module below that one)
+    kern = model.kernel
+    scale = 1.0 / np.sqrt(np.r_[model.modal_mass * model.omega**2, kern.row("kphi"),
+                                kern.row("kz"), model.modal_mass, kern.row("inertia"),
+                                kern.row("mass")])
     base = sliding_equilibrium(model).state
     omega = float(model.speed.omega(0.0))
     rates = slice(model.index("phi_dot"), model.index("phi_dot") + model.n_sliders)
@@ -301,107 +304,6 @@ def case_symmetry(model: Model, check: bool = True) -> CaseSymmetry:
     if not elements:
         return CaseSymmetry((), "none (the pads differ, or are not equally spaced)")
     return CaseSymmetry(tuple(elements), "; ".join(words), error)
-
-
-def _power(el: Element, k: int) -> np.ndarray:
-    return np.linalg.matrix_power(el.matrix, k)
-
-
-def orbit_symmetry(group: CaseSymmetry, model: Model, x0: np.ndarray, phases: np.ndarray,
-                   period: float, rtol: float = 1e-12, atol: float | None = None,
-                   tol: float = ORBIT_SYMMETRY, sticks: bool | None = None,
-                   reduced: bool = False) -> OrbitSymmetry:
-    """The symmetry of the orbit through ``x0`` (phases ``phases``, period ``period``)
-    under the elements of ``group``.
-
-    Parameters
-    ----------
-    tol : float
-        A symmetry holds where ``|x(T/k) - P x(0)|`` (scaled, relative to the orbit's size
-        ``|f(x0)| T``) is below this.
-    sticks : bool, optional
-        Whether the pads stick on the orbit (for the name); default: ``phases`` says.
-    reduced : bool
-        Also compute ``R = P^-1 d phi_{T/k}`` of a spatio-temporal symmetry (its
-        ``reduced``).
-    """
-    from fivdisc.analysis.orbits import Shooting
-
-    if not group:
-        return OrbitSymmetry("none")
-    atol = rtol * 1e-7 if atol is None else atol
-    shooting = Shooting(model, phases, rtol, atol)
-    scale = shooting.scale
-    # the coordinates held by the contact as the flow sets them (a guess may not have)
-    x0 = shooting.held(x0)
-    whole = shooting.shoot(x0, period, tangents=False)
-    x0[~whole.free] = whole.end[~whole.free]
-    ends: dict[int, np.ndarray] = {}
-    size = np.nan
-    for k in sorted({el.order for el in group.elements}, reverse=True):
-        try:
-            shot = shooting.shoot(x0, period / k, tangents=False)
-        except FivdiscError:
-            continue
-        ends[k] = shot.end
-        size = float(np.linalg.norm(shot.rate_start / scale) * period)
-
-    def dist(a: np.ndarray, b: np.ndarray) -> float:
-        return float(np.linalg.norm((a - b) / scale) / size)
-
-    spatial = tuple(el for el in group.elements if dist(el.matrix @ x0, x0) < tol)
-    worst = max((dist(el.matrix @ x0, x0) for el in spatial), default=0.0)
-    best: tuple[int, Element, float] | None = None
-    for k, end in ends.items():
-        for el in group.elements:
-            if el.order != k or el in spatial:
-                continue
-            d = dist(end, el.matrix @ x0)
-            if d < tol:
-                best = (k, el, d)
-                break
-        if best is not None:
-            break
-    if sticks is None:
-        sticks = _sticks(model, x0, phases, period, rtol, atol)
-    verb = "stick" if sticks else "move"
-    parts = []
-    if best is not None:
-        k, el, d = best
-        worst = max(worst, d)
-        parts.append(f"pads {verb} in turn, T/{k} apart" if "turn" in el.label
-                     and "mirror" not in el.label else
-                     f"the faces {verb} in turn, T/{k} apart" if el.label.startswith("mirror")
-                     else f"pads {verb} in turn, T/{k} apart, mirrored")
-    if spatial:
-        if len(spatial) == len(group.elements):
-            parts.append("in phase")
-        else:
-            parts.append(" and ".join(
-                ("the faces in mirror image" if el.label.startswith("mirror") else
-                 f"alike after a {el.label}") for el in spatial))
-    name = "; ".join(parts) if parts else "none"
-    if best is None:
-        return OrbitSymmetry(name, spatial, None, 1, worst)
-    k, el, _ = best
-    red = None
-    if reduced:
-        shot = shooting.shoot(x0, period / k)
-        red = np.linalg.solve(el.matrix, shot.monodromy)
-    return OrbitSymmetry(name, spatial, el, k, worst, red)
-
-
-def _sticks(model: Model, x0: np.ndarray, phases: np.ndarray, period: float, rtol: float,
-            atol: float) -> bool:
-    """Whether a pad sticks on the orbit through ``x0`` over one period."""
-    from fivdisc.engine.integration import Integration
-
-    if np.any(phases == lay.STICK):
-        return True
-    run = Integration(model, x0, duration=period, rtol=rtol, atol=atol, phases=phases)
-    run.run_to(period)
-    _, rows = run.events()
-    return bool(np.any(rows[:, 2] == lay.STICK)) if rows.size else False
 
 
 @dataclass(frozen=True)

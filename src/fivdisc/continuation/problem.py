@@ -399,7 +399,7 @@ class OrbitProblem:
         symmetry: the classification of its multipliers)."""
         if not self.group:
             return
-        from fivdisc.analysis.symmetry import orbit_symmetry
+        from fivdisc.analysis.orbits import orbit_symmetry
 
         sticks = "stick" in " ".join(point.cycle.signature)
         sym = orbit_symmetry(self.group, self.model(point.value), point.x, point.phases,
