@@ -175,6 +175,31 @@ def test_the_asymmetric_orbit_ends_where_a_release_would_jump():
     assert np.ptp(periods) > 1e-7
     assert abs(periods.mean() / period - 1) < 0.01
     assert all(np.sum((kinds == 0) & (sliders == j)) >= 190 for j in range(3))
+    # d/dp of the held flow map just below the end, where a difference step of 1e-6 of
+    # the key straddles the jump: taken on the side away from it, as a much smaller
+    # one-sided difference (1e-8 of the key) on that side gives it (to 1e-2), where the
+    # central difference is off by far more
+    from fivdisc.continuation.problem import OrbitProblem
+    from fivdisc.continuation.settings import DP_STEP, ContinuationSettings
+
+    problem = OrbitProblem(case, "speed.value", phases, period, ContinuationSettings())
+    problem.point_at(problem.shooting.held(state), period, end["parameter"] - 4e-6, phases,
+                     1.0)
+    p = end["parameter"] - 4e-6
+    column, near = problem.dgap_dp(problem.template, period, p)
+    assert near
+    def end_at(q):
+        return problem.shooter(q).shoot(problem.template, period, tangents=False).end
+
+    def scaled(diff):
+        return diff[problem.free] / problem.scale[problem.free] * problem.ps / problem.xs
+
+    h = 1e-8 * p
+    fine = scaled((end_at(p) - end_at(p - h)) / h)
+    assert np.linalg.norm(column - fine) < 1e-2 * np.linalg.norm(fine)
+    wide = DP_STEP * problem.ps
+    central = scaled((end_at(p + wide) - end_at(p - wide)) / (2 * wide))
+    assert np.linalg.norm(central - fine) > 0.3 * np.linalg.norm(fine)
 
 
 @pytest.mark.slow
@@ -194,6 +219,7 @@ def test_the_in_phase_orbit_ends_where_its_release_cascade_breaks():
                         confirm_periods=200)
     assert "release cascade" in br.stop_reason
     (end,) = [b for b in br.bifurcations() if b["kind"] == "cascade end"]
+    assert "the step halved to 1.0e-06" in end["note"]
     assert end["parameter"] == pytest.approx(5.2193, abs=1e-4)
     times, kinds, sliders = run_events(case, orbit.state, orbit.phases, 40 * orbit.period)
     assert np.ptp(stick_periods(times, kinds, sliders)[-20:]) < 1e-9

@@ -141,8 +141,11 @@ def broken_start(case: Case, state: np.ndarray, period: float, phases: np.ndarra
     scores[flow] = np.inf
     i = int(np.argmin(scores))
     if scores[i] > 0.05:
-        raise FivdiscError(f"the point is no symmetry-breaking point: no multiplier but the "
-                           f"flow direction's is near +1 (the nearest is {values[i]:.4f})")
+        raise FivdiscError(
+            f"no branch of orbits leaves the symmetry breaking at {bifurcation['parameter']:.10g}: "
+            f"no multiplier but the flow direction's is near +1 (the nearest is "
+            f"{values[i]:.4f}); its critical pair crosses the unit circle away from +1, so "
+            "the motions born there are tori (quasi-periodic), not periodic orbits")
     along = np.real(vecs[:, i])
     if np.linalg.norm(along) < 1e-6 * np.linalg.norm(vecs[:, i]):
         along = np.imag(vecs[:, i])
