@@ -355,19 +355,21 @@ def test_a_sweep_marks_an_inconclusive_exponent(tmp_path: Path) -> None:
     assert np.isnan(usable.values[0])
 
 
-def test_an_inconclusive_exponent_is_marked_and_fails_the_command() -> None:
-    """One re-orthonormalisation gives no spread, so no uncertainty: inconclusive in
-    text, JSON and the exit status."""
+def test_an_undecided_exponent_is_marked_and_fails_the_command() -> None:
+    """One re-orthonormalisation gives no spread, so no uncertainty: undecided in text,
+    JSON and the exit status."""
     result, _ = cli_run(["lyapunov", "default", "--duration", "0.01", "--transient", "0",
                          "--no-progress"])
     assert result.exit_code == 1
-    assert "(inconclusive)" in result.stdout
-    assert "the largest exponent is inconclusive: lambda_1 = " in one_line_error(result)
+    assert "lambda_1 = " in result.stdout and "undecided at this length" in result.stdout
+    assert "undecided, no uncertainty estimate" in one_line_error(result)
     result, _ = cli_run(["lyapunov", "default", "--duration", "0.01", "--transient", "0",
                          "--no-progress", "--json"])
     import json
 
-    assert json.loads(result.stdout)["conclusive"] == [False]
+    data = json.loads(result.stdout)
+    assert data["conclusive"] == [False, False]
+    assert data["verdicts"] == ["undecided", "undecided"] and data["verdict"] == "undecided"
 
 
 def test_conclusive_follows_the_uncertainty() -> None:

@@ -17,7 +17,6 @@ import numpy as np
 import xarray as xr
 
 from fivdisc.analysis.points import ParameterPoints, reduced_indices
-from fivdisc.analysis.stability import dominant_coordinates
 from fivdisc.case import Case
 from fivdisc.core import tangent as tan
 from fivdisc.engine.equilibrium import Equilibrium, _evaluate, slip_phases
@@ -59,7 +58,10 @@ class HopfPoint:
         largest component is real and positive. A small orbit starts at
         ``state + eps * Re(eigenvector)``.
     mode : str
-        Coordinate with most of the eigenvector's kinetic energy.
+        The label of the pair's eigenvalue branch (the ``mode`` of
+        :func:`~fivdisc.analysis.eigenbranches.eigen_branches` along the same values:
+        :func:`~fivdisc.analysis.stability.mode_labels` where the values come nearest
+        the case's own value of the key).
     on_boundary : bool
         Whether every other eigenvalue has a negative real part there: the equilibrium
         changes stability at this point (else it stays unstable on both sides).
@@ -67,6 +69,9 @@ class HopfPoint:
         The sliding equilibrium at the point.
     case : Case
         The base case with the key set to `value`.
+    unstable_modes : tuple of str
+        The labels of the other modes that are unstable there (empty where
+        `on_boundary`): while one is, every small orbit born here is unstable too.
     """
 
     key: str
@@ -81,6 +86,7 @@ class HopfPoint:
     on_boundary: bool
     equilibrium: Equilibrium
     case: Case
+    unstable_modes: tuple[str, ...] = ()
 
     @property
     def frequency(self) -> float:
@@ -94,7 +100,9 @@ class HopfPoint:
 
     def __str__(self) -> str:
         turn = "loses" if self.direction > 0 else "gains"
-        where = "" if self.on_boundary else " (another mode stays unstable)"
+        others = ", ".join(self.unstable_modes) or "another mode"
+        verb = "stay" if len(self.unstable_modes) > 1 else "stays"
+        where = "" if self.on_boundary else f" ({others} {verb} unstable)"
         return (f"Hopf point at {self.key} = {self.value:.10g}: {self.mode} at "
                 f"{self.frequency:.6g} Hz ({self.omega:.6g} rad/s) {turn} stability as "
                 f"{self.key} increases{where}")
@@ -121,9 +129,14 @@ def _full_layout(model: Model, eq: Equilibrium, vector: np.ndarray
     return state, vec
 
 
-def _locate(points: ParameterPoints, key: str, lo: float, hi: float, lam_lo: complex,
-            lam_hi: complex, guess: Equilibrium) -> HopfPoint:
-    from scipy.optimize import brentq
+def _locate(points: ParameterPoints, key: str, lo: float, hi: float, row_lo: np.ndarray,
+            row_hi: np.ndarray, b: int, labels: Sequence[str], guess: Equilibrium
+            ) -> HopfPoint:
+    """The Hopf point of branch `b` between `lo` and `hi` (its followed rows of
+    eigenvalues there `row_lo`, `row_hi`), its other modes named by `labels`."""
+    from scipy.optimize import brentq, linear_sum_assignment
+
+    lam_lo, lam_hi = row_lo[b], row_hi[b]
 
     def eig_near(value: float) -> tuple:
         model, eq, jac = points.linearise((value,), guess)
@@ -142,16 +155,24 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, lam_lo: com
     step = 1e-6 * abs(hi - lo)
     rate = (growth(root + step) - growth(root - step)) / (2.0 * step)
     pick = i if lam[i].imag > 0 else int(np.argmin(np.abs(lam - np.conj(lam[i]))))
-    others = np.delete(lam.real, [i, int(np.argmin(np.abs(lam - np.conj(lam[i]))))])
+    pair = [i, int(np.argmin(np.abs(lam - np.conj(lam[i]))))]
+    others = np.delete(lam.real, pair)
+    # Each eigenvalue at the point is matched to the branch it continues (the branches
+    # interpolated to the point), which names it.
+    t = (root - lo) / (hi - lo)
+    _, branch_of = linear_sum_assignment(
+        np.abs(lam[:, None] - (row_lo + t * (row_hi - row_lo))[None, :]))
+    unstable = [labels[branch_of[j]] for j in np.argsort(-lam.real)
+                if j not in pair and lam[j].real >= 0.0 and lam[j].imag >= 0.0]
     state, vector = _full_layout(model, eq, vec[:, pick])
     return HopfPoint(
         key=key, value=root, omega=float(lam[pick].imag),
         direction=1 if (lam_hi.real - lam_lo.real) / (hi - lo) > 0.0 else -1,
         rate=float(rate),
         eigenvalue=complex(lam[pick]), state=state, eigenvector=vector,
-        mode=dominant_coordinates(model, vec[:, [pick]])[0],
-        on_boundary=bool(np.all(others < 0.0)), equilibrium=eq,
+        mode=str(labels[b]), on_boundary=bool(np.all(others < 0.0)), equilibrium=eq,
         case=points.case.replace({key: root}),
+        unstable_modes=tuple(dict.fromkeys(unstable)),
     )
 
 
@@ -200,6 +221,7 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
         branches = eigen_branches(case, key, values, option=option)
     values = branches[key].values
     lam = branches["growth_rate"].values + 2j * np.pi * branches["frequency"].values
+    labels = [str(m) for m in branches["mode"].values]
     points = ParameterPoints(case, [key])
     found = []
     for b in range(lam.shape[1]):
@@ -209,7 +231,47 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
             if not both or (re[i] < 0.0) == (re[i + 1] < 0.0) or min(im[i], im[i + 1]) <= 0:
                 continue
             guess = points.equilibrium(points.model((values[i],)))
-            found.append(_locate(points, key, values[i], values[i + 1], lam[i, b],
-                                 lam[i + 1, b], guess))
+            found.append(_locate(points, key, values[i], values[i + 1], lam[i], lam[i + 1],
+                                 b, labels, guess))
     ascending = values[-1] > values[0]
     return sorted(found, key=lambda h: h.value, reverse=not ascending)
+
+
+def with_hopf_points(branches: xr.Dataset, hopf: Sequence[HopfPoint]) -> xr.Dataset:
+    """The branches of :func:`~fivdisc.analysis.eigenbranches.eigen_branches` with their
+    Hopf points (what ``fivdisc stability --x`` writes).
+
+    Parameters
+    ----------
+    branches : xarray.Dataset
+        The branches.
+    hopf : sequence of HopfPoint
+        Their Hopf points (:func:`hopf_points` over the same key and values).
+
+    Returns
+    -------
+    xarray.Dataset
+        `branches` with, along a dimension ``hopf``: ``hopf`` (the key's value),
+        ``hopf_frequency`` [Hz], ``hopf_direction`` (+1: the mode loses stability as the
+        key increases), ``hopf_mode`` (the branch's label, as ``mode``),
+        ``hopf_on_boundary`` (1: the equilibrium changes stability there) and
+        ``hopf_unstable_modes`` (the other modes unstable there, comma-separated).
+    """
+    key = branches.attrs["x_key"]
+    return branches.assign(
+        hopf=(("hopf",), np.array([hp.value for hp in hopf], dtype=float),
+              {**branches[key].attrs, "long_name": "Hopf points: where a complex pair "
+                                                    "crosses the imaginary axis"}),
+        hopf_frequency=(("hopf",), np.array([hp.frequency for hp in hopf], dtype=float),
+                        {"units": "Hz", "long_name": "critical frequency"}),
+        hopf_direction=(("hopf",), np.array([hp.direction for hp in hopf], dtype=np.int8),
+                        {"long_name": "+1: the mode loses stability as the key increases"}),
+        hopf_mode=(("hopf",), np.array([hp.mode for hp in hopf], dtype=str),
+                   {"long_name": "label of the critical mode's branch (as mode)"}),
+        hopf_on_boundary=(("hopf",), np.array([hp.on_boundary for hp in hopf], dtype=np.int8),
+                          {"long_name": "1: the equilibrium changes stability here; 0: "
+                                        "another mode stays unstable on both sides"}),
+        hopf_unstable_modes=(("hopf",), np.array([", ".join(hp.unstable_modes)
+                                                  for hp in hopf], dtype=str),
+                             {"long_name": "the other modes unstable here"}),
+    )

@@ -105,25 +105,16 @@ def _write(out: Path, figure, ds) -> None:
 
 
 def _branches(case, case_file, x_spec: str, output: Path | None, progress: bool) -> None:
-    import numpy as np
 
     from fivdisc.analysis.eigenbranches import eigen_branches
-    from fivdisc.analysis.hopf import hopf_points
+    from fivdisc.analysis.hopf import hopf_points, with_hopf_points
     from fivdisc.analysis.stability import parse_range
 
     key, values = parse_range(x_spec, "--x")
     out, figure = _target(case_file, output, "branches.nc")
     ds = eigen_branches(case, key, values, option="--x", progress=progress)
     hopf = hopf_points(case, key, values, option="--x", branches=ds)
-    ds = ds.assign(
-        hopf=(("hopf",), [hp.value for hp in hopf],
-              {**ds[key].attrs, "long_name": "Hopf points: where a complex pair crosses the "
-                                             "imaginary axis"}),
-        hopf_frequency=(("hopf",), [hp.frequency for hp in hopf],
-                        {"units": "Hz", "long_name": "critical frequency"}),
-        hopf_direction=(("hopf",), np.array([hp.direction for hp in hopf], dtype=np.int8),
-                        {"long_name": "+1: the mode loses stability as the key increases"}),
-    )
+    ds = with_hopf_points(ds, hopf)
     if case_file is not None:
         ds.attrs["case_name"] = case_file.stem
     if figure:
