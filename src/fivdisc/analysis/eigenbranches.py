@@ -239,19 +239,19 @@ def mode_couplings(lam: np.ndarray, tolerance: float = COUPLING_TOLERANCE
             wa, wb = lam[:, a].imag, lam[:, b].imag
             split = np.abs(lam[:, a].real - lam[:, b].real)
             gap = np.abs(wa - wb)
+            merged = (gap <= tolerance * np.maximum(np.abs(wa), np.abs(wb))) & (gap <= split)
             mean = 0.5 * np.abs(lam[:, a].real + lam[:, b].real)
-            merged = ((gap <= tolerance * np.maximum(np.abs(wa), np.abs(wb)))
-                      & (gap <= split) & (split >= mean))
             for i in range(1, lam.shape[0]):
                 if merged[i] == merged[i - 1] or not np.isfinite(wa[i - 1] + wb[i]):
                     continue
                 inside, outside = (i, i - 1) if merged[i] else (i - 1, i)
                 # The growth rates part on the merged side (a coupling, not a veering),
-                # and just outside it they agree as closely as the frequencies do: the
-                # eigenvalues meet. Modes whose growth rates are already apart only
-                # cross in frequency.
+                # by at least their mean distance from zero, and just outside it they
+                # agree as closely as the frequencies do: the eigenvalues meet. Modes
+                # whose growth rates are already apart only cross in frequency.
                 near = tolerance * max(abs(wa[outside]), abs(wb[outside]))
-                if split[outside] <= near and split[inside] > split[outside]:
+                if (split[outside] <= near and split[inside] > split[outside]
+                        and split[inside] >= mean[inside]):
                     found.append((inside, a, b))
     return sorted(found)
 

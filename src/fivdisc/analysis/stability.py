@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -25,6 +26,10 @@ from fivdisc.model.build import Model, build_model
 
 if TYPE_CHECKING:
     import pandas as pd
+
+#: Difference of energy shares below which two modes' labels follow their frequencies
+#: (:func:`mode_labels`).
+LABEL_TIE = 0.1
 
 # Bytes per grid point of a stability map: growth rate and stability flag, and the
 # dataset's and the netCDF writer's copies of them.
@@ -210,7 +215,11 @@ def mode_labels(model: Model, eigenvalues: np.ndarray, vectors: np.ndarray
     :func:`scipy.optimize.linear_sum_assignment`). The two modes of a disc mode with
     nodal diameters, which the sliders mix into travelling waves, are then ``C0l`` and
     ``D0l``, never both ``C0l``; identical pads' modes, each spread over every pad, are
-    ``phi0``, ``phi1``, ``phi2``. A mode left without a coordinate (real eigenvalues
+    ``phi0``, ``phi1``, ``phi2``. Where two modes' shares leave the choice open (they
+    would give up less than :data:`LABEL_TIE` of their shares by trading names: the two
+    halves of travelling waves, identical pads) the lower frequency takes the
+    coordinate listed first, so that labels do not turn on round-off. A mode left
+    without a coordinate (real eigenvalues
     outnumber what is left: an overdamped coordinate has two) takes its dominant
     coordinate's name with a prime per earlier use (``"phi0'"``).
 
@@ -239,7 +248,24 @@ def mode_labels(model: Model, eigenvalues: np.ndarray, vectors: np.ndarray
     modes = [i for i in range(lam.size) if real[i] or lam[i].imag > 0]
     shares = energy_shares(model, vectors[:, modes])
     rows, cols = linear_sum_assignment(-shares)
-    label = {modes[c]: names[r] for r, c in zip(rows, cols, strict=True)}
+    coordinate = dict(zip(cols.tolist(), rows.tolist(), strict=True))  # mode -> coordinate
+    # Near-ties follow the frequencies: where two modes would give up less than
+    # LABEL_TIE of their shares by trading names (a travelling wave's C and D halves,
+    # identical pads), the lower frequency takes the coordinate listed first. The
+    # labels are then the same for eigenvectors equal to round-off, as the same
+    # eigenvalue met in two scans is.
+    order = [(abs(lam[i].imag), lam[i].real) for i in modes]
+    for _ in range(len(modes) ** 2):
+        swapped = False
+        for a, b in itertools.combinations(sorted(coordinate), 2):
+            ca, cb = coordinate[a], coordinate[b]
+            loss = shares[ca, a] + shares[cb, b] - shares[cb, a] - shares[ca, b]
+            if loss < LABEL_TIE and (order[a] < order[b]) != (ca < cb):
+                coordinate[a], coordinate[b] = cb, ca
+                swapped = True
+        if not swapped:
+            break
+    label = {modes[c]: names[r] for c, r in coordinate.items()}
     used = {name: 1 for name in label.values()}
     for k, i in enumerate(modes):
         if i not in label:
