@@ -10,6 +10,7 @@ the real part of the eigenvalue that continues the branch.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -139,11 +140,15 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, row_lo: np.
     lam_lo, lam_hi = row_lo[b], row_hi[b]
 
     def eig_near(value: float) -> tuple:
+        """The eigen-solution at `value` and which eigenvalue continues branch `b`: all
+        of them matched to the branches interpolated there (so that near-equal
+        eigenvalues, as identical pads have, each keep their own branch)."""
         model, eq, jac = points.linearise((value,), guess)
         lam, vec = np.linalg.eig(jac)
         t = (value - lo) / (hi - lo)
-        i = int(np.argmin(np.abs(lam - (lam_lo + t * (lam_hi - lam_lo)))))
-        return model, eq, lam, vec, i
+        _, column = linear_sum_assignment(
+            np.abs((row_lo + t * (row_hi - row_lo))[:, None] - lam[None, :]))
+        return model, eq, lam, vec, int(column[b])
 
     def growth(value: float) -> float:
         _, _, lam, _, i = eig_near(value)
@@ -162,6 +167,7 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, row_lo: np.
     t = (root - lo) / (hi - lo)
     _, branch_of = linear_sum_assignment(
         np.abs(lam[:, None] - (row_lo + t * (row_hi - row_lo))[None, :]))
+    branch_of[i] = b
     unstable = [labels[branch_of[j]] for j in np.argsort(-lam.real)
                 if j not in pair and lam[j].real >= 0.0 and lam[j].imag >= 0.0]
     state, vector = _full_layout(model, eq, vec[:, pick])
@@ -210,9 +216,12 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
     Notes
     -----
     At the point the growth rate ``g(p) = Re lambda(p)`` of the branch is zero; it is
-    bracketed by a change of sign between neighbouring values and found with
-    :func:`scipy.optimize.brentq`, the eigenvalue at each trial value being the one
-    nearest to the branch's linear interpolation. A real eigenvalue crossing zero (a
+    bracketed by a change of sign between neighbouring values, the branches are followed
+    again between them in steps over which every eigenvalue moves less than a quarter
+    of the least distance between two (near-equal eigenvalues, as identical pads have,
+    each keep their own branch: up to 64 steps), and each crossing is found with
+    :func:`scipy.optimize.brentq` on its step, the eigenvalues at each trial value being
+    matched to the branches' linear interpolation. A real eigenvalue crossing zero (a
     fold of the equilibrium, not a Hopf point) is not reported.
     """
     from fivdisc.analysis.eigenbranches import eigen_branches
@@ -224,17 +233,69 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
     labels = [str(m) for m in branches["mode"].values]
     points = ParameterPoints(case, [key])
     found = []
-    for b in range(lam.shape[1]):
-        re, im = lam[:, b].real, lam[:, b].imag
-        for i in range(values.size - 1):
-            both = np.isfinite(re[i]) and np.isfinite(re[i + 1])
-            if not both or (re[i] < 0.0) == (re[i + 1] < 0.0) or min(im[i], im[i + 1]) <= 0:
-                continue
-            guess = points.equilibrium(points.model((values[i],)))
-            found.append(_locate(points, key, values[i], values[i + 1], lam[i], lam[i + 1],
-                                 b, labels, guess))
+    for i in range(values.size - 1):
+        if not _crossed(lam[i], lam[i + 1]):
+            continue
+        guess = points.equilibrium(points.model((values[i],)))
+        # Between the two values the branches are followed again in steps short enough
+        # to keep near-equal eigenvalues apart (identical pads), from the first value's
+        # order, and each crossing is located on its own sub-step.
+        sub, rows = _refine(points, values[i], values[i + 1], lam[i], lam[i + 1], guess)
+        for k in range(sub.size - 1):
+            for b in _crossed(rows[k], rows[k + 1]):
+                found.append(_locate(points, key, sub[k], sub[k + 1], rows[k], rows[k + 1],
+                                     b, labels, guess))
     ascending = values[-1] > values[0]
     return sorted(found, key=lambda h: h.value, reverse=not ascending)
+
+
+# Most sub-steps between two values of a scan in which hopf_points follows the branches
+# again (doubled from 2 until each eigenvalue moves less than _STEP_SHARE of the least
+# distance between two of them).
+_MAX_SUBSTEPS = 64
+_STEP_SHARE = 0.25
+
+
+def _crossed(row: np.ndarray, after: np.ndarray) -> list[int]:
+    """The branches whose complex eigenvalue (positive imaginary part) crosses the
+    imaginary axis from `row` to `after`."""
+    if not (np.isfinite(row).all() and np.isfinite(after).all()):
+        return []
+    return [b for b in range(row.size)
+            if (row[b].real < 0.0) != (after[b].real < 0.0)
+            and min(row[b].imag, after[b].imag) > 0]
+
+
+def _refine(points: ParameterPoints, lo: float, hi: float, row_lo: np.ndarray,
+            row_hi: np.ndarray, guess: Equilibrium) -> tuple[np.ndarray, list[np.ndarray]]:
+    """Values from `lo` to `hi` and the eigenvalues there in the order of `row_lo`'s
+    branches, followed in steps over which each moves less than a quarter of the least
+    distance between two of them."""
+    from scipy.optimize import linear_sum_assignment
+
+    def spread(row: np.ndarray) -> float:
+        d = np.abs(row[:, None] - row[None, :])
+        return float(np.min(d[~np.eye(row.size, dtype=bool)], initial=np.inf))
+
+    m = 2
+    while True:
+        sub = np.linspace(lo, hi, m + 1)
+        raw = [row_lo]
+        for value in sub[1:-1]:
+            point = points.linearise((value,), guess)
+            if point is None:  # no equilibrium inside: the coarse step it is
+                return np.array([lo, hi]), [row_lo, row_hi]
+            raw.append(np.linalg.eigvals(point[2]))
+        raw.append(row_hi)
+        rows = [row_lo]
+        for row in raw[1:]:
+            ahead = rows[-1] if len(rows) < 2 else 2.0 * rows[-1] - rows[-2]
+            _, order = linear_sum_assignment(np.abs(ahead[:, None] - row[None, :]))
+            rows.append(row[order])
+        moves = max(float(np.max(np.abs(b - a))) for a, b in itertools.pairwise(rows))
+        if moves < _STEP_SHARE * min(spread(r) for r in rows) or m >= _MAX_SUBSTEPS:
+            return sub, rows
+        m *= 2
 
 
 def with_hopf_points(branches: xr.Dataset, hopf: Sequence[HopfPoint]) -> xr.Dataset:
