@@ -19,7 +19,8 @@ import xarray as xr
 from fivdisc.analysis.points import ParameterPoints, check_box, check_keys, check_values
 from fivdisc.analysis.stability import mode_labels
 from fivdisc.case import Case
-from fivdisc.engine.equilibrium import Equilibrium
+from fivdisc.engine.equilibrium import Equilibrium, _evaluate
+from fivdisc.model import layout as lay
 from fivdisc.model.build import Model
 
 # Two branches' frequencies count as merged (a coupling) within this fraction of the
@@ -126,8 +127,9 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
         mode's label (:func:`~fivdisc.analysis.stability.mode_labels`, one per mode,
         the two branches of a pair sharing it) at the value nearest the case's own
         value of the key (``mode.labelled_at``), carried along the branch;
-        ``max_growth_rate`` (key); ``normal_force``, ``phi`` (key, slider): the
-        equilibrium (NaN where there is none); ``existence_limit`` (limit): the values
+        ``max_growth_rate`` (key); ``normal_force``, ``phi``, ``w`` (key, slider): the
+        equilibrium's normal forces, slider angles and disc deflections under the
+        sliders (NaN where there is none); ``existence_limit`` (limit): the values
         of the key where a slider's normal force reaches zero and the equilibrium ceases
         to exist; ``coupling`` (coupling) with ``coupling_first``, ``coupling_second``:
         the values (at the grid's resolution) where two branches' frequencies meet
@@ -150,6 +152,7 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
     lam = np.full((values.size, size), np.nan + 1j * np.nan)
     force = np.full((values.size, ns), np.nan)
     angle = np.full((values.size, ns), np.nan)
+    under = np.full((values.size, ns), np.nan)
     own = float(case.get(key))
     labelled = None  # (row, model, Jacobian) nearest the case's own value so far
     limits: list[float] = []
@@ -177,6 +180,7 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
         if labelled is None or abs(value - own) < abs(values[labelled[0]] - own):
             labelled = (i, model, jac)
         force[i], angle[i] = eq.normal_force, eq.phi
+        under[i] = _evaluate(model, eq.state)[1][lay.A_WC]
     if bar is not None:
         bar.close()
     lam = follow(lam)
@@ -185,7 +189,7 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
     # CASE`` does wherever its range holds that value, whatever else it spans.
     row, model, jac = labelled
     modes = _branch_labels(model, jac, lam[row])
-    ds = _dataset(case, key, values, lam, modes, force, angle, limits)
+    ds = _dataset(case, key, values, lam, modes, force, angle, under, limits)
     ds["mode"].attrs["labelled_at"] = float(values[row])
     return ds
 
@@ -258,7 +262,7 @@ def mode_couplings(lam: np.ndarray, tolerance: float = COUPLING_TOLERANCE
 
 def _dataset(case: Case, key: str, values: np.ndarray, lam: np.ndarray,
              modes: tuple[str, ...], force: np.ndarray, angle: np.ndarray,
-             limits: list[float]) -> xr.Dataset:
+             under: np.ndarray, limits: list[float]) -> xr.Dataset:
     from fivdisc.engine.conventions import global_attrs, key_attrs
 
     couplings = mode_couplings(lam)
@@ -279,6 +283,9 @@ def _dataset(case: Case, key: str, values: np.ndarray, lam: np.ndarray,
                 "units": "N", "long_name": "normal force at the sliding equilibrium"}),
             "phi": ((key, "slider"), angle, {
                 "units": "rad", "long_name": "slider angle at the sliding equilibrium"}),
+            "w": ((key, "slider"), under, {
+                "units": "m", "long_name": "disc deflection under the slider at the sliding "
+                                           "equilibrium"}),
             "existence_limit": (("limit",), np.array(limits, dtype=float), {
                 "units": key_attrs(key)["units"],
                 "long_name": "where a slider's normal force at the equilibrium reaches "

@@ -26,10 +26,15 @@ from fivdisc.errors import FivdiscError
               "CASE-branches.nc, CASE-stability.nc or CASE-boundary.nc.")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the equilibrium and the eigenvalues as JSON (without a map).")
+@click.option("--growth-scale", type=click.Choice(("auto", "linear", "symlog")),
+              default=None, help="With --x and a figure: the growth-rate axis, symmetric "
+              "log (linear near zero) or linear [default: auto, symlog where a small "
+              "rate would be a flat line beside the largest].")
 @click.option("--progress/--no-progress", default=True, show_default=True)
 def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
               curve_spec: str | None, boundary_spec: tuple[str, str] | None,
-              output: Path | None, as_json: bool, progress: bool) -> None:
+              output: Path | None, as_json: bool, growth_scale: str | None,
+              progress: bool) -> None:
     """Stability of the sliding equilibrium of CASE_FILE (default: Table 1 at 2 pi rad/s).
 
     CASE_FILE is a TOML case file or the name of a packaged example (``fivdisc examples``).
@@ -64,10 +69,15 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
                            "and --boundary")
     if y_spec is not None and x_spec is None:
         raise FivdiscError("--y needs --x too (KEY=START:STOP:N)")
+    if growth_scale is not None and not (x_spec is not None and y_spec is None
+                                         and output is not None
+                                         and output.suffix.lower() != ".nc"):
+        raise FivdiscError("--growth-scale is used only by the figure of --x alone (the "
+                           "eigenvalue branches): give -o FIGURE.png")
     if x_spec is not None and y_spec is None:
         if curve_spec is not None:
             raise FivdiscError("--curves is used only by a map: give --y too")
-        _branches(case, case_file, x_spec, output, progress)
+        _branches(case, case_file, x_spec, output, progress, growth_scale or "auto")
     elif boundary_spec:
         _boundary(case, case_file, boundary_spec, output)
     else:
@@ -104,7 +114,8 @@ def _write(out: Path, figure, ds) -> None:
     click.echo(f"wrote {out}")
 
 
-def _branches(case, case_file, x_spec: str, output: Path | None, progress: bool) -> None:
+def _branches(case, case_file, x_spec: str, output: Path | None, progress: bool,
+              growth_scale: str = "auto") -> None:
 
     from fivdisc.analysis.eigenbranches import eigen_branches
     from fivdisc.analysis.hopf import hopf_points, with_hopf_points
@@ -120,7 +131,7 @@ def _branches(case, case_file, x_spec: str, output: Path | None, progress: bool)
     if figure:
         from fivdisc.plots.stability import plot_eigen_branches
 
-        _write(out, plot_eigen_branches(ds, hopf), ds)
+        _write(out, plot_eigen_branches(ds, hopf, growth_scale=growth_scale), ds)
     else:
         _write(out, None, ds)
     unstable = ds["max_growth_rate"].values > 0.0

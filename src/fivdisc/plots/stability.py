@@ -16,7 +16,8 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 from fivdisc.plots.text import drawing, new_axes, set_title
 
-__all__ = ["plot_eigen_branches", "plot_stability_boundary", "plot_stability_map"]
+__all__ = ["GROWTH_SCALES", "growth_axis", "plot_eigen_branches", "plot_stability_boundary",
+           "plot_stability_map"]
 
 
 @drawing
@@ -134,15 +135,55 @@ def plot_stability_boundary(ds: xr.Dataset, ax: Axes | None = None) -> Figure:
     return fig
 
 
+#: Scales of the growth-rate axis of :func:`plot_eigen_branches`.
+GROWTH_SCALES = ("auto", "linear", "symlog")
+# "auto" takes a symmetric-log axis where the largest |growth rate| exceeds this many
+# times the typical branch's largest (the median over the branches).
+_SYMLOG_RATIO = 30.0
+
+
+def growth_axis(growth: np.ndarray, scale: str = "auto") -> tuple[str, float]:
+    """The growth-rate axis of an eigenvalue-branch figure: ``("linear", 0)`` or
+    ``("symlog", linthresh)``.
+
+    ``"auto"`` takes the symmetric-log axis where the largest |growth rate| is more than
+    30 times the median over the branches of each one's largest (a 4 1/s instability
+    beside 417 1/s is a flat line on a linear axis); its linear part reaches to the
+    power of ten below that median, where most branches lie.
+
+    Parameters
+    ----------
+    growth : ndarray
+        ``(values, branches)`` growth rates [1/s] (NaN: no equilibrium).
+    scale : str
+        One of :data:`GROWTH_SCALES`.
+    """
+    from fivdisc.analysis.spectra import AnalysisError
+
+    if scale not in GROWTH_SCALES:
+        raise AnalysisError(f"growth_scale = {scale!r} is invalid: must be one of "
+                            f"{', '.join(GROWTH_SCALES)}")
+    peaks = np.nanmax(np.abs(growth), axis=0, initial=0.0) if growth.size else np.zeros(1)
+    peaks = peaks[np.isfinite(peaks)]
+    typical = float(np.median(peaks)) if peaks.size else 0.0
+    top = float(peaks.max(initial=0.0))
+    if scale == "linear" or (scale == "auto" and not top > _SYMLOG_RATIO * typical):
+        return "linear", 0.0
+    floor = typical if typical > 0 else (top if top > 0 else 1.0)
+    return "symlog", float(10.0 ** np.floor(np.log10(floor)))
+
+
 @drawing
-def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None) -> Figure:
+def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None,
+                        growth_scale: str = "auto") -> Figure:
     """Frequency and growth rate of every eigenvalue branch against the key
     (:func:`fivdisc.analysis.eigenbranches.eigen_branches`).
 
-    One colour per branch (positive frequencies only: one of each complex pair); where a
-    branch is unstable it is drawn thick. Mode couplings are marked with a dotted line,
-    existence limits with a solid grey one, and Hopf points
-    (:func:`fivdisc.analysis.hopf.hopf_points`) with dots.
+    One colour per branch (positive frequencies only: one of each complex pair),
+    labelled with its mode in the key beside the axes; where a branch is unstable it is
+    drawn thick. Mode couplings are marked with a dotted line, existence limits with a
+    solid grey one, and Hopf points (:func:`fivdisc.analysis.hopf.hopf_points`) with
+    dots.
 
     Parameters
     ----------
@@ -151,15 +192,20 @@ def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None) -> Figure:
     hopf : sequence of HopfPoint, optional
         Hopf points to mark; by default those stored in `ds` (``hopf``,
         ``hopf_frequency``: ``fivdisc stability --x`` writes them), if any.
+    growth_scale : str
+        The growth-rate axis: ``"linear"``, ``"symlog"`` (symmetric log, linear near
+        zero) or ``"auto"``, symlog where the rates span more than the linear axis
+        shows (:func:`growth_axis`).
     """
     import matplotlib.pyplot as plt
 
     new_axes(None)  # chooses a headless backend where needed
     fig, (top, bottom) = plt.subplots(2, 1, sharex=True, layout="constrained",
-                                      figsize=(7.0, 6.5))
+                                      figsize=(8.0, 6.5))
     key = ds.attrs["x_key"]
     x = ds[key].values
     freq, growth = ds["frequency"].values, ds["growth_rate"].values
+    scale, linthresh = growth_axis(growth, growth_scale)
     for b in range(freq.shape[1]):
         if not np.nanmax(freq[:, b], initial=-1.0) > 0.0:
             continue
@@ -184,9 +230,16 @@ def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None) -> Figure:
         bottom.plot(value, 0.0, "ko", ms=5)
     bottom.axhline(0.0, color="k", lw=0.5)
     top.set_ylabel("frequency [Hz]")
-    bottom.set_ylabel("growth rate [1/s]")
+    if scale == "symlog":
+        bottom.set_yscale("symlog", linthresh=linthresh)
+        bottom.axhspan(-linthresh, linthresh, color="0.92", zorder=0, lw=0)
+        bottom.set_ylabel(f"growth rate [1/s]\n(symmetric log, linear within ±{linthresh:g})")
+    else:
+        bottom.set_ylabel("growth rate [1/s]")
     bottom.set_xlabel(axis_label(ds[key]))
-    top.legend(loc="best", fontsize="small", ncols=2)
+    # Beside the axes, where it hides no branch.
+    fig.legend(*top.get_legend_handles_labels(), loc="outside right upper",
+               fontsize="small", title="mode", title_fontsize="small")
     set_title(top, ds, "eigenvalue branches (thick: unstable)",
            detail="dotted: mode coupling; dots: Hopf points" if len(ds["coupling"]) or marks
            else "")
