@@ -268,7 +268,8 @@ def check_netcdf(path: str | PathLike[str]) -> bool:
 def written_by_fivdisc(path: str | PathLike[str]) -> bool:
     """Whether a netCDF file says fivdisc wrote it: it holds fivdisc's checksum
     (:data:`CHECKSUM`), or, from a fivdisc before checksums, a ``source`` attribute
-    naming fivdisc, a ``fivdisc_kind`` or a branch's ``content``.
+    naming fivdisc, a ``fivdisc_kind`` or a branch's ``content`` (at the root, or in
+    each of its groups: runs gathered into one file).
 
     Raises
     ------
@@ -277,14 +278,18 @@ def written_by_fivdisc(path: str | PathLike[str]) -> bool:
     """
     import netCDF4
 
+    def ours(group: Any) -> bool:
+        attrs = {name: group.getncattr(name) for name in group.ncattrs()}
+        return (CHECKSUM in attrs or str(attrs.get("source", "")).startswith("fivdisc")
+                or "fivdisc_kind" in attrs or attrs.get("content") == "continuation branch")
+
     try:
         with netCDF4.Dataset(path) as root:
-            attrs = {name: root.getncattr(name) for name in root.ncattrs()}
+            groups = list(root.groups.values())
+            return ours(root) or (bool(groups) and all(ours(g) for g in groups))
     except (OSError, RuntimeError, ValueError) as exc:
         raise FivdiscError(f"{path} cannot be read as a netCDF file "
                            f"({' '.join(str(exc).split())[:120]})") from None
-    return (CHECKSUM in attrs or str(attrs.get("source", "")).startswith("fivdisc")
-            or "fivdisc_kind" in attrs or attrs.get("content") == "continuation branch")
 
 
 def require_fivdisc_netcdf(path: str | PathLike[str], what: str) -> None:

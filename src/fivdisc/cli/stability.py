@@ -48,6 +48,11 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
     from fivdisc.case import Case, load_case
 
     case = load_case(case_file) if case_file else Case()
+    if growth_scale is not None and not (x_spec is not None and y_spec is None
+                                         and output is not None
+                                         and output.suffix.lower() != ".nc"):
+        raise FivdiscError("--growth-scale is used only by the figure of --x alone (the "
+                           "eigenvalue branches): give -o FIGURE.png")
     if boundary_spec and (x_spec or y_spec or curve_spec):
         raise FivdiscError("--boundary takes its own two keys: leave out --x, --y and --curves")
     if x_spec is None and y_spec is None and not boundary_spec:
@@ -69,11 +74,6 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
                            "and --boundary")
     if y_spec is not None and x_spec is None:
         raise FivdiscError("--y needs --x too (KEY=START:STOP:N)")
-    if growth_scale is not None and not (x_spec is not None and y_spec is None
-                                         and output is not None
-                                         and output.suffix.lower() != ".nc"):
-        raise FivdiscError("--growth-scale is used only by the figure of --x alone (the "
-                           "eigenvalue branches): give -o FIGURE.png")
     if x_spec is not None and y_spec is None:
         if curve_spec is not None:
             raise FivdiscError("--curves is used only by a map: give --y too")

@@ -307,8 +307,6 @@ def overlay_branch(ax: Axes, branch: Branch, key: str, variable: str, slider: in
         raise FivdiscError(f"a branch keeps phi, phi_dot and normal_force per slider, not the "
                            f"section's variable {variable!r}")
     draw_branch(ax, branch, f"{variable}_max" if maxima else variable, slider, color="C1")
-    from matplotlib.lines import Line2D
-
-    ax.legend(handles=[Line2D([], [], color="C1", ls="-", label="periodic orbits, stable"),
-                       Line2D([], [], color="C1", ls="--", label="periodic orbits, unstable")],
-              loc="best", fontsize="small", frameon=False)
+    # Entries of the key the diagram draws.
+    ax.plot([], [], color="C1", ls="-", label="periodic orbits, stable")
+    ax.plot([], [], color="C1", ls="--", label="periodic orbits, unstable")

@@ -29,8 +29,10 @@ def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None,
     with several (a ``curve_key``), each value of the third key shades the region where
     it is stable, in its colour. The grid's boundary (where the growth rate changes
     sign, either way) is drawn as a contour; a value, or a map, without one says so in
-    the legend and on the axes. Axes are labelled with the keys' descriptions, symbols
-    and units.
+    the legend and on the axes. Where the exact boundary is given, it is drawn instead,
+    over the shading: the grid's contour, a few cells' linear interpolation of the
+    growth rate, would only show beside it where the two disagree. Axes are labelled
+    with the keys' descriptions, symbols and units.
 
     Parameters
     ----------
@@ -40,8 +42,8 @@ def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None,
         Where to draw.
     boundary : xarray.Dataset or sequence of them, optional
         Exact boundary curves of :func:`fivdisc.analysis.boundary.stability_boundary`
-        over the same keys (one per curve value, with `curve_key`), drawn on top
-        (black, dashed).
+        over the same keys (one per curve value, with `curve_key`), drawn on top (solid,
+        black or the value's colour) in place of the grid's contours.
     """
     fig, ax = new_axes(ax)
     xkey, ykey = ds.attrs["x_key"], ds.attrs["y_key"]
@@ -49,16 +51,24 @@ def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None,
     absent: list[str] = []
     x, y = ds[xkey].values, ds[ykey].values
     panels = [(None, ds)] if not ckey else [(v, ds.sel({ckey: v})) for v in ds[ckey].values]
+    exact = [boundary] if isinstance(boundary, xr.Dataset) else list(boundary or [])
+    # One exact boundary per panel replaces its grid contour; any other number is laid
+    # over every panel.
+    per_panel = len(exact) == len(panels)
     from matplotlib import rcParams
 
     cycle = rcParams["axes.prop_cycle"].by_key()["color"]
-    for value, one in panels:
+    for k, (value, one) in enumerate(panels):
         stable = one["stable"].transpose(ykey, xkey).values.astype(float)
         growth = one["max_growth_rate"].transpose(ykey, xkey).values
         stable[np.isnan(growth)] = np.nan
         if value is None:
             text, color = "", "k"
-            ax.contourf(x, y, stable, levels=[-0.5, 0.5, 1.5], colors=["#f4c7c3", "#c6e5c3"])
+            # The sign of the interpolated growth rate, so that the shading's edge is the
+            # grid's contour, not a staircase of its cells.
+            big = float(np.nanmax(np.abs(growth), initial=0.0)) or 1.0
+            ax.contourf(x, y, growth, levels=[-2 * big, 0.0, 2 * big],
+                        colors=["#c6e5c3", "#f4c7c3"])
             ax.plot([], [], color="#c6e5c3", lw=8, label="stable")
             ax.plot([], [], color="#f4c7c3", lw=8, label="unstable")
         else:
@@ -69,24 +79,25 @@ def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None,
             text = f"${symbol}$ = {value:g}{unit}" if symbol else f"{ckey} = {value:g}{unit}"
             color = cycle[list(ds[ckey].values).index(value) % len(cycle)]
             if np.nanmax(stable, initial=0.0) > 0.5:
-                ax.contourf(x, y, stable, levels=[0.5, 1.5], colors=[color], alpha=0.15)
-        if np.isfinite(one["boundary"].values).any():
+                big = float(np.nanmax(np.abs(growth), initial=0.0)) or 1.0
+                ax.contourf(x, y, growth, levels=[-2 * big, 0.0], colors=[color], alpha=0.15)
+        if per_panel:
+            _draw_exact(ax, exact[k], xkey, ykey, color, text)
+        elif np.isfinite(one["boundary"].values).any():
             ax.contour(x, y, growth, levels=[0.0], colors=[color], linewidths=1.5)
             ax.plot([], [], color=color, lw=1.5,
                     label=f"{text}: boundary, stable shaded" if text else "grid boundary")
-        else:
+        if not np.isfinite(one["boundary"].values).any() and not (
+                per_panel and exact[k].sizes.get("point", 0)):
             ok = stable[np.isfinite(stable)]
             state = ("stable throughout" if ok.size and ok.all() else "unstable throughout"
                      if not ok.any() else f"stable at {ok.mean():.0%}, no sign change")
             absent.append(f"{text} ({state})" if text else state)
             if text:
                 ax.plot([], [], color=color, lw=8, alpha=0.3, label=f"{text}: {state}")
-    exact = [boundary] if isinstance(boundary, xr.Dataset) else list(boundary or [])
-    for k, one in enumerate(exact):
-        for b in np.unique(one["branch"].values):
-            sel = one["branch"].values == b
-            ax.plot(one[xkey].values[sel], one[ykey].values[sel], color="k", lw=1.0,
-                    ls="--", label="exact boundary" if k == b == 0 else None)
+    if not per_panel:
+        for k, one in enumerate(exact):
+            _draw_exact(ax, one, xkey, ykey, "k", "", label=k == 0)
     ax.set_xlabel(axis_label(ds[xkey]))
     ax.set_ylabel(axis_label(ds[ykey]))
     ax.set_xlim(x[0], x[-1])
@@ -101,6 +112,20 @@ def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None,
     set_title(ax, ds, what, detail="no boundary in the grid: " + ", ".join(absent) if absent
            else "")
     return fig
+
+
+def _draw_exact(ax: Axes, one: xr.Dataset, xkey: str, ykey: str, color: str, text: str,
+                label: bool = True) -> None:
+    """The curves of an exact boundary, solid and over the map's shading and contours,
+    with a legend entry (``text``: the curve value's) when `label`."""
+    for b in np.unique(one["branch"].values):
+        sel = one["branch"].values == b
+        ax.plot(one[xkey].values[sel], one[ykey].values[sel], color=color, lw=1.5,
+                zorder=3)
+    if label and one.sizes.get("point", 0):
+        ax.plot([], [], color=color, lw=1.5,
+                label=f"{text}: exact boundary, stable shaded" if text
+                else "exact boundary")
 
 
 @drawing
