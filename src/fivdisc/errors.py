@@ -95,7 +95,8 @@ class SweepError(FivdiscError, ValueError):
     ... ''')
     Traceback (most recent call last):
         ...
-    fivdisc.errors.SweepError: reduce.keep: unknown reduction 'separatd'; did you mean 'separated'?; ...
+    fivdisc.errors.SweepError: reduce.keep: unknown reduction 'separatd';
+    did you mean 'separated'?; ...
     """
 
 

@@ -31,9 +31,28 @@ PACKAGE = Path(fivdisc.__file__).resolve().parent
 # Top-level name -> the module it lives in, from the API table (no import needed).
 HOMES = {name: module for module, names in _API.items() for name in names}
 TOP = sorted(HOMES)
-# Where the top-level names' doctests are found when a module is searched: those run in
-# test_public_examples_run already.
-TOP_QUALIFIED = tuple(f"{module}.{name}" for name, module in HOMES.items())
+
+
+def _is_top(module: str, qualname: str) -> bool:
+    """Whether `qualname` in `module` is a top-level name or one of its members, whose
+    examples test_public_examples_run runs (the API table names the module or a package
+    above it that re-exports the name)."""
+    home = HOMES.get(qualname.split(".")[0])
+    return home is not None and (module == home or module.startswith(home + "."))
+
+
+def _examples_in(node: ast.AST, module: str, qualname: str = "") -> list[str]:
+    """Qualified names of the docstrings under `node` (itself included) that hold a
+    doctest and are not the top-level names' or their members'."""
+    found = []
+    doc = ast.get_docstring(node) if isinstance(
+        node, ast.Module | ast.ClassDef | ast.FunctionDef | ast.AsyncFunctionDef) else None
+    if doc and re.search(r"^\s*>>> ", doc, re.MULTILINE) and not _is_top(module, qualname):
+        found.append(f"{module}.{qualname}".rstrip("."))
+    for child in getattr(node, "body", ()):
+        if isinstance(child, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+            found += _examples_in(child, module, f"{qualname}.{child.name}".lstrip("."))
+    return found
 
 
 def _modules_with_examples() -> list[str]:
@@ -43,19 +62,7 @@ def _modules_with_examples() -> list[str]:
     for path in sorted(PACKAGE.rglob("*.py")):
         parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
         module = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
-        found = []
-
-        def visit(node: ast.AST, qualified: str) -> None:
-            doc = ast.get_docstring(node)
-            if doc and re.search(r"^\s*>>> ", doc, re.MULTILINE) and not any(
-                    qualified == top or qualified.startswith(top + ".") for top in TOP_QUALIFIED):
-                found.append(qualified)
-            for child in getattr(node, "body", ()):
-                if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
-                    visit(child, f"{qualified}.{child.name}")
-
-        visit(ast.parse(path.read_text(encoding="utf-8")), module)
-        if found:
+        if _examples_in(ast.parse(path.read_text(encoding="utf-8")), module):
             modules.append(module)
     return modules
 
@@ -106,7 +113,6 @@ def test_other_examples_run(module, tmp_path, monkeypatch):
     sub-packages' names."""
     monkeypatch.chdir(tmp_path)
     tests = doctest.DocTestFinder().find(importlib.import_module(module), globs={})
-    tests = [test for test in tests if test.examples and not any(
-        test.name == top or test.name.startswith(top + ".") for top in TOP_QUALIFIED)]
-    if tests:
-        _run(tests)
+    tests = [test for test in tests if test.examples
+             and not _is_top(module, test.name.removeprefix(module).lstrip("."))]
+    _run(tests)
