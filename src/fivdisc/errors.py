@@ -95,8 +95,7 @@ class SweepError(FivdiscError, ValueError):
     ... ''')
     Traceback (most recent call last):
         ...
-    fivdisc.errors.SweepError: reduce.keep: unknown reduction 'separatd';
-    did you mean 'separated'?; ...
+    fivdisc.errors.SweepError: reduce.keep: unknown reduction 'separatd'; did you mean ...
     """
 
 
@@ -168,8 +167,8 @@ class ConvergenceError(FivdiscError, RuntimeError):
     >>> try:
     ...     fivdisc.periodic_orbit(case, transient=0.1, max_iterations=1)
     ... except fivdisc.ConvergenceError as error:
-    ...     print(error.result.verdict, "-", error.reason)
-    not converged - ...
+    ...     print(f"{error.result.verdict}: {error.reason}")
+    not converged: the iteration budget (1 Newton iterations) ran out
     """
 
     def __init__(self, message: str, result: object = None, reason: str = "") -> None:

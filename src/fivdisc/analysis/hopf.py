@@ -205,6 +205,12 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
     CaseError
         As :func:`~fivdisc.analysis.eigenbranches.eigen_branches`.
 
+    See Also
+    --------
+    fivdisc.eigen_branches : The eigenvalues along the key, from which the points are
+        located.
+    fivdisc.hopf_cycles : The periodic orbits born at a Hopf point.
+
     Notes
     -----
     At the point the growth rate ``g(p) = Re lambda(p)`` of the branch is zero; it is
@@ -212,12 +218,6 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
     :func:`scipy.optimize.brentq`, the eigenvalue at each trial value being the one
     nearest to the branch's linear interpolation. A real eigenvalue crossing zero (a
     fold of the equilibrium, not a Hopf point) is not reported.
-
-    See Also
-    --------
-    fivdisc.eigen_branches : The eigenvalues along the key, from which the points are
-        located.
-    fivdisc.hopf_cycles : The periodic orbits born at a Hopf point.
 
     Examples
     --------

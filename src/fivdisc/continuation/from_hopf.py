@@ -88,6 +88,13 @@ def hopf_cycles(
     ConvergenceError
         The first orbit does not converge (take a smaller `amplitude`).
 
+    See Also
+    --------
+    fivdisc.hopf_points : The Hopf points of the sliding equilibrium along a key.
+    fivdisc.periodic_orbit : One orbit by shooting, from a transient run.
+    fivdisc.continue_orbit : A branch from an orbit found by shooting (a stick-slip
+        orbit, say) instead of from a Hopf point.
+
     Notes
     -----
     The first orbit solves, for ``(x, T, p)``, the shooting equations
@@ -109,12 +116,6 @@ def hopf_cycles(
     undetermined (``bistable_undetermined``): its unstable orbits bound the equilibrium's
     basin, and the motion beyond them may be a stable vibration coexisting with it. The
     equilibrium's stability beyond other Hopf points of the key is not checked.
-
-    See Also
-    --------
-    fivdisc.hopf_points : The Hopf points of the sliding equilibrium along a key.
-    fivdisc.continue_orbit : A branch from an orbit found by shooting (a stick-slip
-        orbit, say) instead of from a Hopf point.
 
     Examples
     --------

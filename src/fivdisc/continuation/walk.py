@@ -148,19 +148,19 @@ def continue_orbit(
     ConvergenceError
         No periodic orbit to start from.
 
-    Notes
-    -----
-    The method is in the module's docstring and on the documentation's continuation
-    page. Step control: after a point that took at most 3 corrector iterations the step
-    grows by 1.5, after 7 or more it halves; a refused or failed step is halved, and a
-    step below ``min_step`` ends the branch as lost.
-
     See Also
     --------
     fivdisc.periodic_orbit : One orbit, at one value of the key.
     fivdisc.hopf_cycles : A branch that starts at a Hopf point of the sliding
         equilibrium instead of at an orbit.
     fivdisc.plots.plot_branch : Draws a branch.
+
+    Notes
+    -----
+    The method is in the module's docstring and on the documentation's continuation
+    page. Step control: after a point that took at most 3 corrector iterations the step
+    grows by 1.5, after 7 or more it halves; a refused or failed step is halved, and a
+    step below ``min_step`` ends the branch as lost.
 
     Examples
     --------

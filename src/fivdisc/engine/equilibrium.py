@@ -145,9 +145,9 @@ def sliding_equilibrium(
     >>> u = case.slider.track_radius * case.speed.value  # [m/s]
     >>> mu = case.friction
     >>> print(f"{equilibrium.friction_force[0] / equilibrium.normal_force[0]:.10f}")
-    0.4833720...
+    0.4833720228
     >>> print(f"{mu.kinetic_min + (mu.kinetic_max - mu.kinetic_min) * np.exp(-mu.decay * u):.10f}")
-    0.4833720...
+    0.4833720228
     """
     from scipy.optimize import root
 
