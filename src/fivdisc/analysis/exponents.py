@@ -243,7 +243,7 @@ def lyapunov(
     .. math::
 
         \lambda_i = \frac{1}{T} \sum_{k=1}^{m} l_i^{(k)}, \qquad
-        l_i^{(k)} = \ln |R_{ii}^{(k)}|.
+        l_i^{(k)} = \ln \lvert R_{ii}^{(k)} \rvert.
 
     **Alignment.** From random vectors, the QR method measures the exponents only once
     the vectors have turned into the most expanding directions. Until then the k-th
