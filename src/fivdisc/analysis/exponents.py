@@ -413,16 +413,17 @@ def lyapunov(
     ...                     speed={"value": 12.0}, simulation={"initial_state": "equilibrium"})
     >>> spectrum = fivdisc.lyapunov(case, transient=0.05, duration=0.2)
     >>> print(f"{spectrum.largest:.0f} +- {spectrum.uncertainty[0]:.1f} 1/s, "
-    ...       f"conclusive: {bool(spectrum.conclusive[0])}")
-    -62 +- 0.3 1/s, conclusive: True
+    ...       f"{spectrum.verdict(0)}")
+    -62 +- 0.3 1/s, negative
     >>> print(f"{fivdisc.linear_stability(case).max_growth_rate:.2f} 1/s")
     -61.75 1/s
 
     On a periodic orbit they are its Floquet exponents: here the stick-slip orbit of a
     slider with constant kinetic friction on a disc of one axisymmetric mode, whose
     first exponent (the flow direction's) is 0 and whose next two (the disc mode's
-    pair) are -4.726 1/s. Over 2 s the first is still inconclusive, its uncertainty
-    larger than itself:
+    pair) are -4.726 1/s. Over 2 s the first is undecided, its range (2.4 1/s either
+    way) reaching the next; over 5 s it is resolved from them (its verdict,
+    :meth:`LyapunovSpectrum.verdict`):
 
     >>> orbit_case = fivdisc.Case(
     ...     disc={"modes": [[0, 0]]},
@@ -432,9 +433,11 @@ def lyapunov(
     ... )
     >>> print(fivdisc.lyapunov(orbit_case, n=3, transient=1.0, duration=2.0))
     Lyapunov exponents over 2 s after a 1 s transient (QR every 0.05 s) [1/s]:
-      lambda_1 = ... +- 2...  (inconclusive)
-      lambda_2 = -4.7... +- 0.06...
-      lambda_3 = -4.7... +- 0.06...
+      lambda_1 = ... +- 2...  undecided at this length
+      lambda_2 = -4.7... +- 0.06...  negative
+      lambda_3 = -4.7... +- 0.06...  negative
+    >>> fivdisc.lyapunov(orbit_case, n=3, transient=1.0, duration=5.0).verdicts
+    ('zero', 'negative', 'negative')
     """
     sim = case.simulation
     transient = 0.2 * sim.duration if transient is None else transient
