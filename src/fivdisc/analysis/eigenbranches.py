@@ -281,7 +281,8 @@ def mode_couplings(lam: np.ndarray, tolerance: float = COUPLING_TOLERANCE
                 if (split[outside] <= near and split[inside] > split[outside]
                         and split[inside] >= mean[inside]):
                     found.append((inside, a, b))
-    return sorted(found)
+    # An interval of one value is entered and left there: one coupling.
+    return sorted(set(found))
 
 
 def _dataset(case: Case, key: str, values: np.ndarray, lam: np.ndarray,
