@@ -66,14 +66,16 @@ def test_from_hopf_says_which_point_it_takes_and_warns_when_its_orbits_are_unsta
     res = run_cli(["continue", case, "--key", "speed.value", "--to", "30", "--from-hopf",
                    "0.3:5:20", "--points", "2", "--no-progress", "--json"])
     assert res.exit_code == 0, res.output
-    out = res.stdout
-    assert "4 Hopf points in speed.value between 0.3 and 5:" in out
-    assert "taking [0]: Hopf point at speed.value = 0.41147" in out
-    assert "none changes the equilibrium's stability" in out
-    (warning,) = messages(res.stderr)
+    # Under --json the choice goes to stderr: stdout is the JSON alone.
+    data = json.loads(res.stdout)
+    said = messages(res.stderr)
+    assert "4 Hopf points in speed.value between 0.3 and 5:" in said
+    (taken,) = [line for line in said if line.startswith("taking")]
+    assert taken.startswith("taking [0]: Hopf point at speed.value = 0.41147")
+    assert "none changes the equilibrium's stability" in taken
+    (warning,) = [line for line in said if line.startswith("warning")]
     assert warning.startswith("warning: at speed.value = 0.41147")
     assert "every orbit born there is unstable" in warning
-    data = json.loads(out[out.index("{"):])
     assert not data["hopf"]["on_boundary"] and data["hopf"]["unstable_modes"]
     assert not any(p["stable"] for p in data["points"])
     found = hopf_points(THREE_PADS, "speed.value", np.linspace(0.3, 5.0, 20))

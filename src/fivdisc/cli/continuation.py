@@ -95,7 +95,7 @@ def continuation(case_file: Path | None, key: str, target: float, back_to: float
                 or back_to is not None):
             raise FivdiscError("--from-hopf starts at a Hopf point: leave out --from, "
                                "--transient, --period and --back-to")
-        branch = _from_hopf(case_file, key, target, hopf_spec, settings, progress)
+        branch = _from_hopf(case_file, key, target, hopf_spec, settings, progress, as_json)
         if out is not None:
             branch.to_netcdf(out)
         click.echo(branch.to_json() if as_json else str(branch))
@@ -127,8 +127,9 @@ def continuation(case_file: Path | None, key: str, target: float, back_to: float
 
 
 def _from_hopf(case_file: Path | None, key: str, target: float, spec: str,
-               settings: ContinuationSettings, progress: bool):
-    """The branch of orbits from the first Hopf point on ``spec``'s values of ``key``."""
+               settings: ContinuationSettings, progress: bool, as_json: bool = False):
+    """The branch of orbits from the first Hopf point on ``spec``'s values of ``key``
+    (which one, on stdout, or on stderr under --json, whose stdout is the JSON)."""
     import numpy as np
 
     from fivdisc.analysis.hopf import hopf_points
@@ -152,7 +153,7 @@ def _from_hopf(case_file: Path | None, key: str, target: float, spec: str,
         raise FivdiscError(f"--from-hopf {spec}: no Hopf point of the sliding equilibrium in "
                            f"{key} between {values[0]:g} and {values[-1]:g}")
     hopf = next((h for h in found if h.on_boundary), found[0])
-    click.echo(hopf_choice(found, hopf, key, values))
+    click.echo(hopf_choice(found, hopf, key, values), err=as_json)
     if not hopf.on_boundary:
         others = ", ".join(hopf.unstable_modes) or "another mode"
         click.echo(f"warning: at {key} = {hopf.value:.10g} {others} of the sliding "
