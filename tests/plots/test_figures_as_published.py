@@ -91,6 +91,24 @@ def test_the_branch_key_sits_beside_the_axes_one_entry_per_mode(three_pad_branch
     assert _outside_canvas(fig) == []
 
 
+def test_each_hopf_dot_has_its_mode_s_colour(three_pad_branches):
+    """The dots tie each Hopf point to its branch in the key: filled in the colour of the
+    branch its stored label names."""
+    from matplotlib.colors import to_hex
+
+    fig = plots.plot_eigen_branches(three_pad_branches)
+    top = fig.axes[0]
+    colour = {t.get_text(): to_hex(h.get_color()) for t, h in
+              zip(fig.legends[0].get_texts(), fig.legends[0].legend_handles, strict=True)}
+    dots = [line for line in top.lines if line.get_marker() == "o"]
+    ds = three_pad_branches
+    assert len(dots) == ds.sizes["hopf"] > 0
+    for line, value, mode in zip(dots, ds["hopf"].values, ds["hopf_mode"].values,
+                                 strict=True):
+        assert line.get_xdata()[0] == value
+        assert to_hex(line.get_markerfacecolor()) == colour[str(mode)]
+
+
 def test_the_growth_scale_is_an_option_of_both_commands(three_pad_branches, tmp_path):
     saved = tmp_path / "branches.nc"
     write_netcdf(saved, three_pad_branches.to_netcdf)

@@ -208,7 +208,7 @@ def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None,
     labelled with its mode in the key beside the axes; where a branch is unstable it is
     drawn thick. Mode couplings are marked with a dotted line, existence limits with a
     solid grey one, and Hopf points (:func:`fivdisc.analysis.hopf.hopf_points`) with
-    dots.
+    dots in the colour of the mode that crosses there.
 
     Parameters
     ----------
@@ -231,10 +231,12 @@ def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None,
     x = ds[key].values
     freq, growth = ds["frequency"].values, ds["growth_rate"].values
     scale, linthresh = growth_axis(growth, growth_scale)
+    colors: dict[str, str] = {}  # mode -> its branch's colour
     for b in range(freq.shape[1]):
         if not np.nanmax(freq[:, b], initial=-1.0) > 0.0:
             continue
         (line,) = top.plot(x, freq[:, b], lw=1.0, label=str(ds["mode"].values[b]))
+        colors[str(ds["mode"].values[b])] = line.get_color()
         bottom.plot(x, growth[:, b], lw=1.0, color=line.get_color())
         bad = np.where(growth[:, b] > 0.0, growth[:, b], np.nan)
         top.plot(x, np.where(growth[:, b] > 0.0, freq[:, b], np.nan), lw=3.5,
@@ -246,13 +248,19 @@ def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None,
         for value in ds["existence_limit"].values:
             ax.axvline(value, color="0.5", lw=2.0)
     if hopf is not None:
-        marks = [(hp.value, hp.frequency) for hp in hopf]
+        marks = [(hp.value, hp.frequency, hp.mode) for hp in hopf]
+    elif "hopf" in ds:
+        modes = (ds["hopf_mode"].values if "hopf_mode" in ds
+                 else np.full(ds.sizes["hopf"], ""))
+        marks = list(zip(ds["hopf"].values, ds["hopf_frequency"].values, modes,
+                         strict=True))
     else:
-        marks = list(zip(ds["hopf"].values, ds["hopf_frequency"].values, strict=True)
-                     ) if "hopf" in ds else []
-    for value, frequency in marks:
-        top.plot(value, frequency, "ko", ms=5)
-        bottom.plot(value, 0.0, "ko", ms=5)
+        marks = []
+    for value, frequency, mode in marks:
+        # Filled with its branch's colour: the key names the mode that crosses there.
+        face = colors.get(str(mode), "k")
+        top.plot(value, frequency, "o", mfc=face, mec="k", ms=6)
+        bottom.plot(value, 0.0, "o", mfc=face, mec="k", ms=6)
     bottom.axhline(0.0, color="k", lw=0.5)
     top.set_ylabel("frequency [Hz]")
     if scale == "symlog":
@@ -266,6 +274,6 @@ def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None,
     fig.legend(*top.get_legend_handles_labels(), loc="outside right upper",
                fontsize="small", title="mode", title_fontsize="small")
     set_title(top, ds, "eigenvalue branches (thick: unstable)",
-           detail="dotted: mode coupling; dots: Hopf points" if len(ds["coupling"]) or marks
-           else "")
+           detail="dotted: mode coupling; dots: Hopf points, in their mode's colour"
+           if len(ds["coupling"]) or marks else "")
     return fig
