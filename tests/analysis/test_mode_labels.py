@@ -142,7 +142,7 @@ def test_the_command_writes_and_prints_the_labels_it_draws(tmp_path):
     from fivdisc.plots.stability import plot_eigen_branches
 
     fig = plot_eigen_branches(ds)
-    legend = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
     assert len(set(legend)) == len(legend)
     assert set(hopf_modes) <= set(legend)
 

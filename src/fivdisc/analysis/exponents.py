@@ -202,10 +202,13 @@ class LyapunovSpectrum:
             j = self._resolved_by(i)
             return (f"{head}: consistent with zero (within one uncertainty, and resolved "
                     f"from lambda_{j + 1} = {self.exponents[j]:+.6g} 1/s)")
+        few = ("too few re-orthonormalisations: lengthen the measurement or shorten the "
+               "interval")
+        if not np.isfinite(u):
+            return f"{head}: undecided, no uncertainty estimate ({few})"
         if not np.all(np.isfinite(self.uncertainty) | np.isneginf(self.exponents)):
-            return (f"{head}: undecided, no uncertainty estimate (too few "
-                    "re-orthonormalisations: lengthen the measurement or shorten the "
-                    "interval)")
+            return (f"{head}: undecided: another exponent has no uncertainty estimate, so "
+                    f"that this one's place in their order is unknown ({few})")
         near_low, near_high = self.bounds(i, 1.0)
         if near_low <= 0 <= near_high and self.exponents.size == 1:
             return (f"{head}: undecided: within one uncertainty of zero, and no other "
