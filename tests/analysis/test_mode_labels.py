@@ -173,3 +173,21 @@ def test_a_coupling_is_reported_only_where_two_frequencies_meet():
     assert 1.0 < value < 3.0
     hopf = hopf_points(THREE_PADS, *SPEEDS, branches=ds)
     assert any(hp.mode in ("C02", "D02") and value < hp.value < value + 1.0 for hp in hopf)
+
+
+def test_an_overdamped_coordinate_s_two_real_eigenvalues_are_named_apart():
+    """A heavily damped slider has two real eigenvalues for one coordinate: the second
+    takes a prime, and both are the slider's (second route: their eigenvectors' energy
+    is all in phi)."""
+    from fivdisc import Case
+
+    case = Case(disc={"modes": [[0, 0], [0, 1]]}, slider={"rotational_damping": 500.0},
+                speed={"value": 12.0})
+    lin = linear_stability(case)
+    real = [i for i, lam in enumerate(lin.eigenvalues) if lam.imag == 0]
+    assert sorted(lin.dominant[i] for i in real) == ["phi", "phi'"]
+    names, shares = _shares(case, lin.eigenvectors[:, real])
+    assert np.all(shares[names.index("phi")] > 0.99)
+    labels = [lin.dominant[i] for i in range(lin.eigenvalues.size)
+              if lin.eigenvalues[i].imag >= 0]
+    assert len(set(labels)) == len(labels)
