@@ -123,6 +123,12 @@ def _branches(case, case_file, x_spec: str, output: Path | None, progress: bool)
                         {"units": "Hz", "long_name": "critical frequency"}),
         hopf_direction=(("hopf",), np.array([hp.direction for hp in hopf], dtype=np.int8),
                         {"long_name": "+1: the mode loses stability as the key increases"}),
+        hopf_l1=(("hopf",), np.array([hp.l1 for hp in hopf], dtype=float),
+                 {"units": "s2", "long_name": "first Lyapunov coefficient per (rad/s)^2 of "
+                                              "slip-speed amplitude (> 0: subcritical, < 0: "
+                                              "supercritical)"}),
+        hopf_l1_error=(("hopf",), np.array([hp.l1_error for hp in hopf], dtype=float),
+                       {"units": "s2", "long_name": "estimated error of hopf_l1"}),
     )
     if case_file is not None:
         ds.attrs["case_name"] = case_file.stem
