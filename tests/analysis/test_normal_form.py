@@ -223,3 +223,36 @@ def pads_case():
     from pathlib import Path
 
     return load_case(Path(__file__).parents[1] / "data" / PADS)
+
+
+def test_printed_and_stored_by_the_command_line(tmp_path):
+    """fivdisc stability --x prints l1 with each Hopf point and stores it in the file;
+    fivdisc continue --from-hopf keeps it in the branch file and says that the orbits
+    agree."""
+    import xarray as xr
+
+    from fivdisc.continuation.branch import open_branch
+
+    from support.cli import run_cli
+
+    case = tmp_path / "rigid.toml"
+    case.write_text(Case(disc={"modes": []}, slider={"rotational_damping": 0.5},
+                         friction={"decay": 1.0}, speed={"value": 1.0}).to_toml())
+    out = tmp_path / "branches.nc"
+    res = run_cli(["stability", case, "--x", "speed.value=0.5:30:25", "--no-progress",
+                   "-o", out])
+    assert res.exit_code == 0, res.output
+    assert "first Lyapunov coefficient l1 = 0.000221 s^2: subcritical" in res.output
+    with xr.open_dataset(out) as ds:
+        (l1,) = ds["hopf_l1"].values
+        assert l1 == pytest.approx(1.0 * 0.5 / (16 * MASS * OMEGA), rel=1e-8)
+        assert ds["hopf_l1_error"].values[0] < 1e-8 * l1
+        from cf_xarray.units import units as registry
+
+        assert registry.Unit(ds["hopf_l1"].attrs["units"]) == registry.Unit("s^2")
+    branch = tmp_path / "cycles.nc"
+    res = run_cli(["continue", case, "--key", "speed.value", "--to", "30", "--from-hopf",
+                   "0.5:30:25", "--points", "2", "--no-progress", "-o", branch])
+    assert res.exit_code == 0, res.output
+    assert "subcritical (first Lyapunov coefficient l1 = 0.000221 s^2, agrees)" in res.output
+    assert open_branch(branch).hopf()["l1"] == pytest.approx(l1, rel=1e-12)
