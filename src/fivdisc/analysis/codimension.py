@@ -471,8 +471,11 @@ def _specials(box: _Box, curve: _Curve, index: int, l1s: list[tuple[float, float
                 and (la < 0) != (lb < 0)):
             point = _locate(box, a, b, lambda q: _l1(q)[0])
             l1, err = _l1(point)
-            found.append(_Special("bautin", point, index,
-                                  note=f"l1 = {l1:.3g} +- {err:.2g} s^2 there"))
+            # A change of sign through a pole of l1 (where the slip speed's share of
+            # the critical mode vanishes, as a normal force reaches zero) is no zero.
+            if abs(l1) <= max(10.0 * err, 1e-6 * max(abs(la), abs(lb))):
+                found.append(_Special("bautin", point, index,
+                                      note=f"l1 = {l1:.3g} +- {err:.2g} s^2 there"))
         sa, sb = a.solve, b.solve
         ia, ib = sa.near(a.lam), sb.near(b.lam)
         # The other pairs, followed from a to b.
