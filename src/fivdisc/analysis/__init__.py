@@ -13,6 +13,7 @@ _API = {
     "fivdisc.analysis.stability": ("LinearStability", "PerturbationTest", "linear_stability",
                                    "perturbation_test", "stability_map"),
     "fivdisc.analysis.boundary": ("stability_boundary",),
+    "fivdisc.analysis.codimension": ("hopf_curve_lines", "hopf_curves"),
     "fivdisc.analysis.eigenbranches": ("eigen_branches",),
     "fivdisc.analysis.hopf": ("HopfPoint", "hopf_points"),
     "fivdisc.analysis.normalform": ("FirstLyapunov", "first_lyapunov", "lyapunov_coefficient"),

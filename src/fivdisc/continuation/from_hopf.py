@@ -172,7 +172,8 @@ def _judge(result: Branch, hopf: HopfPoint) -> None:
     undetermined = bool(hopf.on_boundary and kind == "subcritical" and not coexist.size)
     result.dataset.attrs.update({"hopf_value": hopf.value, "hopf_omega": hopf.omega,
                                  "hopf_direction": hopf.direction, "criticality": kind,
-                                 "hopf_l1": hopf.l1, "hopf_l1_error": hopf.l1_error,
+                                 "hopf_l1": getattr(hopf, "l1", np.nan),
+                                 "hopf_l1_error": getattr(hopf, "l1_error", np.nan),
                                  "bistable_low": low, "bistable_high": high,
                                  "bistable_open": int(open_end),
                                  "bistable_undetermined": int(undetermined)})
