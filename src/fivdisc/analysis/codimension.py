@@ -210,6 +210,7 @@ def _chain(box: _Box, sa: _Solve, sb: _Solve, depth: int = 0) -> list[_Solve]:
 class _Seed:
     u: np.ndarray
     lam: complex
+    gap: float = math.inf  # distance from lam to the nearest other eigenvalue there
 
 
 def _seeds(box: _Box, m: int) -> tuple[list[_Seed], list[list[_Solve | None]]]:
@@ -240,7 +241,10 @@ def _seeds(box: _Box, m: int) -> tuple[list[_Seed], list[list[_Solve | None]]]:
                         continue
                     u, s, i = found
                     if s.force > 0.0:
-                        seeds.append(_Seed(u, complex(s.lam[i])))
+                        others = np.delete(s.lam, i)
+                        gap = float(np.min(np.abs(others - s.lam[i]))) if others.size \
+                            else math.inf
+                        seeds.append(_Seed(u, complex(s.lam[i]), gap))
     return seeds, solves
 
 
@@ -260,30 +264,69 @@ class _Curve:
     notes: list[str] = field(default_factory=list)
 
 
+def _track(box: _Box, sa: _Solve, ia: int, sb: _Solve, depth: int = 0) -> int:
+    """Index in sb of the pair that continues sa's eigenvalue ia along the segment
+    between them: the nearest, halving the segment while another is almost as near."""
+    up = sb.upper
+    if up.size == 0:
+        return -1
+    d = np.abs(sb.lam[up] - sa.lam[ia])
+    order = np.argsort(d)
+    if up.size == 1 or d[order[0]] < _SEPARATION * d[order[1]] or depth >= _EDGE_DEPTH:
+        return int(up[order[0]])
+    mid = box.solve(0.5 * (sa.u + sb.u))
+    if mid is None or mid.upper.size == 0:
+        return int(up[order[0]])
+    return _track(box, mid, _track(box, sa, ia, mid, depth + 1), sb, depth + 1)
+
+
 def _correct(box: _Box, pred: np.ndarray, normal: np.ndarray, width: float,
              target: complex) -> _Point | None:
-    """The zero of the growth rate of the pair nearest `target` on the normal line
-    through `pred`, within +-width; None if it does not change sign there, is lost, or
-    the eigenvalue found is not clearly the one predicted."""
+    """The zero of the growth rate of the pair predicted as `target` at `pred`, on the
+    normal line through `pred` within +-width; None if it does not change sign there, is
+    lost, or the eigenvalue found is not clearly that pair.
+
+    The pair is followed from `pred` to both ends of the bracket (halving where another
+    pair comes near: identical sliders have pairs a fraction of a hertz apart), and at
+    each trial of the root finder it is the eigenvalue nearest to its interpolation
+    between the bracket's ends and `pred`."""
+    sp = box.solve(pred)
+    if sp is None or sp.upper.size == 0:
+        return None
+    ip = sp.near(target)
+    if not sp.separated(ip, target):
+        return None
     a, b = pred - width * normal, pred + width * normal
-    ga, _, _ = box.growth(a, target)
-    gb, _, _ = box.growth(b, target)
-    if not (np.isfinite(ga) and np.isfinite(gb)) or (ga < 0) == (gb < 0):
+    ends = []
+    for u in (a, b):
+        s = box.solve(u)
+        if s is None:
+            return None
+        i = _track(box, sp, ip, s)
+        if i < 0:
+            return None
+        ends.append(complex(s.lam[i]))
+    lam_a, lam_p, lam_b = ends[0], complex(sp.lam[ip]), ends[1]
+    if (lam_a.real < 0) == (lam_b.real < 0):
         return None
 
+    def expected(t: float) -> complex:
+        return (lam_a + 2 * t * (lam_p - lam_a) if t <= 0.5
+                else lam_p + (2 * t - 1) * (lam_b - lam_p))
+
     def g(t: float) -> float:
-        value, _, _ = box.growth(a + t * (b - a), target)
+        value, _, _ = box.growth(a + t * (b - a), expected(t))
         if math.isnan(value):
             raise _Lost
         return value
 
     try:
-        t = _brent(g, 0.0, 1.0, ga, gb, _XTOL / max(2.0 * width, 1e-300))
+        t = _brent(g, 0.0, 1.0, g(0.0), g(1.0), _XTOL / max(2.0 * width, 1e-300))
     except (_Lost, ValueError):
         return None
     u = a + t * (b - a)
-    _, s, i = box.growth(u, target)
-    if s is None or i < 0 or not s.separated(i, target):
+    _, s, i = box.growth(u, expected(t))
+    if s is None or i < 0 or not s.separated(i, expected(t)):
         return None
     return _Point(u, complex(s.lam[i]), s)
 
@@ -314,7 +357,7 @@ def _trace(box: _Box, start: _Point, direction: np.ndarray, step: float
             target = p.lam
         new = None
         for width in (0.125 * h, h):
-            new = _correct(box, pred, normal, width, complex(0.0, target.imag))
+            new = _correct(box, pred, normal, width, complex(target))
             if new is not None:
                 break
         if new is None:
@@ -372,8 +415,7 @@ def _on_chord(box: _Box, a: _Point, b: _Point, s: float) -> _Point | None:
     normal = np.array([-chord[1], chord[0]]) / max(length, 1e-300)
     target = a.lam + s * (b.lam - a.lam)
     for width in (0.25 * length, length):
-        point = _correct(box, a.u + s * chord, normal, max(width, 1e-9),
-                         complex(0.0, target.imag))
+        point = _correct(box, a.u + s * chord, normal, max(width, 1e-9), complex(target))
         if point is not None:
             return point
     return None
@@ -425,19 +467,19 @@ def _trace_seed(box: _Box, seed: _Seed, step: float) -> _Curve | None:
     return _Curve(backward[::-1] + path[1:], begin, end)
 
 
-def _covers(curve: _Curve, seed: _Seed, step: float) -> bool:
-    """Whether the seed lies on the traced curve (same pair: same frequency)."""
+def _covers(curve: _Curve, seed: _Seed, tol: float = 1e-3) -> bool:
+    """Whether the seed lies on the traced curve: within `tol` of the box from it, its
+    eigenvalue nearer to the curve's (interpolated there) than a quarter of its distance
+    to the other eigenvalues at the seed."""
     u = np.array([p.u for p in curve.points])
-    w = np.array([p.lam.imag for p in curve.points])
-    tol = max(2e-3, 0.1 * step)
+    lam = np.array([p.lam for p in curve.points])
     for k in range(len(u) - 1):
         d = u[k + 1] - u[k]
         length2 = float(d @ d)
         t = 0.0 if length2 == 0 else min(max(float((seed.u - u[k]) @ d) / length2, 0.0), 1.0)
-        near = u[k] + t * d
-        if np.linalg.norm(seed.u - near) < tol:
-            omega = w[k] + t * (w[k + 1] - w[k])
-            if abs(omega - seed.lam.imag) < 1e-3 * abs(seed.lam.imag):
+        if np.linalg.norm(seed.u - (u[k] + t * d)) < tol:
+            here = lam[k] + t * (lam[k + 1] - lam[k])
+            if abs(here - seed.lam) < _SEPARATION * min(seed.gap, 1e300):
                 return True
     return False
 
@@ -608,7 +650,7 @@ def hopf_curves(
     found, grid = _seeds(box, seeds)
     curves: list[_Curve] = []
     for seed in found:
-        if any(_covers(c, seed, step) for c in curves):
+        if any(_covers(c, seed) for c in curves):
             continue
         curve = _trace_seed(box, seed, step)
         if curve is not None and len(curve.points) > 1:
@@ -637,8 +679,9 @@ def _other_curve(sp: _Special, curves: list[_Curve]) -> int:
     """The traced curve of the other pair of a double Hopf point (-1: not traced)."""
     if sp.kind != "double_hopf":
         return -1
+    gap = abs(sp.other - sp.point.lam)
     for i, c in enumerate(curves):
-        if i != sp.curve and _covers(c, _Seed(sp.point.u, sp.other), 0.0):
+        if i != sp.curve and _covers(c, _Seed(sp.point.u, sp.other, gap)):
             return i
     return -1
 
