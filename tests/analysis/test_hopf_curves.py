@@ -212,3 +212,46 @@ def test_curve_ends_where_the_equilibrium_ceases_to_exist():
     assert kinds.count("double_hopf") == 2 and "bautin" not in [
         k for k, c in zip(kinds, ds["codim2_curve"].values, strict=True)
         if ds["curve_mode"].values[c] == "phi"]
+
+
+@pytest.mark.slow
+def test_three_pads_in_speed_and_disc_damping():
+    """Issue 36's three pads over (speed, disc damping): one curve per pad's mode, near
+    19.20, 19.34 and 19.573 rad/s and a fraction of a hertz apart, traced apart; the
+    last is subcritical and the stability boundary above the backward wave's curve, on
+    which the Hopf point of the one-key scan at the case's damping lies; the Bautin
+    points on the disc modes' curves against the sign of l1 at one-key scans just beside
+    them."""
+    from pathlib import Path
+
+    from fivdisc.case import load_case
+
+    case = load_case(Path(__file__).parents[1] / "data" / "three_pads_issue36.toml")
+    key = "disc.damping_ratio"
+    ds = hopf_curves(case, (SPEED, (5.0, 40.0)), (key, (0.0005, 0.006)))
+    modes = list(ds["curve_mode"].values)
+    pads = [c for c, m in enumerate(modes) if m.startswith("phi")]
+    assert len(pads) == 3
+    centres = sorted(float(np.median(ds[SPEED].values[ds["hopf_curve"].values == c]))
+                     for c in pads)
+    np.testing.assert_allclose(centres, [19.205, 19.344, 19.573], atol=5e-3)
+    (hp,) = [h for h in hopf_points(case, SPEED, np.linspace(19.4, 19.8, 5))]
+    assert hp.on_boundary and hp.criticality == "subcritical"
+    last = [c for c in pads if abs(centres[2] - np.median(
+        ds[SPEED].values[ds["hopf_curve"].values == c])) < 5e-3][0]
+    sel = ds["hopf_curve"].values == last
+    at = np.interp(0.003, ds[key].values[sel], ds[SPEED].values[sel])
+    assert abs(at - hp.value) < 1e-3  # chords of the curve, 0.02 of the box apart
+    assert (ds["l1"].values[sel] > 0).all()
+    for i in np.flatnonzero(ds["codim2_kind"].values == "bautin"):
+        x, y = float(ds["codim2_x"].values[i]), float(ds["codim2_y"].values[i])
+        freq = float(ds["codim2_frequency"].values[i])
+        signs = []
+        for damping in (y * (1 - 1e-3), y * (1 + 1e-3)):
+            found = [h for h in hopf_points(case.replace({key: damping}), SPEED,
+                                            np.linspace(x - 0.5, x + 0.5, 5))
+                     if abs(h.frequency - freq) < 1.0]
+            (h,) = found
+            assert abs(h.value - x) < 0.1
+            signs.append(np.sign(h.l1))
+        assert signs[0] == -signs[1]

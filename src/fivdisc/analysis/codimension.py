@@ -388,24 +388,23 @@ def _trace(box: _Box, start: _Point, direction: np.ndarray, step: float
 
 def _exit(box: _Box, p: _Point, new: _Point, h: float) -> _Point:
     """Where the curve leaves the box between p (inside) and new (outside): its zero on
-    the crossed edge."""
+    the crossed edge, the pair followed as in :func:`_correct`."""
     d = new.u - p.u
     t = min(((1.0 if d[k] > 0 else 0.0) - p.u[k]) / d[k] for k in range(2)
             if d[k] != 0 and not 0.0 <= new.u[k] <= 1.0)
     end = np.clip(p.u + t * d, 0.0, 1.0)
+    # Along the edge: the coordinate that is not at 0 or 1.
     k = 1 if 0.0 < end[1] < 1.0 else 0
-    a, b = end.copy(), end.copy()
-    a[k], b[k] = max(end[k] - h, 0.0), min(end[k] + h, 1.0)
+    along = np.zeros(2)
+    along[k] = 1.0
+    width = min(h, end[k], 1.0 - end[k])
     target = p.lam + t * (new.lam - p.lam)
-    ga, sa, ia = box.growth(a, target)
-    gb, sb, ib = box.growth(b, target)
-    if np.isfinite(ga) and np.isfinite(gb) and (ga < 0) != (gb < 0):
-        found = _zero_on_segment(box, a, b, sa.lam[ia], sb.lam[ib])
-        if found is not None:
-            u, s, i = found
-            return _Point(u, complex(s.lam[i]), s)
-    s = box.solve(end)
-    return _Point(end, complex(s.lam[s.near(target)]), s) if s is not None else p
+    if width > 0.0:
+        for w in (0.125 * width, width):
+            point = _correct(box, end, along, w, complex(target))
+            if point is not None:
+                return point
+    return p
 
 
 def _on_chord(box: _Box, a: _Point, b: _Point, s: float) -> _Point | None:

@@ -207,7 +207,7 @@ def plot_hopf_curves(ds: xr.Dataset, ax: Axes | None = None,
     """Every Hopf curve of :func:`fivdisc.analysis.codimension.hopf_curves` with its
     codimension-two points.
 
-    One colour per curve, labelled with its mode and frequency; solid where the Hopf
+    One colour per mode, labelled with its frequencies; solid where the Hopf
     point is supercritical (``l1 < 0``), dashed where subcritical (``l1 > 0``: sliding
     is stable on one side but a large enough disturbance starts a vibration), thick
     where the curve is the outer stability boundary. Bautin (GH), double Hopf (HH),
@@ -234,11 +234,22 @@ def plot_hopf_curves(ds: xr.Dataset, ax: Axes | None = None,
         ax.plot([], [], color="#c6e5c3", lw=8, label="sliding stable")
         ax.plot([], [], color="#f4c7c3", lw=8, label="sliding unstable")
     x, y = ds[xkey].values, ds[ykey].values
+    from matplotlib import rcParams
+
+    cycle = rcParams["axes.prop_cycle"].by_key()["color"]
+    # One colour and one legend entry per mode (identical sliders give several curves of
+    # nearly one frequency).
+    modes = list(dict.fromkeys(str(m) for m in ds["curve_mode"].values))
+    for k, mode in enumerate(modes):
+        sel = np.isin(ds["hopf_curve"].values,
+                      np.flatnonzero(ds["curve_mode"].values == mode))
+        freq = ds["frequency"].values[sel]
+        span = (f"{np.median(freq):.5g} Hz" if np.ptp(freq) < 5e-4 * freq.max()
+                else f"{freq.min():.4g}-{freq.max():.4g} Hz")
+        ax.plot([], [], lw=1.5, color=cycle[k % len(cycle)], label=f"{mode}, {span}")
     for c in range(ds.sizes["curve_index"]):
         sel = np.flatnonzero(ds["hopf_curve"].values == c)
-        (line,) = ax.plot([], [], lw=1.5, label=f"{ds['curve_mode'].values[c]}, "
-                          f"{np.median(ds['frequency'].values[sel]):.4g} Hz")
-        color = line.get_color()
+        color = cycle[modes.index(str(ds["curve_mode"].values[c])) % len(cycle)]
         sub = ds["l1"].values[sel] > 0.0
         outer = ds["on_boundary"].values[sel].astype(bool)
         for k in range(sel.size - 1):
