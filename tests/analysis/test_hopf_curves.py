@@ -235,10 +235,10 @@ def test_three_pads_in_speed_and_disc_damping():
     centres = sorted(float(np.median(ds[SPEED].values[ds["hopf_curve"].values == c]))
                      for c in pads)
     np.testing.assert_allclose(centres, [19.205, 19.344, 19.573], atol=5e-3)
-    (hp,) = [h for h in hopf_points(case, SPEED, np.linspace(19.4, 19.8, 5))]
+    (hp,) = hopf_points(case, SPEED, np.linspace(19.4, 19.8, 5))
     assert hp.on_boundary and hp.criticality == "subcritical"
-    last = [c for c in pads if abs(centres[2] - np.median(
-        ds[SPEED].values[ds["hopf_curve"].values == c])) < 5e-3][0]
+    last = next(c for c in pads if abs(centres[2] - np.median(
+        ds[SPEED].values[ds["hopf_curve"].values == c])) < 5e-3)
     sel = ds["hopf_curve"].values == last
     at = np.interp(0.003, ds[key].values[sel], ds[SPEED].values[sel])
     assert abs(at - hp.value) < 1e-3  # chords of the curve, 0.02 of the box apart
