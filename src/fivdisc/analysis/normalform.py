@@ -232,8 +232,13 @@ def lyapunov_coefficient(jacobian, x: np.ndarray, omega: float, index: int, step
         return np.nan, np.nan, complex(np.nan, np.nan)
     q = q * (0.5 / q[index])
     p = p / np.conj(np.vdot(p, q))
-    inv_a = np.linalg.inv(jac)
-    resonant = np.linalg.inv(2j * omega * np.eye(jac.shape[0]) - jac)
+    try:
+        inv_a = np.linalg.inv(jac)
+        resonant = np.linalg.inv(2j * omega * np.eye(jac.shape[0]) - jac)
+    except np.linalg.LinAlgError:
+        # A zero eigenvalue (zero-Hopf) or a pair at 2 i omega (a 1:2 resonance): the
+        # normal form has more critical terms than l1.
+        return np.nan, np.nan, complex(np.nan, np.nan)
     best = (np.nan, np.inf, complex(np.nan, np.nan))
     for _ in range(_RETRIES):
         l1, error, c1 = _ladder(jacobian, x, jac, q, p, inv_a, resonant, omega, step)
