@@ -619,6 +619,13 @@ def hopf_curves(
         Non-numeric or repeated keys, an empty range, an end outside a key's allowed
         values, too few seeds, or no sliding equilibrium at the box's first corner.
 
+    See Also
+    --------
+    fivdisc.stability_boundary : The outer boundary only, the zero of the largest growth
+        rate.
+    fivdisc.hopf_points : Hopf points along one key, with their ``l1``.
+    hopf_curve_lines : The curves and points as text, as the command line prints them.
+
     Notes
     -----
     A curve point solves ``Re lambda(x, y) = 0`` for its pair to ``1e-11`` of the box;
@@ -631,6 +638,31 @@ def hopf_curves(
     another's within ``_EDGE_DEPTH`` halvings of a seed edge, are missed: more seeds find
     them. Where the curve's pair becomes two real eigenvalues (a Bogdanov-Takens point)
     the curve ends as ``lost``.
+
+    Examples
+    --------
+    A slider on a rigid disc with the Stribeck law ``mu = mu_1 + dmu exp(-(u / v_s)^2)``
+    loses stability where its rotational damping falls below ``-r^2 N0 mu'(r Omega)``;
+    ``l1`` is proportional to ``-mu'''(r Omega)``, which changes sign at
+    ``r Omega = v_s sqrt(3/2)``: a Bautin point at ``Omega = 12.2474487`` rad/s, damping
+    ``2 r^2 N0 dmu sqrt(3/2) exp(-3/2) = 0.6831938`` N m s/rad, supercritical below it
+    in speed and subcritical above:
+
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []},
+    ...                      friction={"law": "stribeck", "stribeck_velocity": 1.0,
+    ...                                "stribeck_exponent": 2.0})
+    >>> curves = fivdisc.hopf_curves(rigid, ("speed.value", (5.0, 20.0)),
+    ...                              ("slider.rotational_damping", (0.3, 1.2)),
+    ...                              seeds=4, step=0.05)
+    >>> print(curves.sizes["curve_index"], str(curves["curve_mode"].values[0]))
+    1 phi
+    >>> kind, x, y = (str(curves["codim2_kind"].values[0]), curves["codim2_x"].values[0],
+    ...               curves["codim2_y"].values[0])
+    >>> print(f"{kind} at {x:.7f} rad/s, {y:.7f} N m s/rad")
+    bautin at 12.2474487 rad/s, 0.6831938 N m s/rad
+    >>> print(curves["l1"].values[0] < 0 < curves["l1"].values[-1])
+    True
     """
     xkey, ykey = x[0], y[0]
     xr_, yr_ = check_values("x", xkey, x[1]), check_values("y", ykey, y[1])
@@ -812,7 +844,17 @@ def _dataset(case: Case, box: _Box, curves: list[_Curve], l1s, specials: list[_S
 def hopf_curve_lines(ds: xr.Dataset) -> list[str]:
     """What a dataset of :func:`hopf_curves` holds, as lines of text: per curve its mode,
     frequencies, ends and sub- and supercritical parts; per codimension-two point its
-    kind and where."""
+    kind and where (``fivdisc stability --hopf-curves`` prints them).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        From :func:`hopf_curves` (or its file).
+
+    Returns
+    -------
+    list of str
+    """
     xkey, ykey = ds.attrs["x_key"], ds.attrs["y_key"]
     lines = []
     if ds.sizes["curve_index"] == 0:

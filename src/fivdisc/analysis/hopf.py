@@ -78,6 +78,27 @@ class HopfPoint:
         negative supercritical, positive subcritical.
     l1_error : float
         Its estimated absolute error [s^2].
+
+    See Also
+    --------
+    hopf_points : Makes them.
+    fivdisc.hopf_cycles : The periodic orbits born at one.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> (point,) = fivdisc.hopf_points(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> point.key, point.mode, point.direction, point.on_boundary
+    ('speed.value', 'phi', -1, True)
+    >>> print(f"{point.value:.6f} rad/s, {point.omega:.4f} rad/s, "
+    ...       f"period {2 * np.pi / point.omega * 1e3:.4f} ms")
+    9.162907 rad/s, 1414.2136 rad/s, period 4.4429 ms
+    >>> point.case.speed.value == point.value
+    True
+    >>> print(f"l1 = {point.l1:.6e} s^2: {point.criticality}")
+    l1 = 2.209709e-04 s^2: subcritical
     """
 
     key: str
@@ -219,6 +240,12 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
     CaseError
         As :func:`~fivdisc.analysis.eigenbranches.eigen_branches`.
 
+    See Also
+    --------
+    fivdisc.eigen_branches : The eigenvalues along the key, from which the points are
+        located.
+    fivdisc.hopf_cycles : The periodic orbits born at a Hopf point.
+
     Notes
     -----
     At the point the growth rate ``g(p) = Re lambda(p)`` of the branch is zero; it is
@@ -226,6 +253,23 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
     :func:`scipy.optimize.brentq`, the eigenvalue at each trial value being the one
     nearest to the branch's linear interpolation. A real eigenvalue crossing zero (a
     fold of the equilibrium, not a Hopf point) is not reported.
+
+    Examples
+    --------
+    A slider on a rigid disc (no modes), with rotational damping ``c`` = 0.5 N m s/rad
+    and the falling exponential friction law: sliding turns stable where the friction's
+    negative damping ``r^2 N0 alpha (mu_0 - mu_1) exp(-alpha r Omega)`` drops below
+    ``c``, at ``Omega = 10 ln 2.5`` rad/s, and the pair crosses at
+    ``sqrt(k_phi / I)`` [rad/s]:
+
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> points = fivdisc.hopf_points(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> [(round(p.value, 6), round(p.omega, 3), p.direction) for p in points]
+    [(9.162907, 1414.214, -1)]
+    >>> print(f"{10 * np.log(2.5):.6f} {np.sqrt(2000 / (0.1 * 0.1**2)):.3f}")
+    9.162907 1414.214
     """
     from fivdisc.analysis.eigenbranches import eigen_branches
 

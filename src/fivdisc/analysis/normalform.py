@@ -139,6 +139,21 @@ def first_lyapunov(model: Model, state: np.ndarray, omega: float,
     ``1 / (alpha r)`` (exponential law) or ``v_s / r`` (Stribeck law). A tabulated law
     is a cubic on each piece only: no step crosses a knot, and ``l1`` is not defined at
     a knot (nan there).
+
+    Examples
+    --------
+    A slider on a rigid disc with the exponential law, at its Hopf point in the speed:
+    ``l1 = alpha^2 c / (16 m omega) = 0.5 / (16 0.1 1414.2)``, positive: subcritical.
+
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> from fivdisc.analysis.normalform import first_lyapunov
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> (point,) = fivdisc.hopf_points(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> res = first_lyapunov(fivdisc.build_model(point.case), point.equilibrium.state,
+    ...                      point.omega)
+    >>> print(f"{res.value:.6e} s^2: {res.criticality}")
+    2.209709e-04 s^2: subcritical
     """
     jac = slip_jacobian(model, state) if jacobian is None else jacobian
     idx = reduced_indices(model)
@@ -222,6 +237,21 @@ def lyapunov_coefficient(jacobian, x: np.ndarray, omega: float, index: int, step
     ``step / 16``). Where it exceeds ``1e-6 |l1|`` (the series in the step converging
     slowly: the nonlinearity shorter than `step` says) the ladder is tried again from
     steps 8, 64 and 512 times shorter, and the result with the smallest estimate kept.
+
+    Examples
+    --------
+    The planar normal form ``x' = -y - x (x^2 + y^2)``, ``y' = x - y (x^2 + y^2)``:
+    ``rho' = -rho^3``, so ``c1 = -1`` and ``l1 = -1`` at ``omega = 1``:
+
+    >>> import numpy as np
+    >>> from fivdisc.analysis.normalform import lyapunov_coefficient
+    >>> def jacobian(v):
+    ...     x, y = v
+    ...     return np.array([[-3 * x**2 - y**2, -1 - 2 * x * y],
+    ...                      [1 - 2 * x * y, -x**2 - 3 * y**2]])
+    >>> l1, error, c1 = lyapunov_coefficient(jacobian, np.zeros(2), 1.0, 0, 0.1)
+    >>> print(f"{l1:.10f}, {c1.real:.10f}")
+    -1.0000000000, -1.0000000000
     """
     jac = jacobian(x) if jac is None else jac
     q, p, lam = _critical_vectors(jac, omega)

@@ -38,6 +38,27 @@ class Branch:
         multipliers ``before`` and ``after`` it, signatures on either side, ``rotation``
         (torus), ``bifurcation_point`` (index of the point before it) and ``note``.
         Attributes: ``key``, ``case`` (TOML), ``stop_reason``, ``start``.
+
+    See Also
+    --------
+    fivdisc.continue_orbit, fivdisc.hopf_cycles : Make one.
+    open_branch : Reads one written by :meth:`to_netcdf`.
+
+    Examples
+    --------
+    The first orbits born at the Hopf point of a slider on a rigid disc (no modes):
+
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> (hopf,) = fivdisc.hopf_points(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> branch = fivdisc.hopf_cycles(hopf, 19.0, max_points=3)
+    >>> len(branch), branch.key, branch.signature(0), branch.stop_reason
+    (3, 'speed.value', ('slip+',), 'the largest number of points (3) is reached')
+    >>> dict(branch.dataset.sizes)
+    {'point': 3, 'coordinate': 4, 'slider': 1, 'multiplier': 4, 'bifurcation': 0}
+    >>> print(f"first orbit: {branch.parameter[0]:.4f} rad/s, T = {branch.period[0] * 1e3:.4f} ms")
+    first orbit: 9.1630 rad/s, T = 4.4429 ms
     """
 
     def __init__(self, dataset: xr.Dataset) -> None:
@@ -345,6 +366,22 @@ def open_branch(path: str | PathLike[str]) -> Branch:
     ------
     FivdiscError
         The file is not a branch.
+
+    See Also
+    --------
+    fivdisc.continue_orbit, fivdisc.hopf_cycles : Compute a branch instead.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> (hopf,) = fivdisc.hopf_points(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> branch = fivdisc.hopf_cycles(hopf, 19.0, max_points=3)
+    >>> branch.to_netcdf("branch.nc")
+    >>> again = fivdisc.open_branch("branch.nc")
+    >>> again.dataset.equals(branch.dataset), str(again) == str(branch)
+    (True, True)
     """
     from fivdisc.files import read_dataset
 

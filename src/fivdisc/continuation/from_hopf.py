@@ -90,6 +90,13 @@ def hopf_cycles(
     ConvergenceError
         The first orbit does not converge (take a smaller `amplitude`).
 
+    See Also
+    --------
+    fivdisc.hopf_points : The Hopf points of the sliding equilibrium along a key.
+    fivdisc.periodic_orbit : One orbit by shooting, from a transient run.
+    fivdisc.continue_orbit : A branch from an orbit found by shooting (a stick-slip
+        orbit, say) instead of from a Hopf point.
+
     Notes
     -----
     The first orbit solves, for ``(x, T, p)``, the shooting equations
@@ -111,6 +118,28 @@ def hopf_cycles(
     undetermined (``bistable_undetermined``): its unstable orbits bound the equilibrium's
     basin, and the motion beyond them may be a stable vibration coexisting with it. The
     equilibrium's stability beyond other Hopf points of the key is not checked.
+
+    Examples
+    --------
+    A slider on a rigid disc (no modes): sliding turns stable above the Hopf point at
+    9.1629 rad/s, and the small slipping orbits born there lie on that side and are
+    unstable, a subcritical Hopf point. Their speed offset follows the averaged
+    closed form ``Omega - Omega_H = r alpha V^2 / 8`` in their rate amplitude ``V``, and
+    their period starts at ``2 pi / omega``:
+
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> (hopf,) = fivdisc.hopf_points(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> cycles = fivdisc.hopf_cycles(hopf, 19.0, max_points=3)
+    >>> cycles.hopf()["criticality"], bool(cycles.stable.any())
+    ('subcritical', False)
+    >>> ds = cycles.dataset
+    >>> rate = 0.5 * float(ds["phi_dot_max"][0, 0] - ds["phi_dot_min"][0, 0])  # V [rad/s]
+    >>> print(f"{cycles.parameter[0] - hopf.value:.2e} {0.1 * rate**2 / 8:.2e}")
+    1.05e-04 1.05e-04
+    >>> print(f"{cycles.period[0] / (2 * np.pi / hopf.omega):.6f}")
+    1.000000
     """
     if not (np.isfinite(amplitude) and 0 < amplitude <= 0.5):
         raise FivdiscError(f"amplitude = {amplitude!r} is invalid: must be in (0, 0.5], a "
