@@ -143,13 +143,17 @@ class Branch:
         nan if none) and whether its end away from the Hopf point is only a bound
         (``bistable_open``: the stick-slip orbits beyond a grazing are not followed),
         and whether a subcritical branch stopped before deciding it
-        (``bistable_undetermined``: no fold or grazing reached); else None."""
+        (``bistable_undetermined``: no fold or grazing reached); the point's first
+        Lyapunov coefficient ``l1`` [s^2] and ``l1_error`` (nan in files written before
+        they were stored); else None."""
         attrs = self.dataset.attrs
         if "criticality" not in attrs:
             return None
         return {"value": float(attrs["hopf_value"]), "omega": float(attrs["hopf_omega"]),
                 "direction": int(attrs["hopf_direction"]),
                 "criticality": str(attrs["criticality"]),
+                "l1": float(attrs.get("hopf_l1", math.nan)),
+                "l1_error": float(attrs.get("hopf_l1_error", math.nan)),
                 "bistable": (float(attrs["bistable_low"]), float(attrs["bistable_high"])),
                 "bistable_open": bool(attrs.get("bistable_open", 0)),
                 "bistable_undetermined": bool(attrs.get("bistable_undetermined", 0))}
@@ -313,7 +317,7 @@ class Branch:
         hopf = self.hopf()
         if hopf:
             lines.append(f"from the Hopf point at {self.key} = {hopf['value']:.9g}{unit}: "
-                         f"{hopf['criticality']}")
+                         f"{hopf['criticality']}{_l1_note(hopf)}")
             low, high = hopf["bistable"]
             if math.isnan(low) and hopf["bistable_undetermined"]:
                 reach = (f"not determined up to {self.key} = {p[-1]:.9g}{unit}: the "
@@ -338,6 +342,21 @@ class Branch:
             lines.append(f"  {b['kind']} at {self.key} = {b['parameter']:.9g}{unit}, "
                          f"T = {b['period']:.9g} s: {b['note']}")
         return "\n".join(lines)
+
+
+def _l1_note(hopf: dict[str, Any]) -> str:
+    """The first Lyapunov coefficient beside the orbits' verdict, and whether it agrees."""
+    l1, error = hopf["l1"], hopf["l1_error"]
+    if not math.isfinite(l1):
+        return ""
+    text = f" (first Lyapunov coefficient l1 = {l1:.4g} s^2"
+    if abs(l1) <= error:
+        return text + ", zero within its error: a Bautin point, where the orbits decide)"
+    if (l1 > 0.0) == (hopf["criticality"] == "subcritical"):
+        return text + ", agrees)"
+    return (text + ", says " + ("subcritical" if l1 > 0.0 else "supercritical")
+            + ": the first orbit is too large for the normal form to hold, take a "
+            "smaller --amplitude)")
 
 
 def open_branch(path: str | PathLike[str]) -> Branch:
