@@ -275,7 +275,12 @@ def zero_curves(g, seeds: int = 12, step: float = 0.02
         e = 1e-7
         grad = np.array([(g(seed + e * d) - g(seed - e * d)) / (2 * e)
                          for d in (np.array([1.0, 0.0]), np.array([0.0, 1.0]))])
-        along = np.array([-grad[1], grad[0]])
+        if np.all(np.isfinite(grad)) and np.any(grad):
+            along = np.array([-grad[1], grad[0]])
+        else:
+            # g is undefined or flat beside the seed (a jump, where g is defined on one
+            # side only): start across the seed's edge.
+            along = np.array([0.0, 1.0]) if edge[0] == "h" else np.array([1.0, 0.0])
         path, closed = _trace(g, seed, along, step)
         if not closed:
             backward, _ = _trace(g, seed, -along, step)

@@ -5,18 +5,23 @@ crosses the imaginary axis: there the equilibrium gains or loses stability and a
 of small periodic orbits is born, with the pair's angular frequency and along its
 eigenvector. The crossings are bracketed on the eigenvalue branches of
 :func:`~fivdisc.analysis.eigenbranches.eigen_branches` and located with Brent's method on
-the real part of the eigenvalue that continues the branch.
+the real part of the eigenvalue that continues the branch. Each point carries its first
+Lyapunov coefficient (:mod:`fivdisc.analysis.normalform`), whose sign says whether the
+orbits born there are stable (supercritical) or a threshold around stable sliding
+(subcritical).
 """
 
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
 
+from fivdisc.analysis.normalform import first_lyapunov
 from fivdisc.analysis.points import ParameterPoints, reduced_indices
 from fivdisc.case import Case
 from fivdisc.core import tangent as tan
@@ -73,6 +78,12 @@ class HopfPoint:
     unstable_modes : tuple of str
         The labels of the other modes that are unstable there (empty where
         `on_boundary`): while one is, every small orbit born here is unstable too.
+    l1 : float
+        First Lyapunov coefficient [s^2] per (rad/s)^2 of the slip-speed amplitude of
+        the slider that moves most (:func:`~fivdisc.analysis.normalform.first_lyapunov`):
+        negative supercritical, positive subcritical.
+    l1_error : float
+        Its estimated absolute error [s^2].
 
     See Also
     --------
@@ -92,6 +103,8 @@ class HopfPoint:
     9.162907 rad/s, 1414.2136 rad/s, period 4.4429 ms
     >>> point.case.speed.value == point.value
     True
+    >>> print(f"l1 = {point.l1:.6e} s^2: {point.criticality}")
+    l1 = 2.209709e-04 s^2: subcritical
     """
 
     key: str
@@ -106,6 +119,8 @@ class HopfPoint:
     on_boundary: bool
     equilibrium: Equilibrium
     case: Case
+    l1: float = math.nan
+    l1_error: float = math.nan
     unstable_modes: tuple[str, ...] = ()
 
     @property
@@ -118,14 +133,33 @@ class HopfPoint:
         """``2 pi / omega`` [s], the period of the orbits born here."""
         return 2.0 * np.pi / self.omega
 
+    @property
+    def criticality(self) -> str:
+        """By the sign of :attr:`l1`: ``"subcritical"`` (positive: small unstable orbits
+        on the side where the equilibrium is stable), ``"supercritical"`` (negative:
+        small stable orbits where it is unstable), or ``"degenerate"`` (zero within its
+        error, or not computed)."""
+        if not math.isfinite(self.l1) or abs(self.l1) <= self.l1_error:
+            return "degenerate"
+        return "subcritical" if self.l1 > 0.0 else "supercritical"
+
+    @property
+    def orbit_offset(self) -> float:
+        """``d p / d rho^2`` [unit of the key per (rad/s)^2]: a small orbit of slip-speed
+        amplitude ``rho`` lies at ``p = value + orbit_offset rho^2`` (from the normal
+        form, ``rate (p - value) + omega l1 rho^2 = 0``)."""
+        return -self.omega * self.l1 / self.rate
+
     def __str__(self) -> str:
         turn = "loses" if self.direction > 0 else "gains"
         others = ", ".join(self.unstable_modes) or "another mode"
         verb = "stay" if len(self.unstable_modes) > 1 else "stays"
         where = "" if self.on_boundary else f" ({others} {verb} unstable)"
+        kind = (f"; first Lyapunov coefficient l1 = {self.l1:.4g} s^2: {self.criticality}"
+                if math.isfinite(self.l1) else "")
         return (f"Hopf point at {self.key} = {self.value:.10g}: {self.mode} at "
                 f"{self.frequency:.6g} Hz ({self.omega:.6g} rad/s) {turn} stability as "
-                f"{self.key} increases{where}")
+                f"{self.key} increases{where}{kind}")
 
 
 def _full_layout(model: Model, eq: Equilibrium, vector: np.ndarray
@@ -167,15 +201,15 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, row_lo: np.
         t = (value - lo) / (hi - lo)
         _, column = linear_sum_assignment(
             np.abs((row_lo + t * (row_hi - row_lo))[:, None] - lam[None, :]))
-        return model, eq, lam, vec, int(column[b])
+        return model, eq, jac, lam, vec, int(column[b])
 
     def growth(value: float) -> float:
-        _, _, lam, _, i = eig_near(value)
+        _, _, _, lam, _, i = eig_near(value)
         return float(lam[i].real)
 
     scale = max(abs(lo), abs(hi), abs(hi - lo))
     root = float(brentq(growth, lo, hi, xtol=KEY_TOLERANCE * scale, rtol=1e-15))
-    model, eq, lam, vec, i = eig_near(root)
+    model, eq, jac, lam, vec, i = eig_near(root)
     step = 1e-6 * abs(hi - lo)
     rate = (growth(root + step) - growth(root - step)) / (2.0 * step)
     pick = i if lam[i].imag > 0 else int(np.argmin(np.abs(lam - np.conj(lam[i]))))
@@ -190,6 +224,7 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, row_lo: np.
     unstable = [labels[branch_of[j]] for j in np.argsort(-lam.real)
                 if j not in pair and lam[j].real >= 0.0 and lam[j].imag >= 0.0]
     state, vector = _full_layout(model, eq, vec[:, pick])
+    l1 = first_lyapunov(model, eq.state, float(lam[pick].imag), jac)
     return HopfPoint(
         key=key, value=root, omega=float(lam[pick].imag),
         direction=1 if (lam_hi.real - lam_lo.real) / (hi - lo) > 0.0 else -1,
@@ -198,6 +233,7 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, row_lo: np.
         mode=str(labels[b]), on_boundary=bool(np.all(others < 0.0)), equilibrium=eq,
         case=points.case.replace({key: root}),
         unstable_modes=tuple(dict.fromkeys(unstable)),
+        l1=l1.value, l1_error=l1.error,
     )
 
 
@@ -357,8 +393,9 @@ def with_hopf_points(branches: xr.Dataset, hopf: Sequence[HopfPoint]) -> xr.Data
         `branches` with, along a dimension ``hopf``: ``hopf`` (the key's value),
         ``hopf_frequency`` [Hz], ``hopf_direction`` (+1: the mode loses stability as the
         key increases), ``hopf_mode`` (the branch's label, as ``mode``),
-        ``hopf_on_boundary`` (1: the equilibrium changes stability there) and
-        ``hopf_unstable_modes`` (the other modes unstable there, comma-separated).
+        ``hopf_on_boundary`` (1: the equilibrium changes stability there),
+        ``hopf_unstable_modes`` (the other modes unstable there, comma-separated) and
+        ``hopf_l1``, ``hopf_l1_error`` (the first Lyapunov coefficient and its error).
     """
     key = branches.attrs["x_key"]
     return branches.assign(
@@ -377,4 +414,10 @@ def with_hopf_points(branches: xr.Dataset, hopf: Sequence[HopfPoint]) -> xr.Data
         hopf_unstable_modes=(("hopf",), np.array([", ".join(hp.unstable_modes)
                                                   for hp in hopf], dtype=str),
                              {"long_name": "the other modes unstable here"}),
+        hopf_l1=(("hopf",), np.array([hp.l1 for hp in hopf], dtype=float),
+                 {"units": "s2", "long_name": "first Lyapunov coefficient per (rad/s)^2 of "
+                                              "slip-speed amplitude (> 0: subcritical, < 0: "
+                                              "supercritical)"}),
+        hopf_l1_error=(("hopf",), np.array([hp.l1_error for hp in hopf], dtype=float),
+                       {"units": "s2", "long_name": "estimated error of hopf_l1"}),
     )

@@ -143,10 +143,12 @@ class Branch:
         nan if none) and whether its end away from the Hopf point is only a bound
         (``bistable_open``: the stick-slip orbits beyond a grazing are not followed),
         and whether a subcritical branch stopped before deciding it
-        (``bistable_undetermined``: no fold or grazing reached); the Hopf point's
-        ``mode`` (its branch's label), whether the equilibrium changes stability there
-        (``on_boundary``; else ``unstable_modes`` stay unstable, and every orbit born
-        there is unstable), and whether this branch ``continued`` one from the point
+        (``bistable_undetermined``: no fold or grazing reached); the point's first
+        Lyapunov coefficient ``l1`` [s^2] and ``l1_error`` (nan in files written before
+        they were stored); the Hopf point's ``mode`` (its branch's label), whether the
+        equilibrium changes stability there (``on_boundary``; else ``unstable_modes``
+        stay unstable, and every orbit born there is unstable), and whether this branch
+        ``continued`` one from the point
         (:func:`~fivdisc.continuation.from_hopf.restate_hopf`); else None."""
         attrs = self.dataset.attrs
         if "criticality" not in attrs:
@@ -155,6 +157,8 @@ class Branch:
         return {"value": float(attrs["hopf_value"]), "omega": float(attrs["hopf_omega"]),
                 "direction": int(attrs["hopf_direction"]),
                 "criticality": str(attrs["criticality"]),
+                "l1": float(attrs.get("hopf_l1", math.nan)),
+                "l1_error": float(attrs.get("hopf_l1_error", math.nan)),
                 "bistable": (float(attrs["bistable_low"]), float(attrs["bistable_high"])),
                 "bistable_open": bool(attrs.get("bistable_open", 0)),
                 "bistable_undetermined": bool(attrs.get("bistable_undetermined", 0)),
@@ -324,7 +328,7 @@ class Branch:
             where = "continues the branch from" if hopf["continued"] else "from"
             mode = f" ({hopf['mode']})" if hopf["mode"] else ""
             lines.append(f"{where} the Hopf point at {self.key} = {hopf['value']:.9g}{unit}"
-                         f"{mode}: {hopf['criticality']}")
+                         f"{mode}: {hopf['criticality']}{_l1_note(hopf)}")
             low, high = hopf["bistable"]
             if not hopf["on_boundary"]:
                 others = ", ".join(hopf["unstable_modes"]) or "another mode"
@@ -354,6 +358,21 @@ class Branch:
             lines.append(f"  {b['kind']} at {self.key} = {b['parameter']:.9g}{unit}, "
                          f"T = {b['period']:.9g} s: {b['note']}")
         return "\n".join(lines)
+
+
+def _l1_note(hopf: dict[str, Any]) -> str:
+    """The first Lyapunov coefficient beside the orbits' verdict, and whether it agrees."""
+    l1, error = hopf["l1"], hopf["l1_error"]
+    if not math.isfinite(l1):
+        return ""
+    text = f" (first Lyapunov coefficient l1 = {l1:.4g} s^2"
+    if abs(l1) <= error:
+        return text + ", zero within its error: a Bautin point, where the orbits decide)"
+    if (l1 > 0.0) == (hopf["criticality"] == "subcritical"):
+        return text + ", agrees)"
+    return (text + ", says " + ("subcritical" if l1 > 0.0 else "supercritical")
+            + ": the first orbit is too large for the normal form to hold, take a "
+            "smaller --amplitude)")
 
 
 def open_branch(path: str | PathLike[str]) -> Branch:

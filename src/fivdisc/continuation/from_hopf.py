@@ -78,7 +78,9 @@ def hopf_cycles(
     Branch
         The branch of orbits from the Hopf point, with attributes ``hopf_value``,
         ``hopf_omega``, ``hopf_direction``, ``criticality`` (``"subcritical"`` or
-        ``"supercritical"``) and ``bistable_low``, ``bistable_high`` (nan if there is no
+        ``"supercritical"``, by the side the orbits lie on), ``hopf_l1`` and
+        ``hopf_l1_error`` (the point's first Lyapunov coefficient [s^2], whose sign
+        says the same for small orbits) and ``bistable_low``, ``bistable_high`` (nan if there is no
         bistable range) in its dataset, printed by ``str`` (see :meth:`Branch.hopf`).
 
     Raises
@@ -176,7 +178,8 @@ def restate_hopf(result: Branch, source: Branch) -> None:
     if info is None:
         return
     hopf = types.SimpleNamespace(**{k: info[k] for k in (
-        "value", "omega", "direction", "on_boundary", "mode", "unstable_modes")})
+        "value", "omega", "direction", "on_boundary", "mode", "unstable_modes", "l1",
+        "l1_error")})
     _judge(result, hopf, earlier=info)
     result.dataset.attrs["hopf_continued"] = 1
 
@@ -225,6 +228,8 @@ def _judge(result: Branch, hopf: Any, earlier: dict[str, Any] | None = None) -> 
     undetermined = bool(hopf.on_boundary and kind == "subcritical" and not coexist.size)
     result.dataset.attrs.update({"hopf_value": hopf.value, "hopf_omega": hopf.omega,
                                  "hopf_direction": hopf.direction, "criticality": kind,
+                                 "hopf_l1": getattr(hopf, "l1", np.nan),
+                                 "hopf_l1_error": getattr(hopf, "l1_error", np.nan),
                                  "bistable_low": low, "bistable_high": high,
                                  "bistable_open": int(open_end),
                                  "bistable_undetermined": int(undetermined),
