@@ -315,3 +315,16 @@ def test_the_torus_of_the_hopf_branch_is_a_symmetry_breaking():
     assert abs(abs(near) - 1.0) < 1e-4
     assert abs(np.angle(near)) / (2 * np.pi) == pytest.approx(1 / 3 - 5.7e-6, abs=5e-7)
     assert abs(cmath.phase(near**3)) / (2 * np.pi) == pytest.approx(1.7e-5, abs=1e-6)
+    # the orbits that would break the symmetry: their direction is the pair's (M v =
+    # mu v, mu within 1e-3 of 1), and from so near a resonance, but not at it, none
+    # converges: the error says why
+    from fivdisc.continuation.starts import broken_start
+
+    start_orbit, along = broken_start(case, sb["state"], sb["period"], sb["phases"], sb)
+    shot = Shooting(model, sb["phases"], 1e-12, 1e-19).shoot(sb["state"], sb["period"])
+    values, vectors = np.linalg.eig(shot.monodromy)
+    lined = np.abs(vectors.conj().T @ along) / np.linalg.norm(vectors, axis=0)
+    assert abs(values[np.argmax(lined)] - 1.0) < 1e-3
+    with pytest.raises(ConvergenceError):
+        continue_orbit(case, "speed.value", 30.0, orbit=start_orbit, along=along,
+                       max_points=3, confirm_periods=0)

@@ -109,6 +109,7 @@ def continuation(case_file: Path | None, key: str, target: float, back_to: float
             branch.to_netcdf(out)
         click.echo(branch.to_json() if as_json else str(branch))
         sys.exit(130 if branch.stop_reason == INTERRUPTED else 1 if branch.lost else 0)
+    orbit = None
     try:
         case, orbit, along, search, source = _start(case_file, from_file, which, point, key,
                                                     target, rtol, tol, transient, period)
@@ -118,6 +119,15 @@ def continuation(case_file: Path | None, key: str, target: float, back_to: float
                                 back_to=back_to, settings=settings, progress=progress,
                                 **search)
     except ConvergenceError as exc:
+        if orbit is not None and orbit.start.startswith("at the symmetry breaking"):
+            # A Neimark-Sacker crossing of the reduced map near a resonance gives tori,
+            # and orbits without the symmetry exist near it only where this converges.
+            click.echo(f"error: no orbit without the symmetry converges {orbit.start} "
+                       f"({exc}): the motions born there need not be periodic (a "
+                       "Neimark-Sacker bifurcation of the reduced map near a resonance "
+                       "gives tori drifting through the orbit's images); a forward run "
+                       "(fivdisc simulate --from BRANCH --point K) shows them", err=True)
+            sys.exit(1)
         click.echo(f"error: no periodic orbit to start from: {exc}", err=True)
         sys.exit(1)
     if source is not None:

@@ -96,7 +96,7 @@ class ContinuationSettings:
     >>> import fivdisc
     >>> fivdisc.ContinuationSettings()
     ContinuationSettings(max_points=200, step=0.02, max_step=0.1, min_step=1e-06, rtol=1e-12,
-                         atol=None, tol=1e-08, time_budget=3600.0)
+                         atol=None, tol=1e-08, time_budget=3600.0, confirm_periods=400)
     >>> fivdisc.ContinuationSettings(max_points=50).replace(step=0.01).step
     0.01
     >>> fivdisc.ContinuationSettings(step=-1.0)
