@@ -129,3 +129,11 @@ def test_the_speed_and_pad_stiffness_boundary_of_three_pads_is_one_command(tmp_p
         lam = linear_stability(case.replace({"speed.value": float(x[i]),
                                              "sliders.*.normal_stiffness": float(y[i])}))
         assert abs(lam.max_growth_rate) < 1e-6 * np.max(np.abs(lam.eigenvalues))
+
+
+def test_a_sweep_axis_of_every_slider_sets_every_slider():
+    from fivdisc.sweep.spec import Sweep
+
+    sweep = Sweep(base=THREE, axes={"sliders.*.normal_damping": "0.5:1.5:3"})
+    dampings = [[s.normal_damping for s in case.sliders] for case in sweep]
+    assert dampings == [[0.5] * 3, [1.0] * 3, [1.5] * 3]

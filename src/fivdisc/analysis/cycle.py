@@ -180,8 +180,10 @@ def _dips(model: Model, y: np.ndarray, aux: np.ndarray, dt: float
 #: What each event kind is called in words.
 EVENT_WORDS = {"stick": "stick", "slip": "release", "reversal": "reversal",
                "separation": "separation", "recontact": "re-contact"}
-# Events of different sliders closer than this fraction of the period are simultaneous.
-SIMULTANEOUS = 1e-9
+# Events of different sliders closer than this fraction of the period are simultaneous:
+# the integration makes the switches of one instant at one time, to the last bit, and two
+# switches a picosecond apart near a border are in order, not together.
+SIMULTANEOUS = 1e-13
 
 
 def _matched(events: tuple[tuple[float, str, int], ...]) -> dict[tuple[str, int, int], float]:

@@ -33,6 +33,9 @@ NEAR_SWITCHES = 1e-5
 # The orbit found past a border where the flow map jumps is the branch's continuation if
 # its point lies within this (scaled, relative to the orbit's size) of the border orbit's.
 OTHER_PIECE = 1e-3
+# Where no test function extrapolates to zero at a branch's end, one whose value at the
+# last orbit is below this (a margin of mu_s N, a gap over the period) names it.
+NEAR_ZERO = 1e-5
 # Where the forward run that confirms an end starts: this fraction past the end.
 PAST = 2e-3
 # A forward run has settled on a periodic orbit when its returns to the section come

@@ -68,6 +68,8 @@ from fivdisc.analysis.orbits import (
 )
 from fivdisc.case import Case
 from fivdisc.continuation.borders import (
+    Ahead,
+    Test,
     border_ahead,
     forward_run,
     order_key,
@@ -95,6 +97,7 @@ from fivdisc.continuation.settings import (
     INTERRUPTED,
     LOCATE,
     MIN_COSINE,
+    NEAR_ZERO,
     OTHER_PIECE,
     PAST,
     POLISH,
@@ -604,6 +607,23 @@ def _end(problem: OrbitProblem, walk: Walk, br: Bracket, index: int,
             ahead = border_ahead(problem, lo, earlier, p_hi)
         except FivdiscError:
             ahead = None
+    if ahead is None:
+        # No test function extrapolates to zero there: the one nearest zero at the last
+        # orbit, if it is (the orbit sits next to a border it has partly crossed).
+        try:
+            near = [t for t in switch_tests(problem, lo)
+                    if t.kind in ("gap", "margin", "cascade") and 0 <= t.gone < NEAR_ZERO]
+        except FivdiscError:
+            near = []
+        if near:
+            test = min(near, key=lambda t: t.gone)
+            releases = ((test.kind == "margin" and test.key[1][0] == "slip")
+                        or (test.kind == "gap" and test.key[1][0] == test.key[2][0] == "slip"))
+            if releases:
+                # a stuck pad just short of releasing with another, or just after it:
+                # their cascade
+                test = Test("cascade", test.key, -test.value, test.jump, test.text)
+            ahead = Ahead(test, lo.value, test)
     at = 0.5 * (lo.value + p_hi)
     key = problem.key
     fwd = None
@@ -646,7 +666,10 @@ def _end(problem: OrbitProblem, walk: Walk, br: Bracket, index: int,
     elif ahead is not None and ahead.test.kind == "cascade":
         kind = "cascade end"
         what = (f"{ahead.test.text}: it reaches zero at {key} = {ahead.at:.9g}, where the "
-                "load turns into a relief and the pads no longer switch together")
+                "load turns into a relief and the pads no longer switch together"
+                if ahead.at != lo.value else
+                f"{ahead.test.text}: next to zero at the last orbit, where the pads cease to "
+                "switch together")
         stop = (f"the orbit does not persist past the end of its release cascade at {key} = "
                 f"{at:.9g}")
     elif ahead is not None:

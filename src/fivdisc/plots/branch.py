@@ -30,7 +30,10 @@ NARROW = 0.02
 # Short labels of the bifurcations on a figure.
 _MARKS = {"fold": ("LP", "s"), "period doubling": ("PD", "D"), "torus": ("NS", "o"),
           "branch point": ("BP", "^"), "signature change": ("DIB", "v"),
-          "grazing": ("GR", "v")}
+          "grazing": ("GR", "v"), "symmetry breaking": ("SB", "P"),
+          "switching order": ("SO", "v"), "discontinuity": ("JUMP", "X"),
+          "discontinuity end": ("END", "X"), "cascade end": ("END", "X"),
+          "end": ("LOST", "x"), "gap": ("GAP", "x")}
 
 
 def _columns(branch: Branch, measure: str, slider: int) -> list[tuple[str, np.ndarray, str]]:
