@@ -256,7 +256,7 @@ def test_a_stall_on_a_discontinuity_of_the_shooting_map_names_the_switches():
     assert "the shooting map is discontinuous at the iterate" in loose.note
 
 
-def test_the_pads_in_turn_solved_over_a_third_of_the_period():
+def test_the_pads_in_turn_solved_over_a_third_of_the_period(tmp_path):
     """The orbit at 22 rad/s has x(t + T/3) = P x(t): pads 0, 1 and 2 stick in turn. Solved
     over T/3 with the pads permuted it agrees with the full-period solve to 1e-12 s, with
     the same multipliers to 1e-9.
@@ -271,6 +271,21 @@ def test_the_pads_in_turn_solved_over_a_third_of_the_period():
     assert abs(third.period - full.period) < 1e-12
     np.testing.assert_allclose(np.sort(np.abs(third.multipliers)),
                                np.sort(np.abs(full.multipliers)), atol=1e-9)
+    # and from the command line
+    import json
+
+    from support.cli import run_cli
+
+    saved = full.to_dataset()
+    saved.attrs["case"] = case.to_toml()
+    path = tmp_path / "orbit22.nc"
+    saved.to_netcdf(path)
+    res = run_cli(["orbit", "--from", path, "--symmetric", "--json", "--no-progress"])
+    assert res.exit_code == 0, res.output
+    out = json.loads(res.stdout)
+    assert abs(out["period"] - full.period) < 1e-12
+    assert out["symmetry"] == "pads stick in turn, T/3 apart"
+    assert "solved over T/3" in out["note"]
     times, kinds, sliders = run_events(case, full.state, full.phases, 4 * full.period)
     first = times[(kinds == 0) & (times > full.period) & (times <= 2 * full.period)]
     assert sorted(sliders[(kinds == 0) & (times > full.period)
