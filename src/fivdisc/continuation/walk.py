@@ -437,7 +437,8 @@ def _jump_note(problem: OrbitProblem, lo: Point, other: Point) -> str:
     for pt in (lo, other):
         try:
             for t in switch_tests(problem, pt):
-                if t.kind in ("margin", "cascade") and t.key[2] in pads and t.key[1][1] in pads:
+                if ((t.kind == "margin" and t.key[2] in pads and t.key[1][1] in pads)
+                        or t.kind == "cascade"):
                     tests.append(t.text)
         except FivdiscError:
             pass
