@@ -287,7 +287,7 @@ def symmetric_kind(kind: str, at: Point, before: Point, after: Point
             mu = 0.5 * (passing[0][0] + passing[0][1])
             theta = abs(math.atan2(mu.imag, mu.real)) / (2 * math.pi)
             m = round(theta * k)
-            where = (f" ({m}/{k} {'+' if theta >= m / k else '-'} {abs(theta - m / k):.2g}: "
+            where = (f" ({m}/{k} {'+' if theta >= m / k else '-'} {abs(theta - m / k):.3g}: "
                      f"outside the {RESONANT:g}-turn window of the {m}:{k} resonance)"
                      if m % k else "")
             return kind, (f"the orbit keeps its symmetry ({at.symmetry}): the T/{k} map's "
