@@ -99,6 +99,7 @@ def compare(name, pair):
     c_t = np.concatenate(pair.ev_times) if pair.ev_times else np.empty(0)
     c_r = np.concatenate(pair.ev_rows) if pair.ev_rows else np.empty((0, 4), np.int64)
     out["events"] = nb_t.size
+    out["kinds"] = np.bincount(nb_r[:, 0], minlength=5) if nb_t.size else np.zeros(5, int)
     if nb_t.size != c_t.size or not np.array_equal(nb_r, c_r):
         m = min(nb_t.size, c_t.size)
         first = next((i for i in range(m) if not np.array_equal(nb_r[i], c_r[i])), m)
@@ -149,8 +150,16 @@ def compare(name, pair):
     return out
 
 
+def _kick(model, speed=5.0):
+    """Rest, with a strong transverse velocity of the first disc mode: the sliders separate
+    and land again."""
+    y = np.zeros(model.state_size)
+    y[model.n + 2 * model.n_sliders] = speed
+    return y
+
+
 def cases(span):
-    """(name, case, energy) of the comparison."""
+    """(name, case, energy[, initial state]) of the comparison."""
     for path in sorted(examples.DIRECTORY.glob("*.toml")):
         try:
             case = load_case(path)
@@ -168,6 +177,13 @@ def cases(span):
     fig = tomllib.loads(examples.path("fig18a").read_text())
     yield "fig18a energy", Case(**{**fig, "simulation": {**fig["simulation"],
                                                          "duration": span}}), True
+    kick = Case(simulation={"duration": span, "output_rate": 20000.0})
+    yield "kick impact", kick, True, _kick
+    yield "kick no impact", kick.replace({"simulation.impact": False}), True, _kick
+    yield "kick pads", pads.replace({"simulation.duration": span}), True, _kick
+    for count in (3, 8):
+        spread = Case(**_spread({"simulation": {"duration": span, "output_rate": 1000.0}}, count))
+        yield f"kick x{count}", spread, True, _kick
 
 
 def main() -> int:
@@ -179,18 +195,20 @@ def main() -> int:
     parser.add_argument("--vectors", default="0,1,4", help="tangent vector counts")
     args = parser.parse_args()
     failed = 0
+    kinds = np.zeros(5, int)
     worst = {"dt": 0.0, "traj": 0.0, "tan": 0.0}
     for vectors in (int(v) for v in args.vectors.split(",")):
         span = args.span if vectors == 0 else args.tangent_span
-        for name, case, energy in cases(span):
+        for name, case, energy, *start in cases(span):
             if args.only and args.only not in name:
                 continue
             model = build_model(case)
-            y0 = initial_state(model)
+            y0 = start[0](model) if start else initial_state(model)
             sim = case.simulation
             max_step = tangent_step(model) if vectors else None
             pair = Pair(model, y0, sim.duration, sim.output_rate, vectors, energy, max_step)
             res = compare(name, pair)
+            kinds += res["kinds"]
             for key in worst:
                 worst[key] = max(worst[key], res.get(key, 0.0))
             flag = "ok  " if res["ok"] else "FAIL"
@@ -198,9 +216,11 @@ def main() -> int:
             print(f"{flag} {name:22s} v={vectors} {res['steps']:6d} steps {res['events']:5d} "
                   f"events  dt {res['dt']:.1e}  traj {res['traj']:.1e}"
                   + (f"  tan {res['tan']:.1e}" if "tan" in res else "")
+                  + f"  kinds {'/'.join(str(k) for k in res['kinds'])}"
                   + ("  " + "; ".join(res["notes"]) if res["notes"] else ""), flush=True)
     print(f"worst: event times {worst['dt']:.2e} s, trajectories {worst['traj']:.2e} of peak, "
-          f"tangents {worst['tan']:.2e}; {failed} failed")
+          f"tangents {worst['tan']:.2e}; events stick/slip/reversal/separation/recontact "
+          f"{'/'.join(str(k) for k in kinds)}; {failed} failed")
     return 1 if failed else 0
 
 
