@@ -89,9 +89,10 @@ enum { S_THETA, S_SIGMA, S_MASS, S_INERTIA, S_KZ, S_CZ, S_KPHI, S_CPHI, S_N0, S_
 enum { O_LAW, O_MUS, O_MU0, O_MU1, O_ALPHA, O_VS, O_DELTA, O_MUV, O_OMDOT, O_IMPACT, O_LMAX,
        O_DAMPED, O_MIN_FLIGHT, N_OPTS };
 
-// Largest nodal-diameter count and modal coordinates the core accepts.
+// Largest nodal-diameter count, work array (values) and output (values) the core accepts.
 constexpr int MAX_L = 100000;
-constexpr long MAX_SIZE = 100000000;
+constexpr double MAX_WORK = 2e7;
+constexpr double MAX_OUTPUT = 1e9;
 
 Pieces pieces(const Array& a, const char* name) {
     if (a.ndim() != 2 || a.shape(1) != 5 || a.shape(0) < 1)
@@ -120,13 +121,16 @@ Model make_model(const Array& disc, const Array& slider, const Array& shape, con
              ", S) with S >= 1");
     const long n = static_cast<long>(disc.shape(1));
     const long S = static_cast<long>(slider.shape(1));
-    if (2 * (n + 2 * S) > MAX_SIZE) fail("the model is too large: " + std::to_string(n) + " modal coordinates");
-    need_shape(shape, "shape", {S, n});
     need_shape(opts, "opts", {N_OPTS});
+    need_finite(opts, "opts");
+    const double lw = std::fabs(opts.data()[O_LMAX]) + 2.0;
+    if (!(static_cast<double>(S) * (3.0 * n + 2.0 * lw + S + 1.0) <= MAX_WORK))
+        fail("the model is too large for the core: " + std::to_string(n) + " modal coordinates, " +
+             std::to_string(S) + " sliders");
+    need_shape(shape, "shape", {S, n});
     need_finite(disc, "disc");
     need_finite(slider, "slider");
     need_finite(shape, "shape");
-    need_finite(opts, "opts");
     Model m;
     m.n = static_cast<int>(n);
     m.S = static_cast<int>(S);
@@ -523,9 +527,9 @@ NB_MODULE(_core, m) {
                  if (!(atol > 0 && std::isfinite(atol))) fail("atol must be positive and finite");
                  if (!(max_step >= 0)) fail("max_step must be >= 0 (0: none)");
                  if (!(out_dt > 0)) fail("out_dt must be positive (inf: no samples)");
-                 if (n_out < 0 || n_out > MAX_SIZE / L.size) fail("n_out must be from 0 to " + std::to_string(MAX_SIZE / L.size));
-                 if (n_out > 0 && !(std::isfinite(out_dt) && static_cast<double>(n_out - 1) * out_dt <= t_final * (1 + 1e-9) + 1e-300))
-                     fail("n_out samples at out_dt do not fit in t_final");
+                 const long most = static_cast<long>(MAX_OUTPUT / (L.size + 4 * M.S + 1));
+                 if (n_out < 0 || n_out > most)
+                     fail("n_out must be from 0 to " + std::to_string(most) + " samples");
                  if (breaks.ndim() != 1) fail("breaks must be a vector");
                  need_finite(breaks, "breaks");
                  std::vector<double> br(breaks.data(), breaks.data() + breaks.size());
@@ -680,7 +684,7 @@ NB_MODULE(_core, m) {
                      [](nb::handle_t<PyIntegrator> h) {
                          PyIntegrator& s = nb::cast<PyIntegrator&>(h);
                          const size_t shape[2] = {static_cast<size_t>(s.it.n_out), static_cast<size_t>(s.it.L.size)};
-                         return Out(s.it.out_y.data(), 2, shape, h);
+                         return Out(s.it.out_y.get(), 2, shape, h);
                      },
                      "The state samples (n_out, size), a view; rows past n_samples are not written.", nb::rv_policy::automatic)
         .def_prop_ro("out_aux",
@@ -688,7 +692,7 @@ NB_MODULE(_core, m) {
                          PyIntegrator& s = nb::cast<PyIntegrator&>(h);
                          const size_t shape[2] = {static_cast<size_t>(s.it.n_out),
                                                   static_cast<size_t>(s.it.cols.width())};
-                         return Out(s.it.out_aux.data(), 2, shape, h);
+                         return Out(s.it.out_aux.get(), 2, shape, h);
                      },
                      "Per-sample columns (n_out, 4 S + 1), a view: N_j, f_j, phase_j, w_j, then Omega.", nb::rv_policy::automatic);
 }

@@ -59,8 +59,10 @@ class Integrator {
     std::vector<double> k;   // (7, size): the stages; k[0] the right-hand side at y
     std::vector<double> ev_prev;  // event values at y
     std::vector<double> breaks;   // kinks of the speed profile, increasing
-    std::vector<double> out_y;    // (n_out, size): samples of the state
-    std::vector<double> out_aux;  // (n_out, cols.width()): per-slider N, f, phase, w, and Omega
+    // Samples, left uninitialised (like numpy.empty: pages never written are never
+    // committed): (n_out, size) of the state, (n_out, cols.width()) per-slider N, f,
+    // phase, w, and Omega.
+    std::unique_ptr<double[]> out_y, out_aux;
     int64_t n_out = 0;
     EventLog log;
     int event_capacity = 1 << 15;
@@ -76,8 +78,8 @@ class Integrator {
         sg.assign(M.S, 1);
         k.assign(static_cast<size_t>(7) * L.size, 0.0);
         ev_prev.assign(static_cast<size_t>(3) * M.S, 0.0);
-        out_y.assign(static_cast<size_t>(n_out) * L.size, 0.0);
-        out_aux.assign(static_cast<size_t>(n_out) * cols.width(), 0.0);
+        out_y.reset(new double[static_cast<size_t>(n_out > 0 ? n_out : 1) * L.size]);
+        out_aux.reset(new double[static_cast<size_t>(n_out > 0 ? n_out : 1) * cols.width()]);
         wk.init(M);
         sc.init(L.size, 3 * M.S);
     }
@@ -272,7 +274,7 @@ inline int Integrator::advance(double t_target) {
                       sg.data(), K(0), wk, *tan);
         if (h <= 0.0) h = initial_step(t);
         if (cnt.out_next == 0 && n_out > 0) {
-            for (int i = 0; i < size; ++i) out_y[i] = y[i];
+            for (int i = 0; i < size; ++i) out_y[static_cast<size_t>(i)] = y[i];
             begin_row(0);
             cnt.out_next = 1;
         }
