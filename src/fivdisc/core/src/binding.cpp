@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "floor.hpp"
 #include "integrator.hpp"
 
 namespace nb = nanobind;
@@ -511,6 +512,37 @@ NB_MODULE(_core, m) {
           },
           "dmat"_a, "gam"_a, "forced"_a,
           "(w, lam) solving lam >= 0, w = gam + D lam >= 0, lam.w = 0 (forced contacts bilateral).");
+
+    m.def("floor_dopri_linear",
+          [](nb::ndarray<const int64_t, nb::ndim<1>, nb::c_contig> indptr,
+             nb::ndarray<const int64_t, nb::ndim<1>, nb::c_contig> indices,
+             nb::ndarray<const double, nb::ndim<1>, nb::c_contig> data, const Array& u, const Array& v,
+             const Array& y0, double t_final, double rtol, double atol) {
+              const long n = static_cast<long>(y0.ndim() == 1 ? y0.shape(0) : -1);
+              if (n < 1) fail("y0 must be a non-empty vector");
+              if (static_cast<long>(indptr.shape(0)) != n + 1) fail("indptr must have n + 1 entries");
+              const int64_t* ip = indptr.data();
+              if (ip[0] != 0) fail("indptr must start at 0");
+              for (long i = 0; i < n; ++i)
+                  if (ip[i + 1] < ip[i]) fail("indptr must not decrease");
+              if (ip[n] != static_cast<int64_t>(indices.shape(0)) || indices.shape(0) != data.shape(0))
+                  fail("indices and data must have indptr[-1] entries");
+              for (size_t p = 0; p < indices.shape(0); ++p)
+                  if (indices.data()[p] < 0 || indices.data()[p] >= n) fail("an index is out of range");
+              if (u.ndim() != 2 || v.ndim() != 2 || u.shape(0) != v.shape(0) ||
+                  static_cast<long>(u.shape(1)) != n || static_cast<long>(v.shape(1)) != n)
+                  fail("u and v must have shape (rank, n)");
+              if (!(t_final >= 0 && std::isfinite(t_final) && rtol > 0 && atol > 0))
+                  fail("t_final, rtol and atol must be positive and finite");
+              LinearOperator op{ip, indices.data(),
+                                data.data(), u.data(), v.data(), static_cast<int>(u.shape(0)), static_cast<int>(n)};
+              std::vector<double> y(y0.data(), y0.data() + n);
+              nb::gil_scoped_release release;
+              return floor_dopri_linear(op, y.data(), t_final, rtol, atol);
+          },
+          "indptr"_a, "indices"_a, "data"_a, "u"_a, "v"_a, "y0"_a, "t_final"_a, "rtol"_a, "atol"_a,
+          "Accepted steps of DOPRI5 with the integrator's step control on y' = (B + U^T V) y over "
+          "[0, t_final], B in CSR form: the floor of the cost per step (benchmarks/floor.py).");
 
     nb::class_<PyIntegrator>(m, "Integrator",
         "One integration of a model, advanced call by call; its whole state is kept between calls.")
