@@ -1,4 +1,4 @@
-"""The speed baseline of the benchmarks: the slow reference model of tests/reference_model.py.
+"""The speed baseline of the benchmarks: the slow reference model of tests/reference/model.py.
 
 The reference (plain numpy right-hand side with a dense solve at every evaluation,
 scipy ``solve_ivp`` with Python event functions) is run with ``method="RK45"`` and the

@@ -27,7 +27,7 @@ def tolerance_errors(rtols: tuple[float, ...] = (1e-6, 1e-7, 1e-8)) -> list[tupl
                                                                                   float]]:
     """(rtol, max |phi error| / peak, max switch time error [s]) of the default case over
     0.2 s against a ``rtol = 1e-12`` run; the switch error is nan if the switch sequence
-    differs. tests/test_docs_numbers.py checks the README's numbers with it."""
+    differs. tests/package/test_docs_numbers.py checks the README's numbers with it."""
     case = Case(simulation={"duration": 0.2, "output_rate": 20000.0})
     exact = _run(case, 1e-12).dataset
     peak = np.max(np.abs(exact["phi"].values))

@@ -25,8 +25,8 @@ import time
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-from fivdisc.analysis.continuation import continue_orbit
 from fivdisc.analysis.orbits import periodic_orbit
+from fivdisc.continuation.walk import continue_orbit
 from fivdisc.paper.cases import FIGURES
 
 

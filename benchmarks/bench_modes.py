@@ -5,7 +5,7 @@ mode on its own, an unscaled determinant built from scipy's ``jvp``/``yvp``/``iv
 evaluated point by point on the same dense grid, the (k + 1)-th sign change refined by brentq,
 and the modal mass by adaptive ``quad``; nothing is shared between modes. It also serves as a
 cross-check: its frequencies and its R(r0)^2 / M at the slider's radius r0 (the quantity that
-enters the dynamics, free of the shape's normalisation) must agree with :mod:`fivdisc.plate`.
+enters the dynamics, free of the shape's normalisation) must agree with :mod:`fivdisc.model.plate`.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numpy as np
 from scipy import integrate, optimize, special
 
 from fivdisc.case import Case
-from fivdisc.plate import AnnularPlate, clear_cache
+from fivdisc.model.plate import AnnularPlate, clear_cache
 
 # The paper's Table 1 plate and track radius, from the case defaults.
 _DEFAULT = Case()
@@ -60,7 +60,7 @@ def baseline_modes() -> list[tuple[float, float]]:
     rho_h = TABLE1["density"] * TABLE1["thickness"]
     plate = AnnularPlate(**TABLE1)
     stiffness = math.sqrt(plate.flexural_rigidity / rho_h)
-    step = math.pi / (b - a) / 32  # the grid density fivdisc.plate uses
+    step = math.pi / (b - a) / 32  # the grid density fivdisc.model.plate uses
     out = []
     for k, n in PAIRS:
 
@@ -101,7 +101,7 @@ def main() -> None:
     ours_array, naive_array = np.array(ours_result), np.array(naive_result)
     difference = np.max(np.abs(ours_array / naive_array - 1), axis=0)
     print(f"40 modes (k <= 3, l <= 9), Table 1 plate, cold cache, median of {REPEATS} runs")
-    print(f"  fivdisc.plate     : {ours:.4f} s")
+    print(f"  fivdisc.model.plate     : {ours:.4f} s")
     print(f"  naive baseline    : {naive:.4f} s (median of {BASELINE_REPEATS})")
     print(f"  speed-up          : {naive / ours:.1f}x")
     print(f"  max relative difference, omega       : {difference[0]:.1e}")

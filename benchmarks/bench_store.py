@@ -37,7 +37,8 @@ from typing import Any
 
 from fivdisc.case import Case
 from fivdisc.sweep import Sweep, verify_store
-from fivdisc.sweep.store import PointOutcome, checksummed
+from fivdisc.sweep.store.checksum import checksummed
+from fivdisc.sweep.store.sweep_store import PointOutcome
 
 PER = 100_000  # points, the unit of the reported costs
 REPO = Path(__file__).resolve().parents[1]
@@ -52,12 +53,22 @@ def _spec(n: int) -> Sweep:
                  keep=["separated", "max_normal_force"])
 
 
+def current_store_module() -> ModuleType:
+    """This fivdisc's store functions, as one module like the earlier commits' store.py."""
+    from fivdisc.sweep.store.health import verify_store
+    from fivdisc.sweep.store.lock import store_lock
+    from fivdisc.sweep.store.sweep_store import SweepStore
+
+    module = ModuleType("current")
+    module.store_lock, module.SweepStore, module.verify_store = (store_lock, SweepStore,
+                                                                 verify_store)
+    return module
+
+
 def make_store(path: Path, n: int, full: bool, module: Any = None) -> Sweep:
     """An n x n store, empty or with every point written (made-up outcomes), by the store
     module `module` (default: this fivdisc's)."""
-    from fivdisc.sweep import store as current
-
-    module = module or current
+    module = module or current_store_module()
     spec = _spec(n)
     with module.store_lock(path):
         store = module.SweepStore.open(path, spec)
@@ -125,7 +136,7 @@ def main() -> None:
     parser.add_argument("--previous", nargs="+", default=PREVIOUS,
                         help="commits of the earlier checks")
     args = parser.parse_args()
-    from fivdisc.sweep import store as current
+    current = current_store_module()
 
     with tempfile.TemporaryDirectory() as tmp:
         empty = Path(tmp) / "empty.zarr"

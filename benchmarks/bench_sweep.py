@@ -20,15 +20,15 @@ import tempfile
 import time
 from pathlib import Path
 
-from fivdisc.simulate import simulate
+from fivdisc.engine.simulation import simulate
+from fivdisc.plots import plot_separation_map
 from fivdisc.sweep import (
     open_sweep,
-    plot_separation_map,
     run_sweep,
     separation_sweep,
-    warm_kernel,
 )
 from fivdisc.sweep.reductions import evaluate
+from fivdisc.sweep.run import warm_kernel
 from fivdisc.sweep.separation import DEFAULT_RANGES
 
 X_RANGE = (2.0, 20.0)  # Omega_0 [rad/s], as the default Fig. 27 map

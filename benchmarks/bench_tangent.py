@@ -7,7 +7,7 @@ baseline measured in the same run:
    the same run without them, on the paper's Fig. 8 case (the steps are the same: the
    tangents do not change the step sequence); the target is at most 1 + n;
 2. the largest Lyapunov exponent of the Fig. 8 case over 10 s of simulated time
-   (``fivdisc.analysis.lyapunov.lyapunov``, one vector) against the plain run of the
+   (``fivdisc.analysis.exponents.lyapunov``, one vector) against the plain run of the
    same 10 s; the target is at most 2.5;
 3. with ``--processes N``, the one-vector figure again in N fresh processes (it varies
    from process to process by more than between the rounds of one).
@@ -33,12 +33,12 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
 
-from fivdisc.analysis.lyapunov import lyapunov
+from fivdisc.analysis.exponents import lyapunov
 from fivdisc.case import load_case
+from fivdisc.engine.integration import Integration, tangent_step
+from fivdisc.engine.simulation import initial_state
 from fivdisc.examples import DIRECTORY
-from fivdisc.integration import Integration, tangent_step
-from fivdisc.model import build_model
-from fivdisc.simulate import initial_state
+from fivdisc.model.build import build_model
 
 SPAN = 10.0  # [s] of simulated time per timed run (item 1)
 MEASURE = 10.0  # [s] of simulated time for the exponent (item 2)

@@ -30,13 +30,13 @@ import time
 import numpy as np
 from numba import njit
 
-from fivdisc._kernels.dopri5 import A, E
-from fivdisc._kernels.dynamics import complex_step_jacobian
+from fivdisc.core.dopri5 import A, E
+from fivdisc.core.dynamics import complex_step_jacobian
 
 # The kernel's own step-control constants: the floor must take the steps the kernel would
 # (its PI controller below repeats the kernel's lines on purpose, without events).
-from fivdisc._kernels.integrate import _BETA, _EXPO1
-from fivdisc._kernels.layout import SEPARATION, SLIP
+from fivdisc.core.integrate import _BETA, _EXPO1
+from fivdisc.model.layout import SEPARATION, SLIP
 
 
 @njit(cache=True)
@@ -243,7 +243,7 @@ def _floor_once(op, start, duration: float, clock) -> float:
 
 def _kernel_once(model, y0, duration: float, clock) -> float:
     """Time per accepted step [s] of the kernel's run without output by ``clock``."""
-    from fivdisc.integration import Integration
+    from fivdisc.engine.integration import Integration
 
     run = Integration(model, y0, duration=duration)
     t0 = clock()
@@ -262,7 +262,7 @@ def sliders(rounds: int, clock) -> None:
 
     from bench_family import _spread
     from fivdisc import Case, build_model, examples
-    from fivdisc.simulate import initial_state
+    from fivdisc.engine.simulation import initial_state
 
     # Short runs, many rounds: the more of them, the likelier some ran undisturbed.
     span = 1.0

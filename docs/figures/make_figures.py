@@ -26,7 +26,8 @@ HERE = Path(__file__).resolve().parent
 
 def bifurcation_speed(work: Path) -> None:
     from fivdisc import examples
-    from fivdisc.sweep import load_sweep, open_sweep, plot_bifurcation, run_sweep
+    from fivdisc.plots import plot_bifurcation
+    from fivdisc.sweep import load_sweep, open_sweep, run_sweep
 
     store = work / "bifurcation-speed.zarr"
     spec = load_sweep(examples.path("bifurcation-speed"))

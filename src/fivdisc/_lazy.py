@@ -1,60 +1,51 @@
-"""Packages whose public names are imported on first use (PEP 562).
+"""Packages whose public names are imported on first use (PEP 562), from one table.
 
-Such a package imports none of its modules itself: importing one of them (for example
-``fivdisc.analysis.spectra``) then runs no other, and the import graph stays one-way
-(``tests/test_imports.py``).
+A package lists its public API once, as a table of modules and the names each gives it;
+:func:`public` makes ``__all__``, ``__getattr__`` and ``__dir__`` from it. Such a package
+imports none of its modules itself: importing one of them (for example
+``fivdisc.analysis.spectra``) then runs no other, the import graph stays one-way
+(``tests/package/test_imports.py``), and ``import fivdisc`` starts without scipy, xarray or
+matplotlib. No module of such a package is named like a name it gives the package (the
+import system would bind the module over it once imported; ``tests/package/test_imports.py``
+checks).
 """
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Callable, Iterable, Mapping
 from importlib import import_module
-from types import ModuleType
 from typing import Any
 
-__all__ = ["homes", "lazy_names"]
+__all__ = ["public"]
 
 
-def homes(modules: Mapping[str, Iterable[str]]) -> dict[str, str]:
-    """Public name -> the module that defines it, from module -> names."""
-    return {name: module for module, names in modules.items() for name in names}
+def public(namespace: dict[str, Any], table: Mapping[str, Iterable[str]],
+           computed: Mapping[str, Callable[[], Any]] | None = None
+           ) -> tuple[list[str], Callable[[str], Any], Callable[[], list[str]]]:
+    """Make the package whose globals are ``namespace`` lazy, with the public API ``table``
+    (module -> the names it gives the package).
 
-
-class _Package(ModuleType):
-    """A lazy package's module type: a function keeps its name on the package when the
-    module of the same name that defines it is imported.
-
-    The import system binds a submodule, once imported, to the package's attribute of the
-    same name; the module ``fivdisc.simulate``, imported by whatever needs it first, would
-    then hide the function ``fivdisc.simulate`` that it defines.
+    ``computed`` maps further public names to functions that make their values on first
+    use (``__version__``). Returns ``__all__`` (sorted), ``__getattr__`` and ``__dir__``;
+    ``namespace["_HOMES"]`` is set to the name -> module mapping, which
+    ``tests/package/test_imports.py`` reads.
     """
-
-    _lazy_homes: Mapping[str, str] = {}
-
-    def __setattr__(self, name: str, value: Any) -> None:
-        if isinstance(value, ModuleType) and self._lazy_homes.get(name) == value.__name__:
-            value = getattr(value, name)
-        super().__setattr__(name, value)
-
-
-def lazy_names(namespace: dict[str, Any], names: Mapping[str, str]
-               ) -> tuple[Callable[[str], Any], Callable[[], list[str]]]:
-    """Make the package whose globals are `namespace` lazy: returns its ``__getattr__``
-    and ``__dir__``, which import the names `names` (name -> home module) on first use
-    and keep them in `namespace`."""
-    package = sys.modules[namespace["__name__"]]
-    package.__class__ = _Package
-    package._lazy_homes = names
+    homes = {name: module for module, names in table.items() for name in names}
+    computed = dict(computed or {})
+    namespace["_HOMES"] = homes
+    names = sorted({*homes, *computed})
 
     def __getattr__(name: str) -> Any:
-        if name not in names:
+        if name in computed:
+            value = computed[name]()
+        elif name in homes:
+            value = getattr(import_module(homes[name]), name)
+        else:
             raise AttributeError(f"module {namespace['__name__']!r} has no attribute {name!r}")
-        value = getattr(import_module(names[name]), name)
         namespace[name] = value
         return value
 
     def __dir__() -> list[str]:
-        return sorted({*namespace, *names, *namespace.get("__all__", ())})
+        return sorted({*namespace, *names})
 
-    return __getattr__, __dir__
+    return names, __getattr__, __dir__

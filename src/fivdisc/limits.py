@@ -8,8 +8,8 @@ for hours.
 Mode limits (:data:`MAX_NODAL_CIRCLES`, :data:`MAX_NODAL_DIAMETERS`, :data:`MAX_MODES`,
 :data:`MIN_RADIUS_RATIO`) keep ``fivdisc modes`` on any valid case to a few seconds
 (measured: at most 2.4 s for 31 modes at the limits, over radius ratios from 1e-3 to
-0.99999 and Poisson ratios from -0.999 to 0.4999; ``tests/test_limits.py``). Below the
-radius ratio the root finder of :mod:`fivdisc.plate` loses roots (the hub's Bessel columns
+0.99999 and Poisson ratios from -0.999 to 0.4999; ``tests/case/test_bounded_work.py``). Below the
+radius ratio the root finder of :mod:`fivdisc.model.plate` loses roots (the hub's Bessel columns
 overflow) and slows down without bound.
 """
 

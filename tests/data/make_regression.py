@@ -4,8 +4,8 @@ Run once, from a checkout of the commit recorded in each file, before the kernel
 changed: ``python tests/data/make_regression.py``. Each file holds a whole simulation
 dataset, the case text (``attrs["case"]``), the initial state given to ``simulate``
 (``attrs["regression_initial"]``, empty for the case's own) and the commit
-(``attrs["regression_commit"]``). ``tests/test_regression.py`` reruns every file's case
-with the current code and compares.
+(``attrs["regression_commit"]``). ``tests/engine/test_single_slider_unchanged.py``
+reruns every file's case with the current code and compares.
 """
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from fivdisc.case import Case, load_case
+from fivdisc.engine.simulation import simulate
 from fivdisc.examples import DIRECTORY as EXAMPLES
-from fivdisc.simulate import simulate
 
 HERE = Path(__file__).parent
 

@@ -7,7 +7,7 @@ variables (over their peak) between:
 1. the current code and the saved file (on another CPU than the one that wrote it, a
    last-bit difference of libm or numpy amplified by the switching);
 2. the current code and the same case with the slider's mass changed by 1 and by 4 ulps
-   (what ``tests/test_regression.py`` measures to set its bounds);
+   (what ``tests/engine/test_single_slider_unchanged.py`` measures to set its bounds);
 
 then the same for two real model changes: the accelerating and decelerating runs without
 the dOmega/dt terms, and the stick-slip run with its normal damping changed by 1e-6.
@@ -22,7 +22,7 @@ import numpy as np
 import xarray as xr
 
 from fivdisc.case import Case
-from fivdisc.simulate import simulate
+from fivdisc.engine.simulation import simulate
 
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE.parent))

@@ -5,9 +5,9 @@ gyroscopic sign, is chaotic: tiny differences (another tolerance, another machin
 floating point) grow until the trajectories part, so the time of the first separation,
 the number of separations and the time a printed-sign run diverges are not reproducible
 to the digit (Fig. 8's first separation moved from 26.6 s to 24.3 s between two machines).
-``tests/test_paper.py`` therefore asserts them only within the spread this study measures
+``tests/paper/test_paper.py`` therefore asserts them only within the spread this study measures
 (each case at the default tolerances and at 10x and 100x tighter and 10x looser ones),
-and ``docs/deviations.md`` states these spreads, which ``tests/test_docs_numbers.py``
+and ``docs/deviations.md`` states these spreads, which ``tests/package/test_docs_numbers.py``
 checks against ``separation_tolerance_study.txt``, this script's output::
 
     python tests/data/separation_tolerance_study.py > tests/data/separation_tolerance_study.txt
@@ -22,11 +22,11 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from fivdisc.model import build_model
+from fivdisc.engine.result import select_slider
+from fivdisc.engine.simulation import initial_state, simulate
+from fivdisc.model.build import build_model
 from fivdisc.paper import FIG7, FIG8, FIG10, FIG13, FIG15, FIG18, FIG19, FIG24, FIG28, FIGURES
 from fivdisc.paper import measure as ms
-from fivdisc.result import select_slider
-from fivdisc.simulate import initial_state, simulate
 
 RTOLS = (1e-5, 1e-6, 1e-7, 1e-8)  # the default is 1e-6 with atol = 1e-3 rtol
 # The cases of docs/deviations.md whose separation (fivdisc's skew gyroscopic terms) or

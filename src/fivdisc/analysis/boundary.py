@@ -260,7 +260,7 @@ def zero_curves(g, seeds: int = 12, step: float = 0.02
 
 
 def _dataset(case: Case, g: _Growth, branches, x, y) -> xr.Dataset:
-    from fivdisc.conventions import global_attrs, key_attrs
+    from fivdisc.engine.conventions import global_attrs, key_attrs
 
     (xkey, xr_), (ykey, yr_) = x, y
     rows = []

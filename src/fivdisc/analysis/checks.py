@@ -37,11 +37,11 @@ def check_time(name: str, value: float | None, *, zero: bool = False) -> None:
 
 def shortest_period(case: Case) -> float:
     """The shortest period [s] an orbit of `case` may have: half the period of the
-    model's fastest time scale (:func:`fivdisc.integration.fastest_time_scale`). No
+    model's fastest time scale (:func:`fivdisc.engine.integration.fastest_time_scale`). No
     motion of the model is faster; the half leaves room for the coupling of the disc and
     the sliders, which raises the fastest frequency above each part's own."""
-    from fivdisc.integration import fastest_time_scale
-    from fivdisc.model import build_model
+    from fivdisc.engine.integration import fastest_time_scale
+    from fivdisc.model.build import build_model
 
     return math.pi / fastest_time_scale(build_model(case))[1]
 
@@ -79,7 +79,7 @@ def check_orbit_request(case: Case, *, period: float | None = None,
         One line naming the option, its value and what is allowed; also for a disc
         without modes (nothing to shoot on), a window (without a period) shorter than
         any period, and runs (transient, window, one period) whose work estimate exceeds
-        ``simulation.max_steps`` (:func:`fivdisc.integration.check_steps`).
+        ``simulation.max_steps`` (:func:`fivdisc.engine.integration.check_steps`).
     """
     p_name, t_name, w_name, r_name = names
     check_time(p_name, period)
@@ -99,8 +99,8 @@ def check_orbit_request(case: Case, *, period: float | None = None,
         check_period(case, period, p_name)
     else:
         check_period(case, window, w_name)  # no return comes sooner
-    from fivdisc.integration import check_steps
-    from fivdisc.model import build_model
+    from fivdisc.engine.integration import check_steps
+    from fivdisc.model.build import build_model
 
     model = build_model(case)
     run = case.simulation.duration if transient is None else transient

@@ -15,11 +15,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fivdisc._kernels import layout as lay
+from fivdisc.engine.integration import Integration
+from fivdisc.engine.result import EVENT_KINDS
 from fivdisc.errors import FivdiscError
-from fivdisc.integration import Integration
-from fivdisc.model import Model
-from fivdisc.result import EVENT_KINDS
+from fivdisc.model import layout as lay
+from fivdisc.model.build import Model
 
 __all__ = ["MEASURES", "Cycle", "one_period", "phase_label"]
 

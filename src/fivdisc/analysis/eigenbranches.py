@@ -16,10 +16,10 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
-from fivdisc.analysis.equilibrium import Equilibrium
 from fivdisc.analysis.points import ParameterPoints, check_box, check_keys, check_values
 from fivdisc.analysis.stability import dominant_coordinates
 from fivdisc.case import Case
+from fivdisc.engine.equilibrium import Equilibrium
 
 # Two branches' frequencies count as merged (a coupling) within this fraction of the
 # frequency: inside a flutter region of an undamped system they are equal, damping
@@ -229,7 +229,7 @@ def mode_couplings(lam: np.ndarray, tolerance: float = COUPLING_TOLERANCE
 def _dataset(case: Case, key: str, values: np.ndarray, lam: np.ndarray,
              modes: tuple[str, ...], force: np.ndarray, angle: np.ndarray,
              limits: list[float]) -> xr.Dataset:
-    from fivdisc.conventions import global_attrs, key_attrs
+    from fivdisc.engine.conventions import global_attrs, key_attrs
 
     couplings = mode_couplings(lam)
     growth = lam.real

@@ -18,7 +18,7 @@ def stored_energy(ds: xr.Dataset, model) -> np.ndarray:
     ----------
     ds : xarray.Dataset
         A simulation dataset.
-    model : fivdisc.model.Model
+    model : fivdisc.model.build.Model
         The run's model (modal masses, frequencies, sliders).
 
     Notes
@@ -98,7 +98,7 @@ def energy_balance(data: xr.Dataset | object) -> xr.Dataset:
       loss ``1/2 |du|_W^2`` and the surface's work ``lambda . b``.
     """
     from fivdisc.case import Case
-    from fivdisc.model import build_model
+    from fivdisc.model.build import build_model
 
     ds = as_dataset(data)
     if "energy_work" not in ds:

@@ -16,14 +16,13 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from fivdisc._kernels import layout as lay
-from fivdisc._kernels import tangent as tan
-from fivdisc.analysis.equilibrium import Equilibrium, slip_phases
 from fivdisc.analysis.points import ParameterPoints, reduced_indices
 from fivdisc.analysis.stability import dominant_coordinates
 from fivdisc.case import Case
-from fivdisc.model import Model
-from fivdisc.start import _evaluate
+from fivdisc.core import tangent as tan
+from fivdisc.engine.equilibrium import Equilibrium, _evaluate, slip_phases
+from fivdisc.model import layout as lay
+from fivdisc.model.build import Model
 
 # Relative tolerance of the located value of the key (Brent's method; the growth rate is
 # smooth in the key, so the root is found to about this, far inside the 1e-8 promised).

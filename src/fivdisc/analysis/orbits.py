@@ -5,7 +5,7 @@ coordinates of a point x0 on it and T; the equations are ``phi_T(x0) - x0 = 0`` 
 phase condition ``f(x0_ref) . (x0 - x0_ref) = 0`` (the correction is orthogonal to the
 flow, which removes the freedom to slide x0 along the orbit). Newton's method uses the
 monodromy matrix ``M = d phi_T / d x0``, carried exactly across every switch by the
-saltation matrices (:mod:`fivdisc._kernels.tangent`), and ``d phi_T / dT = f(phi_T(x0))``.
+saltation matrices (:mod:`fivdisc.core.tangent`), and ``d phi_T / dT = f(phi_T(x0))``.
 
 A converged orbit is reduced to its minimal period: an orbit of period T is also a fixed
 point of the flow over 2T, 3T, ..., so a first guess near a multiple of the period
@@ -27,11 +27,11 @@ from os import PathLike
 
 import numpy as np
 
-from fivdisc._kernels import layout as lay
 from fivdisc.case import Case
+from fivdisc.engine.integration import Integration, tangent_step
 from fivdisc.errors import ConvergenceError, FivdiscError
-from fivdisc.integration import Integration, tangent_step
-from fivdisc.model import Model, build_model
+from fivdisc.model import layout as lay
+from fivdisc.model.build import Model, build_model
 
 __all__ = ["PeriodicOrbit", "Shooting", "periodic_orbit", "saved_start"]
 
@@ -60,7 +60,7 @@ class PeriodicOrbit:
     period : float
         T [s].
     state : ndarray
-        A point on the orbit (the state layout of :mod:`fivdisc._kernels.layout`, the
+        A point on the orbit (the state layout of :mod:`fivdisc.model.layout`, the
         contact coordinates filled in as a run's output has them).
     phases : ndarray of int
         Each slider's phase at that point (0 slip, 1 stick, 2 separation).
@@ -226,7 +226,7 @@ class Shot:
 class Shooting:
     """The flow map of a model over a time from a start whose phases are given, with its
     Jacobian: what Newton shooting (:func:`periodic_orbit`) and continuation
-    (:func:`fivdisc.analysis.continuation.continue_orbit`) solve.
+    (:func:`fivdisc.continuation.walk.continue_orbit`) solve.
 
     Parameters
     ----------
@@ -543,8 +543,8 @@ def periodic_orbit(
     model = build_model(case)
     if model.n_sliders == 0 or model.state_size == 0:
         raise FivdiscError("periodic_orbit needs a case with a slider")
-    from fivdisc.simulate import initial_state
-    from fivdisc.split_compile import compile_split
+    from fivdisc.engine.simulation import initial_state
+    from fivdisc.engine.split_compile import compile_split
 
     atol_run = atol if atol is not None else rtol * 1e-7
     if guess is None:
@@ -559,7 +559,7 @@ def periodic_orbit(
         if run.status_name != "success":
             raise FivdiscError(f"periodic_orbit: the transient run ended with "
                                f"{run.status_name} at t = {run.t:.9g} s")
-        from fivdisc.simulate import Deflection
+        from fivdisc.engine.simulation import Deflection
 
         # A run that left the model's range (fivdisc.simulate calls it diverged) has no
         # orbit to find: its samples would overflow the search.
@@ -589,9 +589,9 @@ def periodic_orbit(
     shooting = Shooting(model, phases, rtol, atol_run)
     deadline = time.monotonic() + time_budget
 
-    from fivdisc.compilation import tangent_notice
-    from fivdisc.progress import progress_bar
-    from fivdisc.split_compile import compile_split_tangents
+    from fivdisc.engine.compilation import tangent_notice
+    from fivdisc.engine.progress import progress_bar
+    from fivdisc.engine.split_compile import compile_split_tangents
 
     with tangent_notice(show=progress or None):
         compile_split_tangents()

@@ -15,12 +15,12 @@ from functools import cache
 
 import numpy as np
 
-from fivdisc._kernels import dynamics as dyn
-from fivdisc._kernels import layout as lay
-from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium, slip_phases
 from fivdisc.case import Case
+from fivdisc.core import dynamics as dyn
+from fivdisc.engine.equilibrium import Equilibrium, sliding_equilibrium, slip_phases
 from fivdisc.errors import CaseError, SimulationError
-from fivdisc.model import Model, build_model, model_at
+from fivdisc.model import layout as lay
+from fivdisc.model.build import Model, build_model, model_at
 
 
 def reduced_indices(model: Model) -> np.ndarray:
@@ -141,7 +141,7 @@ class ParameterPoints:
     def equilibrium(self, model: Model, guess: Equilibrium | None = None,
                     contact: bool = True) -> Equilibrium | None:
         """Sliding equilibrium of `model` (None where there is none); see
-        :func:`~fivdisc.analysis.equilibrium.sliding_equilibrium` for `contact`."""
+        :func:`~fivdisc.engine.equilibrium.sliding_equilibrium` for `contact`."""
         key = (_equilibrium_key(model), contact)
         if key not in self._cache:
             try:

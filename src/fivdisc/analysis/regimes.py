@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fivdisc.analysis.lyapunov import LyapunovSpectrum
+from fivdisc.analysis.exponents import LyapunovSpectrum
 from fivdisc.analysis.orbits import PeriodicOrbit
 
 __all__ = ["Regime", "cross_check", "lyapunov_label"]

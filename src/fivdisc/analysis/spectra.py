@@ -6,7 +6,7 @@ the bin width, tells a periodic response (a fundamental and its superharmonics, 
 206 Hz) from a quasi-periodic one (combinations of incommensurate frequencies, e.g.
 181 Hz and 290.5 Hz).
 
-Every function takes a result :class:`xarray.Dataset` or a :class:`fivdisc.result.Result`;
+Every function takes a result :class:`xarray.Dataset` or a :class:`fivdisc.engine.result.Result`;
 a variable with a second dimension (``w``: probe, ``q``/``q_dot``: coordinate) is reduced
 to one time series by an index along that dimension, ``probe`` (default 0).
 """
@@ -46,7 +46,7 @@ _NOISE_FLOOR = 1e-10
 
 
 def as_dataset(data: xr.Dataset | object) -> xr.Dataset:
-    """Return the dataset of a :class:`~fivdisc.result.Result`, or ``data`` if it is one.
+    """Return the dataset of a :class:`~fivdisc.engine.result.Result`, or ``data`` if it is one.
 
     Raises
     ------

@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import xarray as xr
 
-from fivdisc.analysis.equilibrium import Equilibrium, sliding_equilibrium
 from fivdisc.analysis.points import (
     ParameterPoints,
     check_box,
@@ -19,9 +18,10 @@ from fivdisc.analysis.points import (
     slip_jacobian,
 )
 from fivdisc.case import Case, is_case_key, keys_like, unit_of
+from fivdisc.engine.equilibrium import Equilibrium, sliding_equilibrium
 from fivdisc.errors import CaseError, nearest
 from fivdisc.limits import check_memory
-from fivdisc.model import Model, build_model
+from fivdisc.model.build import Model, build_model
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -219,7 +219,7 @@ def perturbation_test(case: Case, duration: float | None = None) -> Perturbation
         Simulated time [s]; defaults to the case's ``simulation.duration``. Growth or decay
         slower than a few times 1/duration cannot be told apart from constancy.
     """
-    from fivdisc.simulate import simulate
+    from fivdisc.engine.simulation import simulate
 
     updates: dict = {"simulation.initial_state": "equilibrium"}
     if duration is not None:
@@ -333,7 +333,7 @@ def stability_map(
             i = change[0]
             g0, g1 = col[i], col[i + 1]
             boundary[ic, ix] = ys[i] + (ys[i + 1] - ys[i]) * g0 / (g0 - g1)
-    from fivdisc.conventions import global_attrs, key_attrs, units
+    from fivdisc.engine.conventions import global_attrs, key_attrs, units
 
     ckey = curves[0] if curves else ""
     dims = (ckey, ykey, xkey) if curves else (ykey, xkey)

@@ -1,6 +1,6 @@
 """Phase portraits, friction trajectories and separation (paper Figs. 17-19, 24, 27).
 
-Functions take a result :class:`xarray.Dataset` or a :class:`fivdisc.result.Result`
+Functions take a result :class:`xarray.Dataset` or a :class:`fivdisc.engine.result.Result`
 and a time window ``[t0, t1]`` [s] (default: the whole record).
 """
 
@@ -10,7 +10,7 @@ import numpy as np
 import xarray as xr
 
 from fivdisc.analysis.spectra import as_dataset, time_window
-from fivdisc.selection import select_slider
+from fivdisc.engine.selection import select_slider
 
 __all__ = ["friction_trajectory", "phase_portrait", "separation_intervals", "separation_stats"]
 

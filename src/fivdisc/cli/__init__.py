@@ -45,7 +45,7 @@ class _Group(click.Group):
 @click.version_option(package_name="fivdisc")
 def cli() -> None:
     """fivdisc: friction-induced vibration of a slider on a spinning elastic disc."""
-    from fivdisc.compilation import announce_by_default
+    from fivdisc.engine.compilation import announce_by_default
 
     announce_by_default()  # every command says when it compiles a kernel
 

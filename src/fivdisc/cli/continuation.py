@@ -9,6 +9,9 @@ from pathlib import Path
 import click
 
 from fivdisc.cli._case import CASE
+from fivdisc.continuation.settings import ContinuationSettings
+
+_DEFAULT = ContinuationSettings()
 
 
 @click.command(name="continue")
@@ -37,17 +40,17 @@ from fivdisc.cli._case import CASE
               "in --key, searched on N values from START to STOP (the first where the "
               "equilibrium changes stability): says whether it is sub- or supercritical "
               "and the bistable range.")
-@click.option("--points", type=int, default=200, show_default=True,
+@click.option("--points", type=int, default=_DEFAULT.max_points, show_default=True,
               help="Most points on the branch.")
-@click.option("--step", type=float, default=0.02, show_default=True,
+@click.option("--step", type=float, default=_DEFAULT.step, show_default=True,
               help="First arclength step (relative change of the orbit, period and key).")
-@click.option("--max-step", type=float, default=0.1, show_default=True,
+@click.option("--max-step", type=float, default=_DEFAULT.max_step, show_default=True,
               help="Largest arclength step.")
 @click.option("--transient", type=float,
               help="Transient run before the first orbit is searched [s] (default: the "
               "case's simulation.duration).")
 @click.option("--period", type=float, help="A guess of the first orbit's period [s].")
-@click.option("--rtol", type=float, default=1e-12, show_default=True,
+@click.option("--rtol", type=float, default=_DEFAULT.rtol, show_default=True,
               help="Integration tolerance of the shooting runs.")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the points and bifurcations as JSON.")
@@ -69,12 +72,9 @@ def continuation(case_file: Path | None, key: str, target: float, back_to: float
     event signature (stick phases appearing, grazing, ...) located to 1e-6 in the key.
     CASE_FILE is a TOML file or a packaged example.
     """
-    from fivdisc.analysis.continuation import (
-        INTERRUPTED,
-        check_key,
-        check_window,
-        continue_orbit,
-    )
+    from fivdisc.continuation.checks import check_key, check_window
+    from fivdisc.continuation.settings import INTERRUPTED
+    from fivdisc.continuation.walk import continue_orbit
     from fivdisc.errors import ConvergenceError, FivdiscError
     from fivdisc.files import check_output
 
@@ -82,16 +82,19 @@ def continuation(case_file: Path | None, key: str, target: float, back_to: float
     out = check_output(output, "-o", (".nc",), inputs=inputs) if output else None
     if which is not None and from_file is None:
         raise FivdiscError("--bifurcation needs --from BRANCH (a file of fivdisc continue -o)")
-    for name, value in (("--points", points),):
-        if value < 1:
-            raise FivdiscError(f"{name} = {value} is invalid: must be >= 1")
+    try:
+        settings = _DEFAULT.replace(max_points=points, step=step, max_step=max_step, rtol=rtol)
+    except FivdiscError as exc:
+        # The settings name their fields; the message names the option given.
+        name, _, rest = str(exc).partition(" = ")
+        option = {"max_points": "--points", "max_step": "--max-step"}.get(name, f"--{name}")
+        raise FivdiscError(f"{option} = {rest}") from None
     if hopf_spec is not None:
         if (from_file is not None or transient is not None or period is not None
                 or back_to is not None):
             raise FivdiscError("--from-hopf starts at a Hopf point: leave out --from, "
                                "--transient, --period and --back-to")
-        branch = _from_hopf(case_file, key, target, hopf_spec, points, step, max_step, rtol,
-                            progress)
+        branch = _from_hopf(case_file, key, target, hopf_spec, settings, progress)
         if out is not None:
             branch.to_netcdf(out)
         click.echo(branch.to_json() if as_json else str(branch))
@@ -102,9 +105,8 @@ def continuation(case_file: Path | None, key: str, target: float, back_to: float
         if back_to is not None:
             check_window(key, check_key(case, key), target, back_to, "--back-to")
         branch = continue_orbit(case, key, target, orbit=orbit, along=along,
-                                back_to=back_to, max_points=points, step=step,
-                                max_step=max_step, rtol=rtol,
-                                progress=progress, **search)
+                                back_to=back_to, settings=settings, progress=progress,
+                                **search)
     except ConvergenceError as exc:
         click.echo(f"error: no periodic orbit to start from: {exc}", err=True)
         sys.exit(1)
@@ -117,14 +119,14 @@ def continuation(case_file: Path | None, key: str, target: float, back_to: float
         sys.exit(1)
 
 
-def _from_hopf(case_file, key: str, target: float, spec: str, points: int, step: float,
-               max_step: float, rtol: float, progress: bool):
+def _from_hopf(case_file: Path | None, key: str, target: float, spec: str,
+               settings: ContinuationSettings, progress: bool):
     """The branch of orbits from the first Hopf point on ``spec``'s values of ``key``."""
     import numpy as np
 
     from fivdisc.analysis.hopf import hopf_points
-    from fivdisc.analysis.hopf_cycle import hopf_cycles
     from fivdisc.case import Case, load_case
+    from fivdisc.continuation.from_hopf import hopf_cycles
     from fivdisc.errors import FivdiscError
 
     usage = f"--from-hopf = {spec!r} is invalid: write START:STOP:N (N >= 2 values of {key})"
@@ -144,13 +146,12 @@ def _from_hopf(case_file, key: str, target: float, spec: str, points: int, step:
                            f"{key} between {values[0]:g} and {values[-1]:g}")
     hopf = next((h for h in found if h.on_boundary), found[0])
     click.echo(str(hopf))
-    return hopf_cycles(hopf, target, max_points=points, step=step, max_step=max_step,
-                       rtol=rtol, progress=progress)
+    return hopf_cycles(hopf, target, settings=settings, progress=progress)
 
 
 def _checked(case, key: str, target: float):
     """The case, once its key and the target are known to be valid."""
-    from fivdisc.analysis.continuation import check_key
+    from fivdisc.continuation.checks import check_key
     from fivdisc.errors import CaseError, FivdiscError
 
     if case.speed.profile != "constant":
@@ -169,10 +170,10 @@ def _start(case_file, from_file, which, key, target, rtol, transient, period):
     """The case, the orbit to start from (None: searched as fivdisc orbit does), the
     branch-switching direction, and the search's options; the key and the target are
     checked before any orbit is computed."""
-    from fivdisc.analysis.branch import CONTENT, open_branch
-    from fivdisc.analysis.continuation import doubled_start
     from fivdisc.analysis.orbits import periodic_orbit, saved_start
     from fivdisc.case import load_case
+    from fivdisc.continuation.branch import CONTENT, open_branch
+    from fivdisc.continuation.starts import doubled_start
     from fivdisc.errors import FivdiscError
 
     case = load_case(case_file) if case_file is not None else None

@@ -123,7 +123,7 @@ def lyapunov(case_file: Path, count: int, transient: float | None, duration: flo
     CASE_FILE is a TOML file or a packaged example. Exits with status 1 when the largest
     exponent is inconclusive (its uncertainty unknown or larger than itself).
     """
-    from fivdisc.analysis.lyapunov import lyapunov as compute
+    from fivdisc.analysis.exponents import lyapunov as compute
     from fivdisc.case import load_case
     from fivdisc.files import check_output
 

@@ -29,7 +29,7 @@ def modes(case: Path | None, as_json: bool) -> None:
     """
     # Imported here so that `fivdisc --help` does not pay for scipy and pydantic.
     from fivdisc.case import Case, load_case
-    from fivdisc.plate import AnnularPlate
+    from fivdisc.model.plate import AnnularPlate
 
     disc = (load_case(case) if case is not None else Case()).disc
     rows = [

@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING
 
 import click
 
-from fivdisc._plot_kinds import KINDS
 from fivdisc.errors import FivdiscError
+from fivdisc.plots.kinds import KINDS
 
 if TYPE_CHECKING:
     import numpy as np
@@ -125,12 +125,13 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
     import xarray as xr
 
     from fivdisc import plots
+    from fivdisc.engine.result import open_result, run_groups
     from fivdisc.files import check_netcdf, check_output, figure_suffixes, read_dataset
-    from fivdisc.result import open_result, run_groups
+    from fivdisc.plots.result import check_fmax
 
     if not result.exists():
         raise FileNotFoundError(2, "No such file", str(result))
-    from fivdisc.analysis.branch import CONTENT
+    from fivdisc.continuation.branch import CONTENT
 
     if read_dataset(result, "plot").attrs.get("content") == CONTENT:
         given = click.get_current_context().get_parameter_source
@@ -173,7 +174,7 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
         if not 0 <= slider < count:
             raise FivdiscError(f"--slider {slider} is invalid: the run has {count} slider"
                                f"{'s' if count > 1 else ''}, numbered from 0")
-        from fivdisc.result import select_slider
+        from fivdisc.engine.result import select_slider
 
         one = select_slider(ds, slider)
         if fmax is not None and kind not in ("spectrogram", "spectrum"):
@@ -190,7 +191,7 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
                 raise FivdiscError(f"--window is not used for {result}: it holds one sample, "
                                    "drawn whole")
         else:
-            plots.check_fmax(fmax, 0.5 * (one.sizes["time"] - 1)
+            check_fmax(fmax, 0.5 * (one.sizes["time"] - 1)
                              / float(one["time"].values[-1] - one["time"].values[0]), "--fmax")
         if segment is not None and kind != "spectrogram":
             raise FivdiscError(f"--segment is not used by --kind {kind}: only by spectrogram")
@@ -217,8 +218,8 @@ def _save(fig, out: Path, dpi: int) -> None:
 
 def _branch(path: Path, var: str | None, slider: int, unused, slider_given: bool):
     """The figure of a branch (fivdisc continue -o): --var is the measure."""
-    from fivdisc.analysis.branch import open_branch
-    from fivdisc.branch_plots import BRANCH_MEASURES, plot_branch
+    from fivdisc.continuation.branch import open_branch
+    from fivdisc.plots.branch import BRANCH_MEASURES, plot_branch
 
     given = [name for name, value in unused if value is not None]
     if given:
@@ -254,6 +255,6 @@ def _map(ds, path: Path):
     if "separated" not in ds:
         raise FivdiscError(f"{path} is a sweep without 'separated': read it with "
                            "xarray.open_dataset")
-    from fivdisc.sweep import plot_separation_map
+    from fivdisc.plots.sweep import plot_separation_map
 
     return plot_separation_map(ds)

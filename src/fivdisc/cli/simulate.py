@@ -30,9 +30,9 @@ def simulate(case_file: Path, output: Path | None, progress: bool) -> None:
     directory instead, where that is possible, and the one-line error names both.
     """
     from fivdisc.case import load_case
+    from fivdisc.engine.preload import warm_up
+    from fivdisc.engine.simulation import simulate as run
     from fivdisc.files import NETCDF, check_output
-    from fivdisc.simulate import simulate as run
-    from fivdisc.warmup import warm_up
 
     case = load_case(case_file)
     out = check_output(output or default_output(case_file, ".nc"), "-o", NETCDF,

@@ -127,7 +127,7 @@ def _branches(case, case_file, x_spec: str, output: Path | None, progress: bool)
     if case_file is not None:
         ds.attrs["case_name"] = case_file.stem
     if figure:
-        from fivdisc.plots import plot_eigen_branches
+        from fivdisc.plots.stability import plot_eigen_branches
 
         _write(out, plot_eigen_branches(ds, hopf), ds)
     else:
@@ -170,7 +170,7 @@ def _boundary(case, case_file, specs: tuple[str, str], output: Path | None) -> N
     if case_file is not None:
         ds.attrs["case_name"] = case_file.stem
     if figure:
-        from fivdisc.plots import plot_stability_map
+        from fivdisc.plots.stability import plot_stability_map
 
         grid = stability_map(case, *[(key, np.linspace(*ends, 40)) for key, ends in box])
         if case_file is not None:
@@ -216,7 +216,7 @@ def _map(case, case_file, x_spec, y_spec, curve_spec, output, progress) -> None:
     if case_file is not None:
         ds.attrs["case_name"] = case_file.stem
     if figure:
-        from fivdisc.plots import plot_stability_map
+        from fivdisc.plots.stability import plot_stability_map
 
         _write(out, plot_stability_map(ds), ds)
     else:

@@ -44,7 +44,8 @@ def _run(
     spec: Sweep, output: Path, scheduler: str | None, workers: int | None, progress: bool
 ) -> SweepReport:
     """Run a sweep into `output`, print what happened; exit 130 on Ctrl-C."""
-    from fivdisc.sweep import read_mask, run_sweep
+    from fivdisc.sweep import run_sweep
+    from fivdisc.sweep.store.health import read_mask
 
     if scheduler is not None:
         _quiet_dask()
@@ -246,7 +247,8 @@ def separation_map(
     require("plot", "fivdisc separation-map")
     from fivdisc.case import load_case
     from fivdisc.files import ZARR, check_output, figure_suffixes
-    from fivdisc.sweep import plot_separation_map, separation_sweep
+    from fivdisc.plots.sweep import plot_separation_map
+    from fivdisc.sweep import separation_sweep
 
     spec = separation_sweep(
         profile,
@@ -320,14 +322,15 @@ def bifurcation(
     require("distributed", "fivdisc bifurcation")
     require("plot", "fivdisc bifurcation")
     from fivdisc.files import ZARR, check_output, figure_suffixes
-    from fivdisc.sweep import load_sweep, plot_bifurcation
+    from fivdisc.plots.sweep import plot_bifurcation
+    from fivdisc.sweep import load_sweep
     from fivdisc.sweep.bifurcation import check_diagram
 
     spec = load_sweep(sweep_file)
     chosen = check_diagram(spec, section)
     branch = None
     if branch_file is not None:
-        from fivdisc.analysis.branch import open_branch
+        from fivdisc.continuation.branch import open_branch
 
         branch = open_branch(branch_file)
         swept = next(iter(spec.axes))

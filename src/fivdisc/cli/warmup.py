@@ -18,13 +18,13 @@ def warmup() -> None:
     """
     import time
 
-    from fivdisc._kernels import integrate
-    from fivdisc.analysis.lyapunov import warm_tangent_kernel
+    from fivdisc.analysis.exponents import warm_tangent_kernel
     from fivdisc.analysis.stability import linear_stability
     from fivdisc.case import Case
-    from fivdisc.compilation import compile_notice
-    from fivdisc.simulate import warm_kernel
-    from fivdisc.split_compile import compile_split, default_run
+    from fivdisc.core import integrate
+    from fivdisc.engine.compilation import compile_notice
+    from fivdisc.engine.simulation import warm_kernel
+    from fivdisc.engine.split_compile import compile_split, default_run
 
     start = time.perf_counter()
     with compile_notice(integrate.run, what="simulation kernel"):

@@ -43,7 +43,7 @@ def _impact_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
 def _impact_plot(data: xr.Dataset) -> Figure:
     from matplotlib.figure import Figure
 
-    from fivdisc.plots import plot_timeseries
+    from fivdisc.plots.result import plot_timeseries
 
     fig = Figure(figsize=(11, 7), layout="constrained")
     axes = fig.subplots(2, 2)

@@ -77,7 +77,7 @@ def _normal_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
 def _normal_plot(data: xr.Dataset) -> Figure:
     from matplotlib.figure import Figure
 
-    from fivdisc.plots import plot_normal_force
+    from fivdisc.plots.result import plot_normal_force
 
     panels = [label for label in _labels(data) if not label.endswith("_printed")]
     fig = Figure(figsize=(12, 3.2 * len(panels) * 2), layout="constrained")
@@ -171,7 +171,7 @@ def _responses_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]
 def _responses_plot(data: xr.Dataset) -> Figure:
     from matplotlib.figure import Figure
 
-    from fivdisc.plots import plot_timeseries
+    from fivdisc.plots.result import plot_timeseries
 
     run = _unpack(data, "main")
     fig = Figure(figsize=(12, 7), layout="constrained")

@@ -96,7 +96,7 @@ def _sweep_compute(pc: PaperCase, runs: Runs) -> tuple[xr.DataTree, list[Row]]:
 def _sweep_plot(data: xr.DataTree) -> Figure:
     from matplotlib.figure import Figure
 
-    from fivdisc.sweep import plot_separation_map
+    from fivdisc.plots.sweep import plot_separation_map
 
     fig = Figure(figsize=(11, 4.8), layout="constrained")
     for ax, key, title in zip(fig.subplots(1, 2), ("skew", "printed"),

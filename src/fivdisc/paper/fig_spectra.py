@@ -179,7 +179,7 @@ def _segment_rows(pc: PaperCase, ds: xr.Dataset) -> list[Row]:
 def _spectra_plot(data: xr.Dataset) -> Figure:
     from matplotlib.figure import Figure
 
-    from fivdisc.plots import plot_spectrum, plot_timeseries
+    from fivdisc.plots.result import plot_spectrum, plot_timeseries
 
     run = _unpack(data, "main")
     figure = int(data.attrs["figure"])
@@ -264,7 +264,7 @@ def _windows_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
 def _windows_plot(data: xr.Dataset) -> Figure:
     from matplotlib.figure import Figure
 
-    from fivdisc.plots import plot_friction, plot_phase_portrait, plot_timeseries
+    from fivdisc.plots.result import plot_friction, plot_phase_portrait, plot_timeseries
 
     labels = _labels(data)
     letters = "abcdefghijkl"

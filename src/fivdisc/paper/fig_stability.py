@@ -111,7 +111,7 @@ def _point_against_boundary(figure: int, fig: int, point: Case, exact: xr.Datase
 def _map_plot(data: xr.DataTree) -> Figure:
     from matplotlib.figure import Figure
 
-    from fivdisc.plots import plot_stability_map
+    from fivdisc.plots.stability import plot_stability_map
 
     labels = _labels(data)
     fig = Figure(figsize=(12, 5.5), layout="constrained")

@@ -116,7 +116,7 @@ def _two_panel_plot(data: xr.Dataset) -> Figure:
     """(a) the slider's angular velocity, (b) the disc at (r0, 0)."""
     from matplotlib.figure import Figure
 
-    from fivdisc.plots import plot_timeseries
+    from fivdisc.plots.result import plot_timeseries
 
     run = _unpack(data, "main")
     fig = Figure(figsize=(9, 6), layout="constrained")

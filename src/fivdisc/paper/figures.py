@@ -75,7 +75,7 @@ def compute(figure: int | PaperCase, runs: Runs | None = None) -> xr.DataTree:
         :meth:`PaperCase.parameters`), ``recipe`` and ``comparison`` (JSON list of
         :class:`Row`), with the CF global attributes.
     """
-    from fivdisc.conventions import global_attrs
+    from fivdisc.engine.conventions import global_attrs
 
     pc = FIGURES[figure] if isinstance(figure, int) else figure
     runs = runs if runs is not None else Runs()

@@ -29,12 +29,12 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from fivdisc.engine.simulation import warm_kernel
 from fivdisc.errors import FivdiscError
 from fivdisc.files import check_netcdf, write_atomic, write_netcdf
 from fivdisc.paper.cases import CITATION, FIGURES
 from fivdisc.paper.figures import RECIPE, Row, Runs, compute, plot, rows
 from fivdisc.paper.report import figure_blocks, render_html, render_markdown, summary_blocks
-from fivdisc.simulate import warm_kernel
 
 __all__ = ["ReproduceReport", "parse_figures", "reproduce"]
 

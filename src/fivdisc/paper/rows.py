@@ -131,7 +131,7 @@ _PAPER_LABEL = {8: "quasi-periodic", 13: "periodic"}
 def _lyapunov_row(pc: PaperCase, ds: xr.Dataset, t0: float, t1: float) -> Row:
     """The spectral label of phi over [t0, t1] against the Lyapunov exponents of the
     same stretch (QR method with the saltation matrices at every switch)."""
-    from fivdisc.analysis.lyapunov import lyapunov
+    from fivdisc.analysis.exponents import lyapunov
     from fivdisc.analysis.regimes import cross_check
 
     spectral = ms.periodicity(ds, "phi", None, t0, t1).kind
@@ -159,7 +159,7 @@ def _window_text(values: list[tuple[float, float]], width: float = _WINDOW) -> s
 
 def _spectrogram(run: xr.Dataset, var: str, probe: int | None, ax: Axes) -> None:
     """Time-frequency plot of one variable, with a short colour-bar label."""
-    from fivdisc.plots import plot_spectrogram
+    from fivdisc.plots.result import plot_spectrogram
 
     plot_spectrogram(run, var, probe=probe, segment=_STFT_SEGMENT, fmax=_FMAX, ax=ax)
     # plot_spectrogram adds the colour bar last; its long name would overlap the panels.

@@ -11,10 +11,10 @@ from typing import TYPE_CHECKING
 import xarray as xr
 
 from fivdisc.case import Case
-from fivdisc.model import build_model
+from fivdisc.engine.selection import select_slider
+from fivdisc.engine.simulation import initial_state, simulate
+from fivdisc.model.build import build_model
 from fivdisc.paper.cases import FIGURES, PaperCase
-from fivdisc.selection import select_slider
-from fivdisc.simulate import initial_state, simulate
 
 if TYPE_CHECKING:
     pass
@@ -127,7 +127,7 @@ def _with_slider(ds: xr.Dataset) -> xr.Dataset:
 def _pack(pc: PaperCase, runs: dict[str, xr.Dataset], variables: tuple[str, ...]
           ) -> xr.DataTree:
     """Runs as the groups of one tree, each in the result layout (see :func:`compute`)."""
-    from fivdisc.conventions import global_attrs
+    from fivdisc.engine.conventions import global_attrs
 
     groups = {}
     for label, ds in runs.items():

@@ -7,53 +7,23 @@
 >>> open_sweep("fig27.zarr")["separated"]  # doctest: +SKIP  (on the grid's axes)
 
 See the documentation's page "Sweep files" (and :mod:`fivdisc.sweep.spec`) for the sweep
-file format, :mod:`fivdisc.sweep.store` for the store layout,
+file format and the store's layout (:mod:`fivdisc.sweep.store`),
 :mod:`fivdisc.sweep.sections` for the values at a section (Poincare-type reductions),
-:mod:`fivdisc.sweep.separation` for the paper's separation maps (Fig. 27) and
-:mod:`fivdisc.sweep.bifurcation` for bifurcation diagrams.
+:mod:`fivdisc.sweep.separation` for the paper's separation maps (Fig. 27); the figures
+of a sweep are in :mod:`fivdisc.plots`.
 """
 
-from fivdisc.sweep.bifurcation import plot_bifurcation
-from fivdisc.sweep.reductions import (
-    BUILTIN,
-    LyapunovSettings,
-    Reduction,
-    RunFailed,
-    SweepError,
-)
-from fivdisc.sweep.run import SweepReport, run_sweep, warm_kernel
-from fivdisc.sweep.sections import Section
-from fivdisc.sweep.separation import plot_separation_map, separation_sweep
-from fivdisc.sweep.spec import Sweep, load_sweep, parse_range
-from fivdisc.sweep.store import (
-    StoreHealth,
-    SweepStore,
-    open_sweep,
-    read_mask,
-    store_lock,
-    verify_store,
-)
+from fivdisc._lazy import public
 
-__all__ = [
-    "BUILTIN",
-    "LyapunovSettings",
-    "Reduction",
-    "RunFailed",
-    "Section",
-    "StoreHealth",
-    "Sweep",
-    "SweepError",
-    "SweepReport",
-    "SweepStore",
-    "load_sweep",
-    "open_sweep",
-    "parse_range",
-    "plot_bifurcation",
-    "plot_separation_map",
-    "read_mask",
-    "run_sweep",
-    "separation_sweep",
-    "store_lock",
-    "verify_store",
-    "warm_kernel",
-]
+_API = {
+    "fivdisc.errors": ("SweepError",),
+    "fivdisc.sweep.spec": ("Sweep", "load_sweep"),
+    "fivdisc.sweep.reductions": ("BUILTIN", "LyapunovSettings", "Reduction", "RunFailed"),
+    "fivdisc.sweep.sections": ("Section",),
+    "fivdisc.sweep.run": ("SweepReport", "run_sweep"),
+    "fivdisc.sweep.separation": ("separation_sweep",),
+    "fivdisc.sweep.store.sweep_store": ("SweepStore", "open_sweep"),
+    "fivdisc.sweep.store.health": ("StoreHealth", "verify_store"),
+}
+
+__all__, __getattr__, __dir__ = public(globals(), _API)

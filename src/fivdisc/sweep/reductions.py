@@ -2,7 +2,7 @@
 
 Built-in reductions are named (see :data:`BUILTIN`); user reductions are named by
 import path, ``"package.module:function"``, and are called with the run's
-:class:`~fivdisc.result.Result`, returning a real number (stored as float64).
+:class:`~fivdisc.engine.result.Result`, returning a real number (stored as float64).
 
 A reduction whose value may not be usable brings its mark along: keeping
 ``largest_lyapunov`` stores ``largest_lyapunov_inconclusive`` too (see :data:`COMPANIONS`
@@ -24,8 +24,8 @@ from functools import cache, lru_cache, partial
 from typing import TYPE_CHECKING, Any
 
 from fivdisc.case import Case
+from fivdisc.engine.result import Result
 from fivdisc.errors import FivdiscError, SweepError, nearest
-from fivdisc.result import Result
 
 if TYPE_CHECKING:
     from fivdisc.sweep.sections import Section
@@ -167,7 +167,7 @@ class LyapunovSettings:
 @lru_cache(maxsize=2)
 def _lyapunov_run(case: Case, settings: LyapunovSettings) -> Any:
     """The exponent's run, once for both reductions that read it."""
-    from fivdisc.analysis.lyapunov import lyapunov
+    from fivdisc.analysis.exponents import lyapunov
 
     transient, duration = settings.window(case)
     return lyapunov(case, n=1, transient=transient, duration=duration,
@@ -309,9 +309,9 @@ def stored(keep: Sequence[str]) -> tuple[str, ...]:
 _NEEDS_MODULE = {
     "dominant_frequency": "fivdisc.analysis.spectra",
     "max_growth_rate": "fivdisc.analysis.stability",
-    "largest_lyapunov": "fivdisc.analysis.lyapunov",
-    "largest_lyapunov_uncertainty": "fivdisc.analysis.lyapunov",
-    "largest_lyapunov_inconclusive": "fivdisc.analysis.lyapunov",
+    "largest_lyapunov": "fivdisc.analysis.exponents",
+    "largest_lyapunov_uncertainty": "fivdisc.analysis.exponents",
+    "largest_lyapunov_inconclusive": "fivdisc.analysis.exponents",
 }
 
 
@@ -455,7 +455,7 @@ def evaluate(
         user reduction returned something other than a real number.
     """
     # Imported here: the simulator loads numba, which validating a sweep does not need.
-    from fivdisc.simulate import simulate
+    from fivdisc.engine.simulation import simulate
 
     reductions = resolve(keep, lyapunov)
     result = None

@@ -26,14 +26,15 @@ from os import PathLike
 from pathlib import Path
 from typing import Any
 
-from fivdisc.analysis.lyapunov import warm_tangent_kernel
+from fivdisc.analysis.exponents import warm_tangent_kernel
 from fivdisc.case import Case
+from fivdisc.engine.simulation import warm_kernel
 from fivdisc.errors import FivdiscError
-from fivdisc.simulate import warm_kernel
 from fivdisc.sweep.reductions import LyapunovSettings, SweepError, evaluate
 from fivdisc.sweep.sections import Section
 from fivdisc.sweep.spec import Sweep
-from fivdisc.sweep.store import PointOutcome, SweepStore, store_lock
+from fivdisc.sweep.store.lock import store_lock
+from fivdisc.sweep.store.sweep_store import PointOutcome, SweepStore
 
 __all__ = ["SweepReport", "run_sweep", "warm_kernel"]
 

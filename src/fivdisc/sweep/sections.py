@@ -43,7 +43,7 @@ from fivdisc.errors import SweepError, nearest
 
 if TYPE_CHECKING:
     from fivdisc.case import Case
-    from fivdisc.result import Result
+    from fivdisc.engine.result import Result
 
 __all__ = ["AT", "EVENT_AT", "VARIABLES", "Section", "Variable", "section_values"]
 
@@ -76,7 +76,7 @@ class Variable:
     long_name: str
 
 
-#: The time series of :attr:`fivdisc.Result.dataset` (as :func:`fivdisc.result.build_dataset`
+#: The time series of :attr:`fivdisc.Result.dataset` (as :func:`fivdisc.engine.result.build_dataset`
 #: writes them), by name; a test keeps this table equal to a run's dataset.
 VARIABLES: dict[str, Variable] = {
     "phi": Variable("slider", "rad", "slider circumferential angle"),
@@ -324,7 +324,7 @@ def _size(case: Case, dim: str) -> int:
         return len(case.simulation.probes)
     if dim == "coordinate":
         return sum(2 if int(l) > 0 else 1 for _, l in case.disc.modes)
-    from fivdisc._kernels.layout import ENERGY_NAMES  # numba: only for this variable
+    from fivdisc.model.layout import ENERGY_NAMES  # numba: only for this variable
 
     return len(ENERGY_NAMES)
 

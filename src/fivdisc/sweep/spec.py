@@ -375,7 +375,7 @@ class Sweep:
 
     def _check_cases(self) -> None:
         """Sections and Lyapunov settings that every point's case allows."""
-        from fivdisc.analysis.lyapunov import DEFAULT_INTERVAL, MAX_INTERVALS
+        from fivdisc.analysis.exponents import DEFAULT_INTERVAL, MAX_INTERVALS
 
         for i, case in enumerate(self.cases):
             for section in self.sections:

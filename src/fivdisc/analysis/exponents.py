@@ -1,0 +1,439 @@
+"""Lyapunov exponents of the non-smooth flow by the QR (Benettin) method.
+
+``n`` tangent vectors are carried with the state (:mod:`fivdisc.core.tangent`: the
+variational equations inside each phase, saltation matrices at every switch) and
+re-orthonormalised every ``interval`` seconds: ``V = Q R``; the logarithms of ``|R_ii|``
+summed over the measurement and divided by its length are the exponents, largest first.
+For more than one exponent two such sets, from independent random starts, are carried
+and the exponents are their mean. The vectors start with the run and are carried through
+the transient, so that the measurement starts from aligned directions; the uncertainty
+adds the drift of the estimate (and the difference between the two starts) to its
+statistical error (Notes of :func:`lyapunov`).
+
+The orthonormalisation uses the energy norm (:func:`fivdisc.analysis.orbits.energy_scales`),
+so that the result does not depend on the units of the coordinates over a finite run.
+Only coordinates that are free in the current phases carry tangent components: a
+direction collapsed by sticking or by a plastic impact has exponent -inf, and at most as
+many exponents as free coordinates exist.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from fivdisc.case import Case
+from fivdisc.engine.integration import Integration, check_steps, tangent_step
+from fivdisc.engine.progress import SIMULATED_TIME, progress_bar
+from fivdisc.errors import FivdiscError
+from fivdisc.model.build import Model, build_model
+
+__all__ = ["LyapunovSpectrum", "lyapunov"]
+
+# Blocks of the run whose exponents give the uncertainty (their spread).
+_BLOCKS = 10
+# Sets of tangent vectors from independent random starts for more than one exponent: the
+# difference of their exponents is what the start still does to the estimate (Notes of
+# `lyapunov`). The largest exponent alone keeps one set: sweeps compute it at every point.
+_STARTS = 2
+# [s]: the default re-orthonormalisation interval.
+DEFAULT_INTERVAL = 0.05
+#: Most re-orthonormalisations of one run, transient and measurement (each returns to
+#: Python, and each of the measurement keeps a row of n logarithms).
+MAX_INTERVALS = 1_000_000
+
+
+@dataclass(frozen=True)
+class LyapunovSpectrum:
+    """The first ``n`` Lyapunov exponents of a run, from :func:`lyapunov`.
+
+    Attributes
+    ----------
+    exponents : ndarray
+        ``(n,)`` exponents [1/s], largest first.
+    uncertainty : ndarray
+        ``(n,)`` uncertainty of each [1/s]: the standard error from ten equal blocks of
+        the measurement combined with the drift between the whole measurement's
+        estimate and its second half's and, for more than one exponent, with the
+        difference between two random starts (Notes of :func:`lyapunov`); an estimate of
+        how far the finite-time value may be from the limit, not a bound.
+    times : ndarray
+        ``(m,)`` times of the re-orthonormalisations [s], from the start of the
+        measurement (after the transient).
+    running : ndarray
+        ``(m, n)`` running estimates [1/s] at those times.
+    transient, duration, interval : float
+        Length of the transient, of the measurement and the re-orthonormalisation
+        interval [s].
+    """
+
+    exponents: np.ndarray
+    uncertainty: np.ndarray
+    times: np.ndarray
+    running: np.ndarray
+    transient: float
+    duration: float
+    interval: float
+
+    @property
+    def largest(self) -> float:
+        """The largest exponent [1/s]."""
+        return float(self.exponents[0])
+
+    @property
+    def conclusive(self) -> np.ndarray:
+        """``(n,)`` whether each exponent is known: its uncertainty is finite and smaller
+        than its magnitude (else even its sign is not; a collapsed direction's -inf is
+        known)."""
+        e, u = self.exponents, self.uncertainty
+        with np.errstate(invalid="ignore"):
+            return np.isneginf(e) | (np.isfinite(e) & np.isfinite(u) & (u < np.abs(e)))
+
+    def verdict(self, i: int) -> str:
+        """Why exponent ``i`` is inconclusive ("" if it is not)."""
+        if self.conclusive[i]:
+            return ""
+        e, u = self.exponents[i], self.uncertainty[i]
+        if not np.isfinite(u):
+            return (f"lambda_{i + 1} = {e:+.6g} 1/s has no uncertainty estimate (too few "
+                    "re-orthonormalisations: lengthen the measurement or shorten the interval)")
+        return (f"lambda_{i + 1} = {e:+.6g} 1/s has an uncertainty of {u:.2g} 1/s, more than "
+                "its magnitude (lengthen the measurement, or the transient if the estimate "
+                "still drifts)")
+
+    def to_dict(self) -> dict:
+        """Exponents [1/s] (largest first) and their uncertainty as plain JSON types
+        (-inf, for a collapsed direction, as ``null``)."""
+        def plain(values):
+            return [float(v) if np.isfinite(v) else None for v in values]
+
+        return {"exponents": plain(self.exponents), "uncertainty": plain(self.uncertainty),
+                "conclusive": [bool(c) for c in self.conclusive],
+                "transient": self.transient, "duration": self.duration,
+                "interval": self.interval}
+
+    def to_json(self) -> str:
+        """:meth:`to_dict` as indented JSON (what ``fivdisc lyapunov --json`` prints)."""
+        return json.dumps(self.to_dict(), indent=2)
+
+    def to_dataset(self):
+        """The spectrum and its running estimates as an :class:`xarray.Dataset`."""
+        import xarray as xr
+
+        return xr.Dataset(
+            {
+                "exponent": ("index", self.exponents,
+                             {"long_name": "Lyapunov exponent", "units": "s-1"}),
+                "uncertainty": ("index", self.uncertainty,
+                                {"long_name": "uncertainty of the exponent (standard "
+                                            "error, drift, difference of starts)",
+                                 "units": "s-1"}),
+                "running": (("time", "index"), self.running,
+                            {"long_name": "running estimate of the exponent",
+                             "units": "s-1"}),
+            },
+            coords={"index": np.arange(self.exponents.size),
+                    "time": ("time", self.times, {"long_name": "time after the transient",
+                                                  "units": "s"})},
+            attrs={"transient": self.transient, "duration": self.duration,
+                   "interval": self.interval, "time_units": "s"},
+        )
+
+    def __str__(self) -> str:
+        lines = [f"Lyapunov exponents over {self.duration:g} s after a {self.transient:g} s "
+                 f"transient (QR every {self.interval:g} s) [1/s]:"]
+        for i, (e, u) in enumerate(zip(self.exponents, self.uncertainty, strict=True)):
+            mark = "" if self.conclusive[i] else "  (inconclusive)"
+            lines.append(f"  lambda_{i + 1} = {e:+.6g} +- {u:.2g}{mark}")
+        return "\n".join(lines)
+
+
+def lyapunov(
+    case: Case,
+    n: int = 1,
+    *,
+    transient: float | None = None,
+    duration: float | None = None,
+    interval: float | None = None,
+    initial=None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    seed: int = 0,
+    progress: bool = False,
+) -> LyapunovSpectrum:
+    r"""The first ``n`` Lyapunov exponents of a case's trajectory.
+
+    Parameters
+    ----------
+    case : Case
+        The case; any speed profile (for a varying speed the exponents are those of
+        the finite run).
+    n : int
+        How many exponents, at most the number of coordinates free at the start.
+    transient : float, optional
+        Simulated time before the measurement starts [s]; default a fifth of the case's
+        ``simulation.duration``. The tangent vectors align with the most expanding
+        directions over it (Notes): it should last several times ``1 / (lambda_n -
+        lambda_(n+1))``.
+    duration : float, optional
+        Length of the measurement [s]; default the case's ``simulation.duration``.
+    interval : float, optional
+        Re-orthonormalisation interval [s]; default 0.05 s, or the whole measurement
+        when that is shorter. Shorter keeps the vectors well apart when
+        the exponents differ widely (the n-th loses about ``(lambda_1 - lambda_n)
+        interval / ln 10`` digits against the first); the exponents do not depend on it
+        otherwise. Each re-orthonormalisation returns to Python (about 0.1 ms), so the
+        default (a few stick-slip cycles of brake squeal) keeps that a small part of the
+        run.
+    initial : optional
+        Initial state, as for :func:`fivdisc.simulate`.
+    rtol, atol : float, optional
+        Integration tolerances (default the case's). The step is also capped at
+        :func:`fivdisc.engine.integration.tangent_step`, so that the tangent dynamics is
+        resolved where the state alone would allow long steps.
+    seed : int
+        Seed of the random tangent vectors at the start of the transient.
+    progress : bool
+        Show a progress bar in simulated time over the transient and the measurement (on
+        a terminal), and a notice when the kernel with tangent vectors compiles (first
+        use).
+
+    Returns
+    -------
+    LyapunovSpectrum
+
+    Notes
+    -----
+    **Alignment.** From random vectors, the QR method measures the exponents only once
+    the vectors have turned into the most expanding directions. Until then the k-th
+    vector grows more slowly than ``lambda_k``, and the deficit decays like
+    ``exp(-(lambda_k - lambda_(k+1)) t)``: with gaps of a few tenths of 1/s, as between
+    the lightly damped modes of a disc, that takes seconds, and a measurement started
+    from random vectors is biased by the deficit divided by its length. The vectors
+    therefore start at random with the run and are carried through the transient,
+    re-orthonormalised every ``interval`` as in the measurement, their stretching
+    discarded. The transient serves both purposes: the trajectory forgets its start on
+    it, and so do the vectors.
+
+    **Uncertainty.** With a set's per-interval logarithms ``l_i^(k) = ln|R_ii|`` at the
+    times ``t_k`` (``k = 1 ... m``, ``t_m = T``), its exponent is
+    ``lambda_i = sum_k l_i^(k) / T``. For ``n > 1`` two sets from independent random
+    starts give ``lambda_i^a`` and ``lambda_i^b``, and the reported exponent and the
+    terms below are those of their mean; for ``n = 1`` the last term is 0. Split into
+    ``B = min(10, m)`` equal blocks of rates ``lambda_i^(b)``, its standard error is
+    ``s_i = std_b(lambda_i^(b)) / sqrt(B)`` (sample standard deviation); the estimate
+    over the second half is ``lambda_i'' = sum_(k > m/2) l_i^(k) / (T - t_(m/2))``, and
+
+    .. math::
+
+        u_i = \sqrt{s_i^2 + (\lambda_i - \lambda_i'')^2 + (\lambda_i^a - \lambda_i^b)^2}.
+
+    The drift term measures a finite-time bias the block spread does not: a deficit
+    ``C`` accumulated early in the measurement (the last of the alignment, or the
+    ``ln(kappa)`` of a non-normal linearisation) biases ``lambda_i`` by ``C / T`` and
+    the second half by little, so their difference is about the bias of the whole.
+    Where the estimate only fluctuates the drift is of the size of ``s_i``. The last
+    term is what the random start still does to the estimate: once both sets have
+    aligned they are the same vectors and it vanishes, chaotic or not; while they align
+    their deficits differ. On three sliders at a stable equilibrium
+    (``tests/analysis/test_lyapunov_against_references.py``, exponents -1.15, -1.15,
+    -1.63, -1.63 1/s)
+    with a transient of 0.5 s, far too short to align, the second exponent over 3 s was
+    8 of ``sqrt(s^2 + drift^2)`` away from its limit, and is 2.3 of ``u`` away. The
+    largest exponent alone is computed from one start: it is what sweeps compute at
+    every point, and a second set of vectors would cost a third more (below), for a
+    direction that the first vector, the fastest to align, finds soonest.
+
+    **Limits.** A vector whose start had almost nothing along its direction measures the
+    next exponent until it turns, steadily, after about ``ln(1/p) / (lambda_k -
+    lambda_(k+1))`` for a start's component ``p``; if every start is like that (a
+    direction that random vectors in the energy norm barely touch) no estimate from the
+    run sees it. On the stick-slip orbit of that test file the third exponent, -1.95
+    1/s, took 15-20 s to turn from the next, -2.14 1/s. Doubling the transient and
+    comparing is the check.
+
+    **Cost.** The transient costs the tangent kernel instead of a plain run, and for
+    ``n > 1`` twice the vectors: a step with one tangent vector costs about 1.8 plain
+    steps, with two 2.4, with four 3.4 (``benchmarks/bench_tangent.py``). Measured on
+    that three-slider case with a transient as long as the measurement, one exponent
+    takes 1.6 and four 3.3 times as long as with one set of vectors started at the
+    measurement (1.8 of that is the alignment, the rest the second start); with a
+    transient of a fifth of it, 1.1 and 2.2 times.
+    """
+    sim = case.simulation
+    transient = 0.2 * sim.duration if transient is None else transient
+    duration = sim.duration if duration is None else duration
+    if interval is None:
+        interval = min(DEFAULT_INTERVAL, duration) if duration > 0 else DEFAULT_INTERVAL
+    from fivdisc.analysis.checks import check_time
+
+    check_time("transient", transient, zero=True)
+    check_time("duration", duration)
+    check_time("interval", interval)
+    if not interval <= duration:
+        raise FivdiscError(f"interval = {interval!r} is invalid: must be <= duration [s]")
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise FivdiscError(f"n = {n!r} is invalid: must be an integer >= 1")
+    from fivdisc.engine.simulation import Deflection, initial_state
+    from fivdisc.engine.split_compile import compile_split
+
+    model = build_model(case)
+    check_steps(model, transient + duration, "transient + duration")
+    # After check_steps, which names a transient or duration too long to run at all.
+    if (transient + duration) / interval > MAX_INTERVALS:
+        raise FivdiscError(
+            f"interval = {interval!r} is invalid: (transient + duration) / interval = "
+            f"{(transient + duration) / interval:.3g} re-orthonormalisations, more than "
+            f"{MAX_INTERVALS:g}; must be >= (transient + duration) / 1e6 [s]")
+    cap = tangent_step(model)
+    if sim.max_step > 0:
+        cap = min(cap, sim.max_step)
+    run = Integration(model, initial_state(model, initial), duration=transient + duration,
+                      rtol=rtol, atol=atol, max_step=cap)
+    # The kernel's first compilation, if it is one, on two cores; the one with tangents,
+    # needed next, begins meanwhile.
+    compile_split(run, tangents=True)
+    run.advance(0.0)
+    # The phases at the start are chosen by the first advance.
+    free = run.free()
+    if n > free.sum():
+        raise FivdiscError(f"n = {n} is invalid: must be at most {int(free.sum())}, the "
+                           "number of coordinates free at the start (where the tangent "
+                           "vectors start)")
+    limit = Deflection(model)
+    # One bar in simulated time over the transient and the measurement: a long transient
+    # is the first minutes of a run.
+    bar = progress_bar(transient + duration, "Lyapunov exponents", "s", show=progress,
+                       bar_format=SIMULATED_TIME)
+    try:
+        spectrum = _measure(run, model, limit, free, n, seed, transient, duration, interval,
+                            progress, bar)
+    finally:
+        bar.close()
+    return spectrum
+
+
+def _measure(run: Integration, model: Model, limit: Any, free: np.ndarray, n: int,
+             seed: int | None, transient: float, duration: float, interval: float,
+             progress: bool, bar: Any) -> LyapunovSpectrum:
+    """Align random tangent vectors over the transient, then measure the exponents over
+    `duration`, with `bar` counting both."""
+    from fivdisc.analysis.orbits import energy_scales
+    from fivdisc.engine.compilation import tangent_notice
+    from fivdisc.engine.split_compile import compile_split_tangents
+
+    sc = energy_scales(model)
+    rng = np.random.default_rng(seed)
+    starts = _STARTS if n > 1 else 1
+    q = np.hstack([np.linalg.qr(rng.standard_normal((model.state_size, n)) * free[:, None])[0]
+                   for _ in range(starts)])
+    aligning = transient > 0
+    t0 = run.t
+    # The first interval compiles the kernel with tangents in a fresh installation; it
+    # is the transient's first, or without a transient the measurement's.
+    with tangent_notice(show=progress or None):
+        compile_split_tangents()
+        run.set_tangents((q * sc[:, None]).T)
+        first = _interval(run, limit, min(interval, transient if aligning else duration), sc,
+                          starts, "the transient" if aligning else "the measurement")
+    bar.update(run.t - bar.n)
+    # Alignment: the vectors are carried through the transient and re-orthonormalised as
+    # in the measurement, their stretching discarded, so that the measurement starts from
+    # directions that have forgotten their random start (Notes of `lyapunov`).
+    k = 2
+    while aligning and run.t < transient:
+        _interval(run, limit, min(k * interval, transient), sc, starts, "the transient")
+        bar.update(run.t - bar.n)
+        k += 1
+    if aligning:
+        t0 = run.t
+    steps = int(np.ceil(duration / interval - 1e-9))
+    logs = np.zeros((steps, starts * n))
+    times = np.zeros(steps)
+    for k in range(steps):
+        if k or aligning:
+            logs[k] = _interval(run, limit, min(t0 + (k + 1) * interval, transient + duration),
+                                sc, starts, "the measurement")
+        else:
+            logs[k] = first
+        times[k] = run.t - t0
+        bar.update(run.t - bar.n)
+    # Over a finite run the QR order need not be the order of the values: sort each start's.
+    sets = [part[:, np.argsort(-part.sum(axis=0), kind="stable")]
+            for part in np.split(logs, starts, axis=1)]
+    logs = np.mean(sets, axis=0)
+    exponents = logs.sum(axis=0) / times[-1]
+    running = np.cumsum(logs, axis=0) / times[:, None]
+    with np.errstate(invalid="ignore"):
+        spread = np.ptp([part.sum(axis=0) / times[-1] for part in sets], axis=0)
+    return LyapunovSpectrum(exponents, _uncertainty(logs, times, exponents, spread), times,
+                            running, float(transient), float(duration), float(interval))
+
+
+def _uncertainty(logs: np.ndarray, times: np.ndarray, exponents: np.ndarray,
+                 spread: np.ndarray) -> np.ndarray:
+    """Standard error of ten blocks combined with the drift from the second half's
+    estimate and the spread between the starts (formula in Notes of `lyapunov`); NaN with
+    fewer than two intervals."""
+    steps = len(times)
+    if steps < 2:
+        return np.full(logs.shape[1], np.nan)
+    blocks = np.array_split(np.arange(steps), min(_BLOCKS, steps))
+    edges = np.r_[0.0, times]
+    half = steps // 2
+    with np.errstate(invalid="ignore"):
+        rates = np.array([logs[b].sum(axis=0) / (edges[b[-1] + 1] - edges[b[0]])
+                          for b in blocks])
+        error = rates.std(axis=0, ddof=1) / np.sqrt(len(blocks))
+        later = logs[half:].sum(axis=0) / (times[-1] - times[half - 1])
+        return np.sqrt(error**2 + (exponents - later) ** 2 + spread**2)
+
+
+def _interval(run: Integration, limit: Any, target: float, sc: np.ndarray, starts: int,
+              what: str) -> np.ndarray:
+    """Integrate to `target`, re-orthonormalise each start's tangent vectors (energy norm)
+    and return the logarithms of their stretching factors, start after start."""
+    run.run_to(target)
+    _check(run, limit, what)
+    vectors = run.tangents(slaved=False).T / sc[:, None]
+    stretch = np.empty(vectors.shape[1])
+    for cols in np.split(np.arange(vectors.shape[1]), starts):
+        q, r = np.linalg.qr(vectors[:, cols])
+        diag = np.diag(r)
+        vectors[:, cols] = q * np.where(diag < 0, -1.0, 1.0)
+        stretch[cols] = np.abs(diag)
+    run.set_tangents((vectors * sc[:, None]).T)
+    with np.errstate(divide="ignore"):
+        return np.log(stretch)
+
+
+def _check(run: Integration, limit, what: str) -> None:
+    """Refuse to go on from a run that failed or left the model's range (as
+    :func:`fivdisc.simulate` would call it diverged): its exponents would describe a
+    blow-up, not the case."""
+    if limit.beyond(run.y):
+        raise FivdiscError(f"lyapunov: the run diverged during {what}: "
+                           f"{limit.message(run.t)}")
+    if run.status_name not in ("running", "success"):
+        raise FivdiscError(f"lyapunov: the run ended with {run.status_name} at "
+                           f"t = {run.t:.9g} s during {what}")
+
+
+def warm_tangent_kernel(show: bool = False) -> None:
+    """Compile or load the kernel with tangent vectors now, with an exponent over 1 ms
+    of simulated time (a sweep computing exponents does it before its workers start,
+    ``fivdisc warmup`` with every kernel).
+
+    Parameters
+    ----------
+    show
+        Print the notice of :func:`fivdisc.engine.compilation.tangent_notice` if it compiles.
+    """
+    from fivdisc.engine.compilation import tangent_notice
+
+    with tangent_notice(show=show):
+        lyapunov(Case(simulation={"duration": 1e-3}), transient=0.0, duration=1e-3,
+                 interval=1e-3)

@@ -1,0 +1,58 @@
+"""Checks of a continuation's key, target and window, before any work."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fivdisc.case import Case, is_case_key
+from fivdisc.errors import CaseError, FivdiscError
+
+
+def check_key(case: Case, key: str, option: str = "key") -> float:
+    """The current value of a numeric case key, or a one-line error.
+
+    Raises
+    ------
+    CaseError
+        The key is unknown, a simulation setting, or not a single number (a table, a
+        list, a name, a switch).
+    """
+    if not is_case_key(key):
+        from fivdisc.analysis.stability import resolve_key
+
+        key = resolve_key(key, option)
+    if key.startswith("simulation."):
+        raise CaseError(f"{option} = {key!r} is invalid: the simulation settings do not "
+                        "change the system, so its periodic orbits do not depend on them; "
+                        "continue in a key of disc, slider(s), friction or speed")
+    value = case.get(key)
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise CaseError(f"{option} = {key!r} is invalid: its value {value!r} is not a number; "
+                        "continuation needs a numeric key")
+    return float(value)
+
+
+def check_window(key: str, p0: float, to: float, back_to: float, option: str = "back_to"
+                 ) -> None:
+    """A one-line refusal of a window's far end ``back_to`` that is not finite or lies
+    between the start's value ``p0`` and ``to``."""
+    if not (np.isfinite(back_to) and (back_to - p0) * (to - p0) <= 0):
+        raise CaseError(f"{option} = {back_to!r} is invalid: must be a finite value of {key} "
+                        f"at the start's value {p0:g} or on its side away from {to:g}")
+
+
+def check_target(case: Case, key: str, to: float) -> float:
+    """The one-line refusals of a continuation's key and target; the key's value in
+    ``case``."""
+    if case.speed.profile != "constant":
+        raise FivdiscError(f"continuation needs a constant disc speed (speed.profile = "
+                           f"'constant'), not {case.speed.profile!r}: with a varying speed "
+                           "the system is not autonomous and has no periodic orbits")
+    p0 = check_key(case, key)
+    if not np.isfinite(to):
+        raise CaseError(f"to = {to!r} is invalid: must be a finite value of {key}")
+    case.replace({key: float(to)})  # the target must be an allowed value
+    if to == p0:
+        raise CaseError(f"to = {to!r} is invalid: it is the case's own value of {key}; "
+                        "give the value to continue to")
+    return p0

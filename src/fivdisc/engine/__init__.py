@@ -1,0 +1,1 @@
+"""The engine: one integration advanced call by call, the simulation driver, results."""

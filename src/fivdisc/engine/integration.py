@@ -1,0 +1,407 @@
+"""One integration of a model, advanced call by call: the kernel's whole state between calls.
+
+:func:`fivdisc.simulate` drives one to write a :class:`~fivdisc.engine.result.Result`; the
+nonlinear-dynamics analyses (:mod:`fivdisc.analysis.orbits`,
+:mod:`fivdisc.analysis.exponents`) drive them with tangent vectors.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from fivdisc.core import integrate as kern
+from fivdisc.core import slots
+from fivdisc.core import tangent as tan
+from fivdisc.engine.result import EVENT_KINDS
+from fivdisc.errors import FivdiscError
+from fivdisc.model import layout as lay
+from fivdisc.model.build import Model
+
+_EVENT_BUFFER = 1 << 15
+# Switches closer than this, this many times in a row, are taken as Zeno/chattering.
+ZENO_DT = 1e-10
+ZENO_COUNT = 1000
+# An accumulation of switches that interleaves tiny spacings with longer ones (a cascade
+# among many sliders) escapes the test above: ZENO_RATE_COUNT switch events within
+# ZENO_RATE_SPAN of simulated time (a mean spacing of 1e-9 s, a thousand times the
+# densest switching of the paper's cases) are taken as Zeno too.
+ZENO_RATE_COUNT = 10_000
+ZENO_RATE_SPAN = 1e-5
+# Mean step [s per unit of max(1, t)] of a whole kernel call below which the run is taken
+# as stalled (the kernel's own test of a step size underflow: 1e-14 max(1, t)).
+_STALLED = 1e-14
+# Work [state values x (sliders + 1)] one kernel call may do before it returns to Python,
+# about 0.05 s: the bound on how long an interrupt or a step budget waits.
+_CALL_WORK = 500_000
+
+STATUS = {
+    slots.ST_RUNNING: "running",
+    slots.ST_DONE: "success",
+    slots.ST_STOPPED: "stopped",
+    slots.ST_NONFINITE: "nonfinite",
+    slots.ST_UNDERFLOW: "step_size_underflow",
+    slots.ST_ZENO: "endless_switching",
+    slots.ST_MAX_SWITCHES: "max_switches",
+    slots.ST_TOO_MANY_STEPS: "too_many_steps",
+}
+
+
+# h omega of the tangent step cap: DOPRI5's amplification of an oscillation of frequency
+# omega is 1 - (h omega)^6 / 3600 per step, so an exponent is biased by about
+# 1e-5 omega [1/s] at 0.5 (0.02 1/s for the paper's fastest mode kept, 2774 rad/s).
+_TANGENT_STEP = 0.5
+
+
+def time_scales(model: Model) -> list[tuple[str, float]]:
+    """The rates [1/s] of the model's fast motions, each with the keys that set it: the
+    disc's natural frequencies and damping rates, each slider's normal and in-plane
+    oscillator (separated) and damping rates. The spin's shift l Omega of a disc frequency
+    is small against them for the speeds of brake squeal and left out."""
+    kern = model.kernel
+    case = model.case
+    labels = np.array(model.labels)
+    scales = [(f"disc.modes {lab} natural frequency", w) for lab, w in zip(labels, model.omega,
+                                                                          strict=True)]
+    scales += [(f"disc.damping_ratio of {lab}", 2.0 * z * w)
+               for lab, z, w in zip(labels, model.damping, model.omega, strict=True)]
+    with np.errstate(all="ignore"):
+        rows = [("sqrt(normal_stiffness / mass)", np.sqrt(kern.row("kz") / kern.row("mass"))),
+                ("sqrt(rotational_stiffness / inertia)",
+                 np.sqrt(kern.row("kphi") / kern.row("inertia"))),
+                ("normal_damping / mass", kern.row("cz") / kern.row("mass")),
+                ("rotational_damping / inertia", kern.row("cphi") / kern.row("inertia"))]
+    for what, rates in rows:
+        scales += [(f"{case.slider_key(j)}: {what}", float(r)) for j, r in enumerate(rates)]
+    return [(what, float(rate)) for what, rate in scales]
+
+
+def fastest_time_scale(model: Model) -> tuple[str, float]:
+    """The largest of :func:`time_scales` (a nan counts as infinite)."""
+    return max(((what, math.inf if math.isnan(r) else r) for what, r in time_scales(model)),
+               key=lambda item: item[1], default=("none", 0.0))
+
+
+def tangent_step(model: Model, h_omega: float = _TANGENT_STEP) -> float:
+    """Largest step [s] that resolves the tangent dynamics: ``h_omega`` (default half)
+    the shortest time scale of the model (:func:`time_scales`).
+
+    The integrator's steps follow the state alone (so that tangents do not change the
+    trajectory); where the state hardly moves (near an equilibrium, a disc mode at rest)
+    its steps may be far too long for the tangent dynamics, which then are not merely
+    inaccurate but unstable. Analyses that carry tangents cap the step at this.
+    """
+    return h_omega / fastest_time_scale(model)[1]
+
+
+# h |lambda| at the edge of DOPRI5's stability region on the negative real axis (3.3) and
+# the imaginary axis (3.4).
+_STABLE_STEP = 3.3
+
+
+# h omega of a step that meets the tolerance on an oscillation of frequency omega: the
+# local error of DOPRI5 grows as (h omega)^5, so h omega = _ACCURATE rtol^(1/5). The
+# paper's cases take about 4 (0.24 at rtol = 1e-6, 11,500 steps per second against their
+# fastest mode); 8 makes the estimate about half the steps actually taken.
+_ACCURATE = 8.0
+
+
+def estimate_steps(model: Model, duration: float) -> tuple[float, str, float]:
+    """A lower estimate of the steps a run of `duration` [s] takes, with the time scale
+    that sets it and its rate [1/s].
+
+    An explicit integrator's step is bounded by its stability region whatever the
+    tolerance, ``h <= 3.3 / rate`` for a decay rate (dampers), and on an oscillation of
+    frequency omega also by the tolerance, ``h omega <= 8 rtol^(1/5)``; the fastest time
+    scale of :func:`time_scales`, or the disc's spin times the largest nodal-diameter
+    count, sets the number of steps. Contact and friction only add to it.
+    """
+    rtol = model.case.simulation.rtol
+    accurate = min(_STABLE_STEP, _ACCURATE * rtol**0.2)
+    oscillating = ("natural frequency", "sqrt(")
+    worst = (0.0, "none", 0.0)
+    # The spin shifts a disc frequency by l Omega, small against the time scales for the
+    # speeds of brake squeal but not for any speed a profile may reach.
+    bp = model.speed.breakpoints
+    times = np.concatenate([np.linspace(0.0, duration, 1001), bp[bp < duration]])
+    with np.errstate(all="ignore"):
+        spin = float(np.max(model.l, initial=0) * np.max(np.abs(model.speed.omega(times))))
+    scales = [*time_scales(model),
+              ("speed: the disc's spin (largest Omega) times the largest l", spin)]
+    for what, rate in scales:
+        rate = math.inf if math.isnan(rate) else rate
+        step = (accurate if any(word in what for word in oscillating) or what.startswith(
+            "speed") else _STABLE_STEP)
+        steps = duration * rate / step
+        if not steps <= worst[0]:
+            worst = (steps, what, rate)
+    return worst
+
+
+def check_steps(model: Model, duration: float, span: str = "simulation.duration") -> None:
+    """Refuse a run whose estimated steps (:func:`estimate_steps`) exceed
+    ``simulation.max_steps``, before it starts.
+
+    ``duration`` [s] is the simulated time the command will integrate; ``span`` names
+    what the user set to get it, for the message (e.g. ``"transient + duration"``).
+
+    Raises
+    ------
+    FivdiscError
+        Naming the estimate, the time scale and its keys, and what to change.
+    """
+    steps, what, rate = estimate_steps(model, duration)
+    budget = model.case.simulation.max_steps
+    if not steps <= budget:
+        raise FivdiscError(
+            f"the run needs about {steps:.3g} integrator steps, more than "
+            f"simulation.max_steps = {budget}: {what} = {rate:.3g} 1/s limits the step to "
+            f"{duration / steps:.3g} s over {span} = {duration!r} s; change "
+            "that parameter, shorten the run or raise simulation.max_steps"
+        )
+
+
+class Integration:
+    """The integrator of ``model`` from state ``y0`` at t = 0 to ``duration``.
+
+    Parameters
+    ----------
+    model : Model
+        The model (its case gives tolerances, step and switch limits).
+    y0 : ndarray
+        Initial state, ``2 (n + 2 S)`` values.
+    duration : float
+        End time [s]; the last step lands on it exactly.
+    output_rate : float
+        Output samples per second [Hz]; 0 records none.
+    stop_on : tuple of str
+        Event kinds that end the run early.
+    energy : bool
+        Integrate the energy accumulators too.
+    rtol, atol : float, optional
+        Override the case's tolerances.
+    max_step : float, optional
+        Override the case's largest step [s] (0: none).
+    phases : array of int, optional
+        Phase of each slider at the start (``layout.SLIP``, ``STICK``, ``SEPARATION``);
+        a slider in contact takes the phase its state allows, one given as separated
+        starts flying from its own ``z``, ``zdot``. Default: all in contact.
+    """
+
+    def __init__(self, model: Model, y0: np.ndarray, *, duration: float,
+                 output_rate: float = 0.0, stop_on: tuple[str, ...] = (),
+                 energy: bool = False, rtol: float | None = None,
+                 atol: float | None = None, max_step: float | None = None,
+                 phases: np.ndarray | None = None) -> None:
+        sim = model.case.simulation
+        self.model = model
+        self.duration = duration
+        n_acc = lay.N_ENERGY if energy else 0
+        self.y = np.concatenate([np.asarray(y0, dtype=float), np.zeros(n_acc)])
+        size = self.y.size
+        n_sl = model.n_sliders
+        n_out = int(np.floor(duration * output_rate + 1e-9)) + 1 if output_rate > 0 else 0
+        # Rows past the last written sample are cut off, so they need no fill.
+        self.out_y = np.empty((n_out, size))
+        self.out_aux = np.empty((n_out, 4 * n_sl + 1))
+        ctl = np.zeros(slots.N_CONTROL)
+        ctl[slots.C_RTOL] = sim.rtol if rtol is None else rtol
+        ctl[slots.C_ATOL] = sim.atol if atol is None else atol
+        ctl[slots.C_MAX_STEP] = sim.max_step if max_step is None else max_step
+        ctl[slots.C_T_FINAL] = duration
+        ctl[slots.C_OUT_DT] = 1.0 / output_rate if output_rate > 0 else np.inf
+        ctl[slots.C_MAX_SWITCHES] = sim.max_switches
+        ctl[slots.C_ZENO_DT] = ZENO_DT
+        ctl[slots.C_ZENO_COUNT] = ZENO_COUNT
+        ctl[slots.C_STOP_MASK] = sum(1 << EVENT_KINDS.index(k) for k in set(stop_on))
+        self.ctl = ctl
+        self.max_steps = sim.max_steps
+        self.call_steps = max(20, _CALL_WORK // (size * (n_sl + 1)))
+        self.zeno_sliders: tuple[int, ...] = ()
+        self.zeno_span = 0.0
+        self.zeno_count = 0
+        self.fst = np.zeros(slots.N_FSTATE)
+        self.fst[slots.F_LAST_SWITCH] = -np.inf
+        self.ist = np.zeros(slots.N_ISTATE, dtype=np.int64)
+        self.ph = np.full(n_sl, lay.SLIP, dtype=np.int64)
+        if phases is not None:
+            self.ph[:] = phases
+        self.sg = np.ones(n_sl, dtype=np.int64)
+        self.k = np.zeros((7, size))
+        self.ev_prev = np.zeros(3 * n_sl)
+        self.ev_t = np.empty(_EVENT_BUFFER)
+        self.ev_i = np.empty((_EVENT_BUFFER, slots.N_EVI), dtype=np.int64)
+        bp = model.speed.breakpoints
+        self.breaks = np.unique(bp[bp < duration])
+        self.mdl = model.kernel_args
+        self.ev_times: list[np.ndarray] = []
+        self.ev_rows: list[np.ndarray] = []
+        self.tan: tuple[np.ndarray, np.ndarray] | None = None
+        self.status = slots.ST_RUNNING
+
+    @property
+    def t(self) -> float:
+        """Time reached [s]."""
+        return float(self.fst[slots.F_T])
+
+    @property
+    def state(self) -> np.ndarray:
+        """The dynamic state reached (without energy accumulators), slaved coordinates as
+        the kernel holds them."""
+        return self.y[: self.model.state_size].copy()
+
+    @property
+    def status_name(self) -> str:
+        return STATUS.get(self.status, "unknown")
+
+    @property
+    def n_samples(self) -> int:
+        return int(self.ist[slots.I_OUT_NEXT])
+
+    def take_peak(self) -> float:
+        """The largest |w| [m] under the sliders at the samples written since the last
+        call (nan if any was not finite), and start again."""
+        peak = float(self.fst[slots.F_W_PEAK])
+        self.fst[slots.F_W_PEAK] = 0.0
+        return peak
+
+    @property
+    def steps_tried(self) -> int:
+        """Steps tried so far, accepted and rejected."""
+        return int(self.ist[slots.I_STEPS] + self.ist[slots.I_REJECTED])
+
+    def advance(self, target: float) -> int:
+        """Integrate until ``t >= target`` (or the end, a failure, a full event buffer, the
+        call's step budget); returns the status. The first call (any target) also chooses
+        the phases at the start.
+
+        A call tries at most a bounded number of steps (about 0.05 s of work), so that
+        the caller regains control often: a run that cannot make progress is seen to, and
+        an interrupt is handled, within a fraction of a second. Splitting a run into calls
+        changes none of its steps. The run ends as ``too_many_steps`` once
+        ``simulation.max_steps`` steps were tried, and as ``endless_switching`` when its
+        switches accumulate (:data:`ZENO_RATE_COUNT` within :data:`ZENO_RATE_SPAN`).
+        """
+        left = self.max_steps - self.steps_tried
+        if left <= 0 and self.ist[slots.I_STARTED]:
+            self.status = slots.ST_TOO_MANY_STEPS
+            return self.status
+        self.ctl[slots.C_CALL_STEPS] = max(1, min(self.call_steps, left))
+        tried, t0 = self.steps_tried, self.t
+        status = kern.run(target, self.mdl, self.ctl, self.fst, self.ist, self.y, self.ph,
+                          self.sg, self.k, self.ev_prev, self.breaks, self.out_y, self.out_aux,
+                          self.ev_t, self.ev_i, self.tan)
+        n_ev = self.ist[slots.I_EVENTS]
+        if n_ev:
+            self.ev_times.append(self.ev_t[:n_ev].copy())
+            self.ev_rows.append(self.ev_i[:n_ev].copy())
+            self.ist[slots.I_EVENTS] = 0
+        if status == slots.ST_ZENO:
+            self._name_zeno(ZENO_COUNT)
+        elif status == slots.ST_RUNNING and n_ev and self._accumulating():
+            status = slots.ST_ZENO
+        elif (status == slots.ST_RUNNING and self.t < self.duration
+              and self.steps_tried >= self.max_steps):
+            status = slots.ST_TOO_MANY_STEPS
+        elif (status == slots.ST_RUNNING and self.steps_tried - tried >= self.call_steps
+              and self.t - t0 < (self.steps_tried - tried) * _STALLED * max(1.0, self.t)):
+            # A whole call's steps that do not add up to the round-off of t: the
+            # step size has underflowed although each step is accepted.
+            status = slots.ST_UNDERFLOW
+        self.status = status
+        return status
+
+    def _recent(self, count: int) -> tuple[np.ndarray, np.ndarray]:
+        """Times and rows of the last ``count`` events (fewer if there are fewer)."""
+        times, rows, have = [], [], 0
+        for t, r in zip(reversed(self.ev_times), reversed(self.ev_rows), strict=True):
+            times.append(t[-(count - have):])
+            rows.append(r[-(count - have):])
+            have += times[-1].size
+            if have >= count:
+                break
+        if not times:
+            return np.empty(0), np.empty((0, slots.N_EVI), dtype=np.int64)
+        return np.concatenate(times[::-1]), np.concatenate(rows[::-1])
+
+    def _name_zeno(self, count: int) -> None:
+        """Keep the sliders of the last ``count`` events, their number and the time they
+        span."""
+        times, rows = self._recent(count)
+        if times.size:
+            self.zeno_sliders = tuple(int(j) for j in np.unique(rows[:, slots.EVI_SLIDER]))
+            self.zeno_span = float(times[-1] - times[0])
+            self.zeno_count = int(times.size)
+
+    def _accumulating(self) -> bool:
+        """Whether :data:`ZENO_RATE_COUNT` consecutive events among the latest fall within
+        :data:`ZENO_RATE_SPAN` of simulated time."""
+        new = self.ev_times[-1].size
+        times, rows = self._recent(new + ZENO_RATE_COUNT - 1)
+        if times.size < ZENO_RATE_COUNT:
+            return False
+        spans = times[ZENO_RATE_COUNT - 1:] - times[: times.size - ZENO_RATE_COUNT + 1]
+        dense = np.flatnonzero(spans < ZENO_RATE_SPAN)
+        if not dense.size:
+            return False
+        first = int(dense[0])
+        window = rows[first:first + ZENO_RATE_COUNT]
+        self.zeno_sliders = tuple(int(j) for j in np.unique(window[:, slots.EVI_SLIDER]))
+        self.zeno_span = float(spans[first])
+        self.zeno_count = ZENO_RATE_COUNT
+        return True
+
+    def run_to(self, target: float) -> int:
+        """Advance until ``target`` is reached or the run ends."""
+        while True:
+            status = self.advance(target)
+            if status != slots.ST_RUNNING or self.t >= target:
+                return status
+
+    def events(self) -> tuple[np.ndarray, np.ndarray]:
+        """Times and integer rows (kind, from, to, slider) of the switches so far."""
+        if not self.ev_times:
+            return np.empty(0), np.empty((0, slots.N_EVI), dtype=np.int64)
+        return np.concatenate(self.ev_times), np.concatenate(self.ev_rows)
+
+    def set_tangents(self, vectors: np.ndarray) -> None:
+        """Carry tangent vectors (rows, over the dynamic state) from the current state on.
+
+        Rows of coordinates that are not free in the current phases (``z``, ``zdot`` of a
+        slider in contact, ``phidot`` of a sticking one) are ignored. Given before the
+        first :meth:`advance`, they are carried across the start's choice of phases.
+        """
+        vectors = np.atleast_2d(np.asarray(vectors, dtype=float))
+        nd = self.model.state_size
+        if vectors.ndim != 2 or vectors.shape[1] != nd:
+            raise ValueError(
+                f"tangent vectors have shape {vectors.shape}: must be (k, {nd}), rows over "
+                "the dynamic state"
+            )
+        if self.tan is None or self.tan[0].shape != vectors.shape:
+            self.tan = (np.zeros(vectors.shape), np.zeros((vectors.shape[0], 7, nd)))
+        v, kv = self.tan
+        v[:] = vectors
+        if self.ist[slots.I_STARTED]:
+            tan.prepare(self.t, self.y, self.ph, self.sg, self.mdl, v, kv)
+
+    def tangents(self, slaved: bool = True) -> np.ndarray:
+        """Current tangent vectors (rows); with ``slaved``, the rows of coordinates that
+        follow the contact (``z``, ``zdot`` in contact) are filled in as the output
+        carries them, else they are zero as integrated."""
+        if self.tan is None:
+            raise RuntimeError("no tangent vectors are carried: call set_tangents first")
+        if not slaved:
+            return self.tan[0].copy()
+        return tan.unslaved(self.t, self.y, self.ph, self.sg, self.mdl, self.tan[0])
+
+    def free(self) -> np.ndarray:
+        """Mask of the coordinates that are free in the current phases."""
+        mask = np.ones(self.model.state_size)
+        tan.slave(self.ph, self.mdl, mask)
+        return mask.astype(bool)
+
+    def rhs(self) -> np.ndarray:
+        """The current phases' right-hand side at the current state (dynamic part)."""
+        return self.k[0, : self.model.state_size].copy()

@@ -1,0 +1,82 @@
+"""The disc's radial modes, kept on disk from one process to the next.
+
+Finding a mode's frequency parameter and the peak of its shape takes root searches
+(:func:`scipy.optimize.brentq`), and importing :mod:`scipy.optimize` alone is a third of a
+second of every short command. The modes of a geometry are therefore stored once, in
+``fivdisc-plate-modes.json`` in ``$FIVDISC_CACHE_DIR`` (else ``$NUMBA_CACHE_DIR``, else
+``~/.cache/fivdisc``), and read back exactly (JSON keeps every bit of a float). The file
+is stamped with a hash of :mod:`fivdisc.model.plate`'s source and the numpy and scipy
+versions: when one changes, the stored modes are ignored and found again. A file that
+cannot be read, or a directory that cannot be written, only costs the root searches.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+__all__ = ["lookup", "remember"]
+
+_FILE = "fivdisc-plate-modes.json"
+_modes: dict[str, Any] | None = None
+
+
+def _path() -> Path:
+    directory = os.environ.get("FIVDISC_CACHE_DIR") or os.environ.get("NUMBA_CACHE_DIR")
+    if directory:
+        return Path(directory) / _FILE
+    home = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(home) / "fivdisc" / _FILE
+
+
+@lru_cache(maxsize=1)
+def _stamp() -> str:
+    # The modes are what plate.py computes with these numpy and scipy (their Bessel
+    # functions may change in the last bits from one version to the next).
+    import numpy
+    import scipy
+
+    source = Path(__file__).with_name("plate.py").read_bytes()
+    versions = f"{numpy.__version__} {scipy.__version__}".encode()
+    return hashlib.sha256(source + versions).hexdigest()[:16]
+
+
+def _read() -> dict[str, Any]:
+    try:
+        stored = json.loads(_path().read_text())
+    except (OSError, ValueError):
+        return {}
+    if not (isinstance(stored, dict) and stored.get("stamp") == _stamp()
+            and isinstance(stored.get("modes"), dict)):
+        return {}
+    return stored["modes"]
+
+
+def lookup(key: str) -> Any:
+    """The value stored under ``key`` (a mode's ``repr`` of its arguments), or None."""
+    global _modes
+    if _modes is None:
+        _modes = _read()
+    return _modes.get(key)
+
+
+def remember(key: str, value: Any) -> None:
+    """Store ``value`` (JSON: numbers and lists) under ``key``, merged with what other
+    processes stored meanwhile."""
+    global _modes
+    from fivdisc.files import write_atomic
+
+    modes = _read()
+    modes[key] = value
+    _modes = modes
+    path = _path()
+    text = json.dumps({"stamp": _stamp(), "modes": modes})
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_atomic(path, lambda target: Path(target).write_text(text))
+    except OSError:
+        pass  # a read-only cache: the modes are found again next time

@@ -1,0 +1,1 @@
+"""Sweep results in a Zarr store."""

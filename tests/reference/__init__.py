@@ -1,0 +1,1 @@
+"""The slow reference implementation, written from the equations alone."""

@@ -1,0 +1,1 @@
+"""What several test modules share: small cases, the command line, CF checks."""
