@@ -19,13 +19,21 @@ import tomllib
 import numpy as np
 
 from fivdisc import examples
-from fivdisc._kernels import integrate as kern
-from fivdisc._kernels import slots
+from fivdisc.core import slots
 from fivdisc.case import Case, load_case
 from fivdisc.core import _core
-from fivdisc.integration import Integration, tangent_step
-from fivdisc.model import build_model
-from fivdisc.simulate import initial_state
+from fivdisc.engine.integration import Integration, tangent_step
+from fivdisc.model.build import build_model
+from fivdisc.engine.equilibrium import initial_state
+
+
+def _spread(base: dict, count: int) -> dict:
+    """``base`` with ``count`` copies of its slider spread around the disc."""
+    case = {k: v for k, v in base.items() if k != "slider"}
+    slider = base.get("slider", {})
+    case["sliders"] = [{**slider, "angle": 2 * np.pi * j / count + 0.05 * j}
+                       for j in range(count)]
+    return case
 
 CHUNKS = 200
 TOL_TIME = 1e-12
@@ -167,8 +175,6 @@ def cases(span):
             continue
         sim = case.simulation
         yield path.stem, case.replace({"simulation.duration": min(span, sim.duration)}), False
-    from bench_family import _spread
-
     stick = {"simulation": {"duration": span, "output_rate": 1000.0}}
     for count in (2, 4, 8):
         yield f"stick-slip x{count}", Case(**_spread(stick, count)), False

@@ -15,15 +15,14 @@ import time
 import tomllib
 
 import numpy as np
-from bench_family import _spread
-from compare_core import core_model
+from compare_core import _spread, core_model
 
 from fivdisc import Case, examples
-from fivdisc._kernels import slots
+from fivdisc.core import slots
 from fivdisc.core import _core
-from fivdisc.integration import Integration, tangent_step
-from fivdisc.model import build_model
-from fivdisc.simulate import initial_state
+from fivdisc.engine.integration import Integration, tangent_step
+from fivdisc.model.build import build_model
+from fivdisc.engine.equilibrium import initial_state
 
 clock = time.thread_time
 
