@@ -241,7 +241,8 @@ void phases_of(const Model& m, const IntArray& ph, const IntArray& sg, std::vect
     }
 }
 
-nb::dict aux_dict(const Model& m, const SliderAux<double>& a) {
+nb::dict aux_dict(const Model& m, const Work<double>& wk) {
+    const SliderAux<double>& a = wk.aux;
     nb::dict out;
     auto put = [&](const char* name, const std::vector<double>& v) {
         double* p;
@@ -256,6 +257,16 @@ nb::dict aux_dict(const Model& m, const SliderAux<double>& a) {
     put("relative_speed", a.v);
     put("gpq", a.gpq);
     put("phi_dot", a.phid);
+    double* g;
+    double* gp;
+    Out ga = new_array({static_cast<size_t>(m.S), static_cast<size_t>(m.n)}, &g);
+    Out gpa = new_array({static_cast<size_t>(m.S), static_cast<size_t>(m.n)}, &gp);
+    for (size_t i = 0; i < wk.g.size(); ++i) {
+        g[i] = wk.g[i];
+        gp[i] = wk.gp[i];
+    }
+    out["g"] = ga;
+    out["g_prime"] = gpa;
     return out;
 }
 
@@ -345,11 +356,12 @@ NB_MODULE(_core, m) {
               Out out = new_array({static_cast<size_t>(L.size)}, &dy);
               Work<double> wk(M);
               evaluate<double, double>(M, t, y.data(), L.size, p.data(), s.data(), right, wk, dy);
-              return nb::make_tuple(out, aux_dict(M, wk.aux));
+              return nb::make_tuple(out, aux_dict(M, wk));
           },
           "model"_a, "t"_a, "y"_a, "phases"_a, "signs"_a, "right"_a = true,
           "(rhs, aux): the time derivative and a dict of per-slider arrays: normal_force [N], "
-          "friction_force [N], w [m], w_rate [m/s], relative_speed [rad/s], gpq, phi_dot [rad/s].");
+          "friction_force [N], w [m], w_rate [m/s], relative_speed [rad/s], gpq, phi_dot [rad/s], and "
+          "(S, n) arrays g and g_prime: the mode shapes at each slider and their angular derivatives.");
 
     m.def("event_values",
           [](const PyModel& pm, double t, const Array& y, const IntArray& ph, const IntArray& sg, bool right) {
