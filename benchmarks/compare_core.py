@@ -19,12 +19,11 @@ import tomllib
 import numpy as np
 
 from fivdisc import examples
-from fivdisc.core import slots
 from fivdisc.case import Case, load_case
-from fivdisc.core import _core
+from fivdisc.core import _core, slots
+from fivdisc.engine.equilibrium import initial_state
 from fivdisc.engine.integration import Integration, tangent_step
 from fivdisc.model.build import build_model
-from fivdisc.engine.equilibrium import initial_state
 
 
 def _spread(base: dict, count: int) -> dict:

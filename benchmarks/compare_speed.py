@@ -15,14 +15,13 @@ import time
 import tomllib
 
 import numpy as np
-from compare_core import _spread, core_model
 
+from compare_core import _spread, core_model
 from fivdisc import Case, examples
-from fivdisc.core import slots
-from fivdisc.core import _core
+from fivdisc.core import _core, slots
+from fivdisc.engine.equilibrium import initial_state
 from fivdisc.engine.integration import Integration, tangent_step
 from fivdisc.model.build import build_model
-from fivdisc.engine.equilibrium import initial_state
 
 clock = time.thread_time
 

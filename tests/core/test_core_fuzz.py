@@ -74,14 +74,12 @@ def test_random_models_and_states_never_crash():
         y0 = np.array([_value(rng, 1e-3) for _ in range(nd + energy)])
         phases = rng.integers(0, 3, size=model.n_sliders)
         signs = rng.choice([-1, 1], size=model.n_sliders)
-        with np.errstate(all="ignore"):
-            for call in (lambda: _core.rhs(model, 0.1, y0, phases, signs),
-                         lambda: _core.evaluate(model, 0.1, y0, phases, signs, False),
-                         lambda: _core.jacobian(model, 0.0, y0, phases, signs),
-                         lambda: _core.jvp(model, 0.0, y0, y0[:nd], phases, signs),
-                         lambda: _core.unslaved(model, 0.0, y0, phases, signs, y0[None, :nd]),
-                         lambda: _core.event_values(model, 0.0, y0, phases, signs)):
-                call()
+        _core.rhs(model, 0.1, y0, phases, signs)
+        _core.evaluate(model, 0.1, y0, phases, signs, False)
+        _core.jacobian(model, 0.0, y0, phases, signs)
+        _core.jvp(model, 0.0, y0, y0[:nd], phases, signs)
+        _core.unslaved(model, 0.0, y0, phases, signs, y0[None, :nd])
+        _core.event_values(model, 0.0, y0, phases, signs)
         run = _core.Integrator(model, y0, phases, t_final=float(rng.uniform(0, 0.05)),
                                rtol=10.0 ** rng.uniform(-10, -2), atol=1e-9,
                                max_step=float(rng.choice([0.0, 1e-4])), out_dt=1e-3,
@@ -169,9 +167,6 @@ def test_bad_input_is_refused_in_one_line():
 
 
 def test_a_huge_model_is_refused_before_any_work():
-    disc = np.zeros((10, 1))
-    disc[0], disc[2], disc[3] = 1.0, -1, 1.0
-    slider = np.ones((16, 1))
     opts = np.zeros(13)
     opts[10] = 100000  # the largest l the core takes, over a very wide work array
     with pytest.raises(FivdiscError, match="too large"):

@@ -16,9 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
+from fivdisc import core
 from fivdisc.analysis.points import ParameterPoints, reduced_indices
 from fivdisc.analysis.stability import dominant_coordinates
-from fivdisc import core
 from fivdisc.case import Case
 from fivdisc.engine.equilibrium import Equilibrium, _evaluate, slip_phases
 from fivdisc.model.build import Model

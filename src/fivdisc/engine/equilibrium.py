@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fivdisc.case import Case
 from fivdisc import core
+from fivdisc.case import Case
 from fivdisc.errors import SimulationError
 from fivdisc.model import layout as lay
 from fivdisc.model.build import Model, build_model

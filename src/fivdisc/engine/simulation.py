@@ -8,8 +8,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from fivdisc.case import Case
 from fivdisc import core
+from fivdisc.case import Case
 from fivdisc.engine.conventions import fivdisc_version
 from fivdisc.engine.equilibrium import initial_state
 from fivdisc.engine.integration import STATUS, Integration, check_steps
