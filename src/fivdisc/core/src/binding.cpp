@@ -273,6 +273,9 @@ nb::dict aux_dict(const Model& m, const Work<double>& wk) {
 // The integrator, with a guard against a second call while one runs (the GIL is released).
 struct PyIntegrator {
     Integrator it;
+    // The samples' numpy arrays, which the integrator writes into (made by numpy, so
+    // that Python's memory accounting sees them).
+    nb::object out_y, out_aux;
     std::atomic<bool> busy{false};
     struct Guard {
         std::atomic<bool>& b;
@@ -590,7 +593,13 @@ NB_MODULE(_core, m) {
                  c.zeno_count = zeno_count;
                  c.stop_mask = stop_mask;
                  new (self) PyIntegrator{Integrator(M, std::vector<double>(y0.data(), y0.data() + L.size), p, c,
-                                                    n_out, br)};
+                                                    n_out, br), nb::none(), nb::none()};
+                 nb::object empty = nb::module_::import_("numpy").attr("empty");
+                 self->out_y = empty(nb::make_tuple(n_out, L.size));
+                 self->out_aux = empty(nb::make_tuple(n_out, self->it.cols.width()));
+                 using Rows = nb::ndarray<double, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
+                 self->it.attach_output(nb::cast<Rows>(self->out_y).data(),
+                                        nb::cast<Rows>(self->out_aux).data());
              },
              "model"_a, "y0"_a, "phases"_a, nb::kw_only(), "t_final"_a, "rtol"_a, "atol"_a, "max_step"_a = 0.0,
              "out_dt"_a = INFINITY, "n_out"_a = 0, "max_switches"_a = 1e18, "zeno_dt"_a = 1e-10,
@@ -724,19 +733,10 @@ NB_MODULE(_core, m) {
                          return res;
                      },
                      "A copy of every slider's slip sign.", nb::rv_policy::automatic)
-        .def_prop_ro("out_y",
-                     [](nb::handle_t<PyIntegrator> h) {
-                         PyIntegrator& s = nb::cast<PyIntegrator&>(h);
-                         const size_t shape[2] = {static_cast<size_t>(s.it.n_out), static_cast<size_t>(s.it.L.size)};
-                         return Out(s.it.out_y.get(), 2, shape, h);
-                     },
-                     "The state samples (n_out, size), a view; rows past n_samples are not written.", nb::rv_policy::automatic)
-        .def_prop_ro("out_aux",
-                     [](nb::handle_t<PyIntegrator> h) {
-                         PyIntegrator& s = nb::cast<PyIntegrator&>(h);
-                         const size_t shape[2] = {static_cast<size_t>(s.it.n_out),
-                                                  static_cast<size_t>(s.it.cols.width())};
-                         return Out(s.it.out_aux.get(), 2, shape, h);
-                     },
-                     "Per-sample columns (n_out, 4 S + 1), a view: N_j, f_j, phase_j, w_j, then Omega.", nb::rv_policy::automatic);
+        .def_prop_ro("out_y", [](PyIntegrator& s) { return s.out_y; },
+                     "The state samples (n_out, size), a numpy array the integrator writes into; "
+                     "rows past n_samples are not written.")
+        .def_prop_ro("out_aux", [](PyIntegrator& s) { return s.out_aux; },
+                     "Per-sample columns (n_out, 4 S + 1), as out_y: N_j, f_j, phase_j, w_j, then "
+                     "Omega.");
 }

@@ -59,10 +59,12 @@ class Integrator {
     std::vector<double> k;   // (7, size): the stages; k[0] the right-hand side at y
     std::vector<double> ev_prev;  // event values at y
     std::vector<double> breaks;   // kinks of the speed profile, increasing
-    // Samples, left uninitialised (like numpy.empty: pages never written are never
-    // committed): (n_out, size) of the state, (n_out, cols.width()) per-slider N, f,
-    // phase, w, and Omega.
-    std::unique_ptr<double[]> out_y, out_aux;
+    // Samples (n_out rows): of the state, (n_out, size), and per slider N, f, phase, w,
+    // then Omega, (n_out, cols.width()). The caller's arrays (attach_output), or owned
+    // storage left uninitialised (like numpy.empty: pages never written are never
+    // committed).
+    double* out_y = nullptr;
+    double* out_aux = nullptr;
     int64_t n_out = 0;
     EventLog log;
     int event_capacity = 1 << 15;
@@ -78,8 +80,10 @@ class Integrator {
         sg.assign(M.S, 1);
         k.assign(static_cast<size_t>(7) * L.size, 0.0);
         ev_prev.assign(static_cast<size_t>(3) * M.S, 0.0);
-        out_y.reset(new double[static_cast<size_t>(n_out > 0 ? n_out : 1) * L.size]);
-        out_aux.reset(new double[static_cast<size_t>(n_out > 0 ? n_out : 1) * cols.width()]);
+        own_y.reset(new double[static_cast<size_t>(n_out > 0 ? n_out : 1) * L.size]);
+        own_aux.reset(new double[static_cast<size_t>(n_out > 0 ? n_out : 1) * cols.width()]);
+        out_y = own_y.get();
+        out_aux = own_aux.get();
         wk.init(M);
         sc.init(L.size, 3 * M.S);
     }
@@ -91,9 +95,19 @@ class Integrator {
         if (cnt.started) tangent_prepare(M, clk.t, y.data(), L.size, ph.data(), sg.data(), *tan);
     }
 
+    // Write the samples into the caller's arrays, (n_out, size) and (n_out, width), which
+    // must outlive the integrator's use of them; the owned storage is released.
+    void attach_output(double* y_rows, double* aux_rows) {
+        out_y = y_rows;
+        out_aux = aux_rows;
+        own_y.reset();
+        own_aux.reset();
+    }
+
     int advance(double t_target);
 
   private:
+    std::unique_ptr<double[]> own_y, own_aux;
     Work<double> wk;
     Scratch sc;
 
