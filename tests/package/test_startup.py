@@ -19,7 +19,7 @@ import pytest
 
 import fivdisc
 
-HEAVY = ("scipy.optimize", "xarray", "numba", "matplotlib", "dask")
+HEAVY = ("scipy.optimize", "xarray", "matplotlib", "dask")
 
 # Runs CODE (which may end the process, as click does after --help), then prints which
 # of HEAVY were imported, as the last line of stdout.
