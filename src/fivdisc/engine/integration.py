@@ -396,11 +396,6 @@ class Integration:
             )
         self.core.set_tangents(vectors)
 
-    @property
-    def tan(self) -> bool:
-        """Whether tangent vectors are carried."""
-        return bool(self.core.has_tangents)
-
     def tangents(self, slaved: bool = True) -> np.ndarray:
         """Current tangent vectors (rows); with ``slaved``, the rows of coordinates that
         follow the contact (``z``, ``zdot`` in contact) are filled in as the output
