@@ -334,8 +334,12 @@ def test_bad_simulation(simulation: dict[str, Any], key: str, value: str) -> Non
     assert _error(simulation=simulation).startswith(f"{key} = {value} is invalid")
 
 
-def test_rtol_range_is_stated() -> None:
-    assert _error(simulation={"rtol": 0.2}).endswith("must lie in (0, 0.1]")
+def test_tolerance_ranges_are_stated() -> None:
+    assert _error(simulation={"rtol": 0.2}).endswith("must lie in [1e-15, 0.1]")
+    # A subnormal tolerance reached the kernel and divided by zero (found by the generated
+    # cases of tests/cli/test_errors_are_one_line.py).
+    assert _error(simulation={"atol": 5e-324}).endswith("must be >= 1e-30")
+    assert _error(simulation={"rtol": 1e-300}).endswith("must lie in [1e-15, 0.1]")
 
 
 def test_probe_on_the_edges_is_valid() -> None:

@@ -158,9 +158,10 @@ def test_torus_points_lie_where_independent_solves_cross_the_unit_circle():
 def test_an_interrupted_continuation_keeps_its_branch(rigid_orbit, tmp_path, monkeypatch):
     """Ctrl-C during the walk ends it as a time budget does: the points so far are the
     branch (the API returns it, the command writes it and exits 130)."""
-    from fivdisc.analysis import continuation
+    from fivdisc.continuation.problem import OrbitProblem
+    from fivdisc.continuation.settings import INTERRUPTED
 
-    step_from = continuation._Branch.step_from
+    step_from = OrbitProblem.step_from
     calls = {"n": 0}
 
     def interrupted_later(self, a, s, deadline):
@@ -169,9 +170,9 @@ def test_an_interrupted_continuation_keeps_its_branch(rigid_orbit, tmp_path, mon
             raise KeyboardInterrupt
         return step_from(self, a, s, deadline)
 
-    monkeypatch.setattr(continuation._Branch, "step_from", interrupted_later)
+    monkeypatch.setattr(OrbitProblem, "step_from", interrupted_later)
     br = continue_orbit(RIGID, "speed.value", 3.0, orbit=rigid_orbit, max_points=20)
-    assert br.stop_reason == continuation.INTERRUPTED
+    assert br.stop_reason == INTERRUPTED
     assert len(br) == 4
     for p, period in zip(br.parameter, br.period, strict=True):
         assert period == pytest.approx(rigid_disc_closed_form(p)[0], rel=1e-9)

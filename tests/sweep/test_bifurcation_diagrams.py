@@ -477,7 +477,7 @@ def test_command_runs_the_sweep_and_draws_the_diagram(diagram, sweep_file) -> No
     # the dots are the stored values: 4 maxima at each of the 3 speeds
     xs, ys = top.lines[0].get_data()
     assert len(xs) == 12 and set(np.round(xs, 9)) == {0.8, 1.0, 1.2}
-    from fivdisc.sweep.bifurcation import _DOT
+    from fivdisc.plots.sweep import _DOT
 
     assert top.lines[0].get_markersize() > 2 * _DOT  # few values: visible markers
     np.testing.assert_array_equal(ys, open_sweep(store)["phi_maxima"].values.ravel())

@@ -83,8 +83,10 @@ class Simulation(Table):
     probes: tuple[Probe, ...] = field(((0.1, 0.0), (0.1, 1.0)))
     omega_dot_terms: Flag = True
     printed_gyroscopic_sign: Flag = False
-    rtol: Real = field(1e-6, gt=0, le=0.1)
-    atol: Real = field(1e-9, gt=0)
+    # Below these the error test is rounding: a relative tolerance under 1e-15 is below the
+    # spacing of doubles, and an absolute one under 1e-30 squares to underflow.
+    rtol: Real = field(1e-6, ge=1e-15, le=0.1)
+    atol: Real = field(1e-9, ge=1e-30)
     max_step: Real = field(0.0, "s", ge=0)
     max_switches: Count = field(10_000_000, ge=1)
     max_steps: Count = field(100_000_000, ge=1)

@@ -20,15 +20,15 @@ def checksummed(sweep: Sweep) -> list[str]:
     return [*names, "error"]
 
 
-def framed(token: bytes) -> bytes:
+def frame_token(token: bytes) -> bytes:
     return len(token).to_bytes(4, "little") + token
 
 
-NAN_TOKEN = framed(b"nan")
-BOOL_TOKENS = np.array([framed(b"F"), framed(b"T")], dtype=object)
+NAN_TOKEN = frame_token(b"nan")
+BOOL_TOKENS = np.array([frame_token(b"F"), frame_token(b"T")], dtype=object)
 
 
-def tokens(column: np.ndarray) -> list[bytes]:
+def value_tokens(column: np.ndarray) -> list[bytes]:
     """What the checksum hashes of every value of a column, its length ahead (see
     :func:`checksums`): a boolean as T or F, a float as its little-endian bytes (nan for
     NaN), a section's values as their little-endian bytes (one NaN for every NaN), anything
@@ -48,7 +48,7 @@ def tokens(column: np.ndarray) -> list[bytes]:
             for i in np.flatnonzero(nan[:, 0]):
                 tokens[i] = NAN_TOKEN
         return tokens
-    return [framed(str(value).encode()) for value in column.tolist()]
+    return [frame_token(str(value).encode()) for value in column.tolist()]
 
 
 def checksums(digest: str, indices: Sequence[int], columns: Sequence[np.ndarray]
@@ -62,7 +62,7 @@ def checksums(digest: str, indices: Sequence[int], columns: Sequence[np.ndarray]
     """
     blake2b = hashlib.blake2b
     sums = np.empty(len(indices), dtype=np.uint64)
-    for k, (index, *row) in enumerate(zip(indices, *map(tokens, columns), strict=True)):
+    for k, (index, *row) in enumerate(zip(indices, *map(value_tokens, columns), strict=True)):
         head = f"{digest}:{index}".encode()
         sums[k] = int.from_bytes(blake2b(head + b"".join(row), digest_size=8).digest(),
                                  "little") or 1
