@@ -30,7 +30,6 @@ namespace fivdisc {
 // Scratch of the integrator, allocated once.
 struct Scratch {
     std::vector<double> ynew, ytmp, yout, dy, kst, rc, evn, evt, probes, ev_old, err_vec;
-    std::vector<double> ph_tmp;
     void init(int size, int n_ev) {
         ynew.assign(size, 0.0);
         ytmp.assign(size, 0.0);
