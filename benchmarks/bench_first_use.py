@@ -72,11 +72,12 @@ def _seconds(python: str, args: tuple[str, ...], env: dict[str, str], workdir: P
 
 
 def _fresh_install(home: Path) -> str:
-    """Python of a new virtual environment with the working tree installed."""
+    """Python of a new virtual environment with the working tree installed (with the
+    distributed extra, which `fivdisc sweep` needs)."""
     subprocess.run([sys.executable, "-m", "venv", str(home)], check=True)
     python = str(home / "bin" / "python")
     start = time.perf_counter()
-    subprocess.run([python, "-m", "pip", "install", "-q", str(REPO)], check=True)
+    subprocess.run([python, "-m", "pip", "install", "-q", f"{REPO}[distributed]"], check=True)
     print(f"pip install of the working tree: {time.perf_counter() - start:.0f} s", flush=True)
     return python
 
