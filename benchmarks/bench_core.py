@@ -6,7 +6,8 @@ kernel was numba (``previous.LAST_NUMBA``) is installed into its own virtual env
 there, outside the timings), and the two are timed in turns, ``--rounds`` times: 1, 2 and
 8 sliders, in stick-slip (Figs. 8-9 parameters spread around the disc) and in steady
 sliding (Fig. 4), plain and with 1, 2 and 4 tangent vectors (the step capped at
-``tangent_step``, as the analyses do). Each figure is the time per accepted step by the
+``tangent_step``, as the analyses do), and the paper's Fig. 10 case (decelerating disc)
+without and with its 10 kHz output. Each figure is the time per accepted step by the
 CPU time of the integrating thread (a machine busy with other work disturbs it far less
 than the wall time), the fastest of the rounds; the ratio core / numba is printed (the
 target is <= 1.0), the step counts of both (they must agree: the same steps), and the
@@ -50,8 +51,8 @@ _TIMER = textwrap.dedent(
     def steps_of(run):
         return run.stats["steps"] if hasattr(run, "stats") else int(run.ist[1])
 
-    def one(model, y0, span, vectors, cap):
-        run = Integration(model, y0, duration=span, max_step=cap)
+    def one(model, y0, span, vectors, cap, rate=0.0):
+        run = Integration(model, y0, duration=span, max_step=cap, output_rate=rate)
         if vectors:
             run.set_tangents(np.eye(vectors, model.state_size))
         start = time.thread_time()
@@ -70,6 +71,13 @@ _TIMER = textwrap.dedent(
                 cap = tangent_step(model) if vectors else None
                 one(model, y0, 0.01, vectors, cap)  # imports, and numba's compilation
                 out[f"{{label}} {{count}} {{vectors}}"] = one(model, y0, {span!r}, vectors, cap)
+    # The paper's Fig. 10 case (decelerating disc), without and with its 10 kHz output.
+    from fivdisc import load_case
+    model = build_model(load_case(examples.path("fig10")))
+    y0 = initial_state(model)
+    for label, rate in (("fig10", 0.0), ("fig10-10kHz", 10000.0)):
+        one(model, y0, 0.01, 0, None, rate)
+        out[f"{{label}} 1 0"] = one(model, y0, {span!r}, 0, None, rate)
     print(json.dumps(out))
     """
 )
