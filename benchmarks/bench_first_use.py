@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 import os
 import resource
+import shutil
 import statistics
 import subprocess
 import sys
@@ -42,8 +43,28 @@ COMMANDS: dict[str, tuple[str, ...]] = {
     "continue": ("continue", "fig13", "--key", "speed.value", "--to", "6.35", "--points",
                  "3", "--transient", "5", "--no-progress"),
     "stability": ("stability",),
-    "sweep": ("sweep", "sweep_fig27", "-o", "sweep.zarr", "--no-progress", "--workers", "2"),
+    "sweep": ("sweep", "small-sweep.toml", "-o", "sweep.zarr", "--no-progress", "--workers",
+              "2"),
 }
+# A sweep of 2 x 2 short runs of a decelerating disc, written into each working directory;
+# its store is removed before each run, so that every run computes every point.
+_SWEEP = """\
+[base.speed]
+profile = "decelerating"
+initial = 6.0
+duration = 5.0
+
+[base.simulation]
+duration = 0.2
+output_rate = 100.0
+
+[axes]
+"speed.initial" = "2.0:6.0:2"
+"speed.duration" = "5.0:20.0:2"
+
+[reduce]
+keep = ["separated"]
+"""
 # Processor time of each process timed, in order [s].
 CPU: list[float] = []
 
@@ -57,6 +78,8 @@ def _seconds(python: str, args: tuple[str, ...], env: dict[str, str], workdir: P
     """Wall time of one process running the command line with ``args`` [s]; its processor
     time (with its workers') goes to ``CPU``."""
     env = {**env, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+    (workdir / "small-sweep.toml").write_text(_SWEEP)
+    shutil.rmtree(workdir / "sweep.zarr", ignore_errors=True)
     cpu = _cpu()
     start = time.perf_counter()
     out = subprocess.run([python, "-c", _CLI, *args], env=env, cwd=workdir,
