@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -26,6 +27,10 @@ from fivdisc.model.build import Model, build_model
 if TYPE_CHECKING:
     import pandas as pd
 
+#: Difference of energy shares below which two modes' labels follow their frequencies
+#: (:func:`mode_labels`).
+LABEL_TIE = 0.1
+
 # Bytes per grid point of a stability map: growth rate and stability flag, and the
 # dataset's and the netCDF writer's copies of them.
 _GRID_BYTES = 3 * (8 + 1)
@@ -47,9 +52,28 @@ class LinearStability:
     eigenvectors : ndarray
         Right eigenvectors (columns), in the order of ``eigenvalues``.
     dominant : tuple of str
-        Per eigenvalue, the coordinate (``"C01"``, ..., ``"phi"``; ``"phi0"``,
-        ``"phi1"``, ... with several sliders) with the largest share of the
-        eigenvector's kinetic energy.
+        Per eigenvalue, its mode's label (:func:`mode_labels`): a coordinate
+        (``"C01"``, ..., ``"phi"``; ``"phi0"``, ``"phi1"``, ... with several sliders)
+        with a large share of the eigenvector's kinetic energy, a different one for
+        every mode (the two eigenvalues of a complex pair share theirs).
+
+    See Also
+    --------
+    linear_stability : Makes it.
+
+    Examples
+    --------
+    In the paper's Table 1 case (Figs. 8 and 9) the slider's own mode is unstable,
+    through the falling friction law, at about 222 Hz:
+
+    >>> import fivdisc
+    >>> stability = fivdisc.linear_stability(fivdisc.Case())
+    >>> stability.stable, stability.dominant[0]
+    (False, 'phi')
+    >>> print(f"{stability.max_growth_rate:.2f} 1/s at {stability.frequencies[0]:.2f} Hz")
+    239.69 1/s at 221.82 Hz
+    >>> stability.jacobian.shape  # (q, phi, qdot, phidot): 7 modal coordinates, 1 slider
+    (16, 16)
     """
 
     equilibrium: Equilibrium
@@ -78,7 +102,7 @@ class LinearStability:
         part (one of each complex pair), in order of decreasing growth rate.
 
         Columns: ``growth_rate`` [1/s] (the real part), ``frequency_hz`` [Hz] (the damped
-        frequency) and ``coordinate`` (the dominant one, see :attr:`dominant`).
+        frequency) and ``coordinate`` (its mode's label, :attr:`dominant`).
         """
         import pandas as pd
 
@@ -160,6 +184,38 @@ def linear_stability(case: Case | Model) -> LinearStability:
     Returns
     -------
     LinearStability
+        The equilibrium, the eigenvalues and eigenvectors, and the coordinate each
+        eigenvector moves most; ``print`` it for a table.
+
+    See Also
+    --------
+    perturbation_test : The paper's test of the same question by simulation.
+    stability_map : The largest growth rate over a grid of two case keys.
+    eigen_branches : The eigenvalues followed along one key.
+
+    Examples
+    --------
+    The paper's Table 1 case is unstable through its slider mode; more rotational
+    damping and a little disc damping make it stable:
+
+    >>> import fivdisc
+    >>> print(fivdisc.linear_stability(fivdisc.Case()))
+    sliding equilibrium at Omega = 6.28319 rad/s:
+      phi = 0.0104946 rad, N = 434.226 N, f = 209.893 N
+     growth rate [1/s]  frequency [Hz]  mode
+               239.687         221.823  phi
+              0.391607         411.434  C03
+              0.270571         274.007  C02
+             0.0153899         238.644  C00
+            -0.0595182         241.543  D01
+             -0.314983         180.853  C01
+             -0.346412         290.487  D02
+             -0.446632         441.789  D03
+    unstable (max growth 239.7 1/s)
+    >>> damped = fivdisc.Case(slider={"rotational_damping": 2.0}, disc={"damping_ratio": 0.01})
+    >>> stability = fivdisc.linear_stability(damped)
+    >>> print(stability.stable, f"{stability.max_growth_rate:.3f} 1/s", stability.dominant[0])
+    True -7.390 1/s C01
     """
     model = case if isinstance(case, Model) else build_model(case)
     eq = sliding_equilibrium(model)
@@ -168,18 +224,114 @@ def linear_stability(case: Case | Model) -> LinearStability:
     order = np.lexsort((-lam.imag, -lam.real))
     lam = lam[order]
     vec = vec[:, order]
-    return LinearStability(eq, jac, lam, vec, dominant_coordinates(model, vec))
+    return LinearStability(eq, jac, lam, vec, mode_labels(model, lam, vec))
 
 
-def dominant_coordinates(model: Model, vectors: np.ndarray) -> tuple[str, ...]:
-    """Per eigenvector (columns, variables ``(q, phi, qdot, phidot)``), the coordinate
-    with the largest share of its kinetic energy (``"C01"``, ..., ``"phi"``)."""
+def coordinate_names(model: Model) -> tuple[str, ...]:
+    """The model's coordinates in the order of the slip equations' variables: the disc's
+    modal coordinates (``"C00"``, ``"C01"``, ``"D01"``, ...), then the sliders' angles
+    (``"phi"``; ``"phi0"``, ``"phi1"``, ... with several sliders)."""
+    return (*model.labels, *_angle_names(model))
+
+
+def energy_shares(model: Model, vectors: np.ndarray) -> np.ndarray:
+    """``(coordinates, vectors)``: each coordinate's share of each eigenvector's kinetic
+    energy (columns sum to 1; variables ``(q, phi, qdot, phidot)``, coordinates as
+    :func:`coordinate_names`)."""
     size = model.n + model.n_sliders
     inertia = np.append(model.modal_mass, model.kernel.row("inertia"))
     # Velocity part of an eigenvector is lambda times its displacement part.
     energy = inertia[:, None] * np.abs(vectors[size:, :]) ** 2
-    names = (*model.labels, *_angle_names(model))
-    return tuple(names[i] for i in np.argmax(energy, axis=0))
+    total = energy.sum(axis=0)
+    return energy / np.where(total > 0, total, 1.0)
+
+
+def dominant_coordinates(model: Model, vectors: np.ndarray) -> tuple[str, ...]:
+    """Per eigenvector (columns, variables ``(q, phi, qdot, phidot)``), the coordinate
+    with the largest share of its kinetic energy (``"C01"``, ..., ``"phi"``). Two
+    eigenvectors may share one; :func:`mode_labels` names every mode apart."""
+    names = coordinate_names(model)
+    return tuple(names[i] for i in np.argmax(energy_shares(model, vectors), axis=0))
+
+
+def mode_labels(model: Model, eigenvalues: np.ndarray, vectors: np.ndarray
+                ) -> tuple[str, ...]:
+    """One label per eigenvalue, a different one for every mode: a complex pair is one
+    mode (both its eigenvalues get its label), a real eigenvalue another.
+
+    Each coordinate (:func:`coordinate_names`) names at most one mode: the modes are
+    matched to the coordinates so that the sum of the named coordinates' shares of the
+    modes' kinetic energy (:func:`energy_shares`) is largest (an assignment problem,
+    :func:`scipy.optimize.linear_sum_assignment`). The two modes of a disc mode with
+    nodal diameters, which the sliders mix into travelling waves, are then ``C0l`` and
+    ``D0l``, never both ``C0l``; identical pads' modes, each spread over every pad, are
+    ``phi0``, ``phi1``, ``phi2``. Where two modes' shares leave the choice open (they
+    would give up less than :data:`LABEL_TIE` of their shares by trading names: the two
+    halves of travelling waves, identical pads) the lower frequency takes the
+    coordinate listed first, so that labels do not turn on round-off. A mode left
+    without a coordinate (real eigenvalues
+    outnumber what is left: an overdamped coordinate has two) takes its dominant
+    coordinate's name with a prime per earlier use (``"phi0'"``).
+
+    Parameters
+    ----------
+    model : Model
+        The model the eigenvectors belong to.
+    eigenvalues : ndarray
+        ``(k,)`` complex eigenvalues of the slip equations.
+    vectors : ndarray
+        ``(2 (n + S), k)`` their right eigenvectors (columns).
+
+    Returns
+    -------
+    tuple of str
+        In the order of `eigenvalues`.
+    """
+    from scipy.optimize import linear_sum_assignment
+
+    lam = np.asarray(eigenvalues, dtype=complex)
+    names = coordinate_names(model)
+    scale = max(float(np.abs(lam).max(initial=0.0)), 1e-300)
+    # One representative per mode: the eigenvalue with a positive imaginary part of a
+    # pair, and each real eigenvalue; the other of a pair is its conjugate.
+    real = np.abs(lam.imag) <= 1e-12 * scale
+    modes = [i for i in range(lam.size) if real[i] or lam[i].imag > 0]
+    shares = energy_shares(model, vectors[:, modes])
+    rows, cols = linear_sum_assignment(-shares)
+    coordinate = dict(zip(cols.tolist(), rows.tolist(), strict=True))  # mode -> coordinate
+    # Near-ties follow the frequencies: where two modes would give up less than
+    # LABEL_TIE of their shares by trading names (a travelling wave's C and D halves,
+    # identical pads), the lower frequency takes the coordinate listed first. The
+    # labels are then the same for eigenvectors equal to round-off, as the same
+    # eigenvalue met in two scans is.
+    order = [(abs(lam[i].imag), lam[i].real) for i in modes]
+    for _ in range(len(modes) ** 2):
+        swapped = False
+        for a, b in itertools.combinations(sorted(coordinate), 2):
+            ca, cb = coordinate[a], coordinate[b]
+            loss = shares[ca, a] + shares[cb, b] - shares[cb, a] - shares[ca, b]
+            if loss < LABEL_TIE and (order[a] < order[b]) != (ca < cb):
+                coordinate[a], coordinate[b] = cb, ca
+                swapped = True
+        if not swapped:
+            break
+    label = {modes[c]: names[r] for c, r in coordinate.items()}
+    used = {name: 1 for name in label.values()}
+    for k, i in enumerate(modes):
+        if i not in label:
+            base = names[int(np.argmax(shares[:, k]))]
+            label[i] = base + "'" * used.get(base, 0)
+            used[base] = used.get(base, 0) + 1
+    out = []
+    for i in range(lam.size):
+        if i in label:
+            out.append(label[i])
+        else:
+            # The lower eigenvalue of a pair: its conjugate's label.
+            partner = min((j for j in modes if not real[j]),
+                          key=lambda j: abs(lam[j] - np.conj(lam[i])))
+            out.append(label[partner])
+    return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -200,6 +352,17 @@ class PerturbationTest:
         ``log(final / initial) / duration`` [1/s], a rough envelope rate.
     decays : bool
         Whether the perturbation shrank.
+
+    See Also
+    --------
+    perturbation_test : Makes it.
+
+    Examples
+    --------
+    >>> import fivdisc
+    >>> test = fivdisc.perturbation_test(fivdisc.Case(), duration=0.05)
+    >>> print(test.decays, f"{test.initial_amplitude:.4f} -> {test.final_amplitude:.3f}")
+    False 0.0447 -> 0.490
     """
 
     initial_amplitude: float
@@ -218,6 +381,32 @@ def perturbation_test(case: Case, duration: float | None = None) -> Perturbation
     duration : float, optional
         Simulated time [s]; defaults to the case's ``simulation.duration``. Growth or decay
         slower than a few times 1/duration cannot be told apart from constancy.
+
+    Returns
+    -------
+    PerturbationTest
+        The perturbation's amplitude at the start and at the end, and whether it
+        decayed.
+
+    See Also
+    --------
+    linear_stability : The eigenvalues: growth rates however slow, without a
+        simulation.
+
+    Examples
+    --------
+    Over 50 ms the perturbation of the paper's Table 1 case grows into stick-slip, whose
+    amplitude the nonlinearity bounds (so the envelope rate is well below the
+    linearisation's 240 1/s), and dies out when the slider is damped:
+
+    >>> import fivdisc
+    >>> for damping in (0.1, 2.0):
+    ...     case = fivdisc.Case(slider={"rotational_damping": damping},
+    ...                         disc={"damping_ratio": 0.01})
+    ...     test = fivdisc.perturbation_test(case, duration=0.05)
+    ...     print(damping, test.decays, f"{test.growth_rate:.0f} 1/s")
+    0.1 False 48 1/s
+    2.0 True -77 1/s
     """
     from fivdisc.engine.simulation import simulate
 
@@ -279,6 +468,30 @@ def stability_map(
         boundary exactly, as curves. Attributes ``x_key``,
         ``y_key`` and (with `curves`) ``curve_key`` name the axes; the CF global
         attributes and the base case's TOML (``case``) are there too.
+
+    See Also
+    --------
+    stability_boundary : The boundary traced as curves, to the root finder's
+        tolerance, instead of sampled on a grid.
+    fivdisc.plots.plot_stability_map : Draws the map.
+
+    Examples
+    --------
+    A slider on a rigid disc (no modes) with the falling exponential friction law is
+    stable where its rotational damping ``c`` exceeds the friction's negative damping,
+    ``c > r^2 N0 alpha (mu_0 - mu_1) exp(-alpha r Omega) = 1.25 exp(-0.1 Omega)``
+    [N m s/rad]:
+
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []})
+    >>> grid = fivdisc.stability_map(rigid, ("speed.value", [2.0, 6.0, 10.0, 14.0]),
+    ...                              ("slider.rotational_damping", [0.25, 0.5, 1.0]))
+    >>> print(grid["stable"].values)
+    [[0 0 0 0]
+     [0 0 1 1]
+     [0 1 1 1]]
+    >>> print(grid["boundary"].values.round(4))  # the growth rate is linear in c here
+    [   nan 0.686  0.4598 0.3082]
     """
     axes = [(x[0], check_values("x", x[0], x[1])), (y[0], check_values("y", y[0], y[1]))]
     if curves:

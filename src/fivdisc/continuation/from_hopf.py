@@ -78,7 +78,9 @@ def hopf_cycles(
     Branch
         The branch of orbits from the Hopf point, with attributes ``hopf_value``,
         ``hopf_omega``, ``hopf_direction``, ``criticality`` (``"subcritical"`` or
-        ``"supercritical"``) and ``bistable_low``, ``bistable_high`` (nan if there is no
+        ``"supercritical"``, by the side the orbits lie on), ``hopf_l1`` and
+        ``hopf_l1_error`` (the point's first Lyapunov coefficient [s^2], whose sign
+        says the same for small orbits) and ``bistable_low``, ``bistable_high`` (nan if there is no
         bistable range) in its dataset, printed by ``str`` (see :meth:`Branch.hopf`).
 
     Raises
@@ -87,6 +89,13 @@ def hopf_cycles(
         A bad argument (one line, before any work).
     ConvergenceError
         The first orbit does not converge (take a smaller `amplitude`).
+
+    See Also
+    --------
+    fivdisc.hopf_points : The Hopf points of the sliding equilibrium along a key.
+    fivdisc.periodic_orbit : One orbit by shooting, from a transient run.
+    fivdisc.continue_orbit : A branch from an orbit found by shooting (a stick-slip
+        orbit, say) instead of from a Hopf point.
 
     Notes
     -----
@@ -109,6 +118,28 @@ def hopf_cycles(
     undetermined (``bistable_undetermined``): its unstable orbits bound the equilibrium's
     basin, and the motion beyond them may be a stable vibration coexisting with it. The
     equilibrium's stability beyond other Hopf points of the key is not checked.
+
+    Examples
+    --------
+    A slider on a rigid disc (no modes): sliding turns stable above the Hopf point at
+    9.1629 rad/s, and the small slipping orbits born there lie on that side and are
+    unstable, a subcritical Hopf point. Their speed offset follows the averaged
+    closed form ``Omega - Omega_H = r alpha V^2 / 8`` in their rate amplitude ``V``, and
+    their period starts at ``2 pi / omega``:
+
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> (hopf,) = fivdisc.hopf_points(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> cycles = fivdisc.hopf_cycles(hopf, 19.0, max_points=3)
+    >>> cycles.hopf()["criticality"], bool(cycles.stable.any())
+    ('subcritical', False)
+    >>> ds = cycles.dataset
+    >>> rate = 0.5 * float(ds["phi_dot_max"][0, 0] - ds["phi_dot_min"][0, 0])  # V [rad/s]
+    >>> print(f"{cycles.parameter[0] - hopf.value:.2e} {0.1 * rate**2 / 8:.2e}")
+    1.05e-04 1.05e-04
+    >>> print(f"{cycles.period[0] / (2 * np.pi / hopf.omega):.6f}")
+    1.000000
     """
     if not (np.isfinite(amplitude) and 0 < amplitude <= 0.5):
         raise FivdiscError(f"amplitude = {amplitude!r} is invalid: must be in (0, 0.5], a "
@@ -136,12 +167,34 @@ def hopf_cycles(
     return result
 
 
-def _judge(result: Branch, hopf: HopfPoint) -> None:
-    """The Hopf point's kind and the bistable range, in the branch's attributes."""
+def restate_hopf(result: Branch, source: Branch) -> None:
+    """Give `result`, which continues `source` (a branch from
+    :func:`hopf_cycles`, or itself such a continuation), the Hopf point's kind and the
+    bistable range over both branches' orbits (what ``fivdisc continue --from hopf.nc``
+    prints); nothing if `source` is not from a Hopf point."""
+    import types
+
+    info = source.hopf()
+    if info is None:
+        return
+    hopf = types.SimpleNamespace(**{k: info[k] for k in (
+        "value", "omega", "direction", "on_boundary", "mode", "unstable_modes", "l1",
+        "l1_error")})
+    _judge(result, hopf, earlier=info)
+    result.dataset.attrs["hopf_continued"] = 1
+
+
+def _judge(result: Branch, hopf: Any, earlier: dict[str, Any] | None = None) -> None:
+    """The Hopf point's kind and the bistable range, in the branch's attributes; for a
+    branch that continues another from the Hopf point, `earlier` is that one's
+    :meth:`~fivdisc.continuation.branch.Branch.hopf`: its kind stands, and its range
+    joins this branch's."""
     p = result.parameter
     unstable_side = float(hopf.direction)
     side = np.sign(p[0] - hopf.value)
     kind = "supercritical" if side == unstable_side else "subcritical"
+    if earlier is not None:
+        kind = earlier["criticality"]
     # Orbits on the side where the equilibrium is stable, and stable themselves.
     stable_side = (p - hopf.value) * unstable_side < 0
     coexist = list(p[result.stable & stable_side])
@@ -156,6 +209,11 @@ def _judge(result: Branch, hopf: HopfPoint) -> None:
     folds = [b["parameter"] for b in result.bifurcations()
              if b["kind"] == "fold" and (b["parameter"] - hopf.value) * unstable_side < 0
              and any(result.stable[i] for i in (b["point"], b["point"] + 1) if i < n)]
+    if earlier is not None and np.isfinite(earlier["bistable"][0]):
+        # The earlier branch's range: its end away from the Hopf point, a bound if it was.
+        low, high = earlier["bistable"]
+        far = low if high == hopf.value else high
+        (grazing if earlier["bistable_open"] else folds).append(far)
     coexist = np.array(coexist + grazing + folds)
     open_end = False
     if hopf.on_boundary and coexist.size:
@@ -170,6 +228,12 @@ def _judge(result: Branch, hopf: HopfPoint) -> None:
     undetermined = bool(hopf.on_boundary and kind == "subcritical" and not coexist.size)
     result.dataset.attrs.update({"hopf_value": hopf.value, "hopf_omega": hopf.omega,
                                  "hopf_direction": hopf.direction, "criticality": kind,
+                                 "hopf_l1": getattr(hopf, "l1", np.nan),
+                                 "hopf_l1_error": getattr(hopf, "l1_error", np.nan),
                                  "bistable_low": low, "bistable_high": high,
                                  "bistable_open": int(open_end),
-                                 "bistable_undetermined": int(undetermined)})
+                                 "bistable_undetermined": int(undetermined),
+                                 "hopf_on_boundary": int(hopf.on_boundary),
+                                 "hopf_mode": str(getattr(hopf, "mode", "")),
+                                 "hopf_unstable_modes": ", ".join(
+                                     getattr(hopf, "unstable_modes", ()))})
