@@ -85,7 +85,7 @@ def simulate(
     switches: 18, separations: 0, impacts: 0
     peak normal force: 668.6... N, largest |w| at probes: 0.00434... m
     note: the disc deflected by up to 4.34 mm, 2.17 times its thickness h = 2 mm; ...
-    wall time: ... s (integration only, without compiling the kernel)
+    wall time: ... s (integration only)
 
     A kick of the first disc mode's velocity makes the slider leave the disc; stop the
     run there:
