@@ -353,6 +353,17 @@ class Integration:
         """Whether :data:`ZENO_RATE_COUNT` consecutive events among the latest fall within
         :data:`ZENO_RATE_SPAN` of simulated time."""
         new = self.ev_times[-1].size
+        # A window that holds a new event lies after the first new event's time less the
+        # span: count the events there first (most calls stop here, having looked at the
+        # last few chunks only).
+        cutoff = self.ev_times[-1][0] - ZENO_RATE_SPAN
+        near = 0
+        for chunk in reversed(self.ev_times):
+            near += chunk.size - int(np.searchsorted(chunk, cutoff))
+            if chunk[0] < cutoff or near >= ZENO_RATE_COUNT:
+                break
+        if near < ZENO_RATE_COUNT:
+            return False
         times, rows = self._recent(new + ZENO_RATE_COUNT - 1)
         if times.size < ZENO_RATE_COUNT:
             return False
