@@ -29,8 +29,12 @@ __all__ = [
     "MAX_NODAL_CIRCLES",
     "MAX_NODAL_DIAMETERS",
     "MAX_RASTER_SIDE",
+    "MAX_SHOOTING_RTOL",
+    "MAX_SHOOTING_TOL",
     "MAX_SLIDERS",
     "MIN_RADIUS_RATIO",
+    "MIN_SHOOTING_RTOL",
+    "MIN_SHOOTING_TOL",
     "available_memory",
     "check_memory",
     "check_raster",
@@ -47,6 +51,16 @@ MIN_RADIUS_RATIO = 1e-3
 #: their number, and a switch re-checks every slider (measured: 1.8 s to choose the
 #: phases at the start of 100 sliders, 0.2 s per 20 steps; 1000 never got past the start).
 MAX_SLIDERS = 100
+#: Integration tolerances a periodic orbit's shooting runs accept: below the lower, the
+#: error control asks for less than double precision's round-off (unbounded work); above
+#: the upper, as for ``simulation.rtol``, the integrator no longer resolves the dynamics.
+MIN_SHOOTING_RTOL = 1e-14
+MAX_SHOOTING_RTOL = 0.1
+#: Shooting residuals (relative to the orbit's size) an orbit may be converged to: above
+#: the upper, the first return of a transient already meets it (0.5 % on Table 1) and
+#: the "orbit" is a trajectory that does not close; below the lower, round-off.
+MIN_SHOOTING_TOL = 1e-14
+MAX_SHOOTING_TOL = 1e-4
 #: Largest raster side matplotlib's Agg renderer draws [pixels].
 MAX_RASTER_SIDE = 2**16 - 1
 # Share of the available memory one request may plan to use.

@@ -140,7 +140,7 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
     """
     values = check_values(option, key, values)
     check_keys(case, [key], [option])
-    check_box(case, [(key, values)])
+    check_box(case, [(key, values)], [option])
     points = ParameterPoints(case, [key])
     points.require_equilibrium((values[0],), option)
     size, ns = points.size, points.base.n_sliders

@@ -16,17 +16,27 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from fivdisc.analysis.points import ParameterPoints, reduced_indices
+from fivdisc.analysis.points import (
+    ParameterPoints,
+    check_jacobian,
+    reduced_indices,
+    slip_jacobian,
+)
 from fivdisc.analysis.stability import dominant_coordinates
 from fivdisc.case import Case
 from fivdisc.core import tangent as tan
-from fivdisc.engine.equilibrium import Equilibrium, _evaluate, slip_phases
+from fivdisc.engine.equilibrium import Equilibrium, _evaluate, sliding_equilibrium, slip_phases
+from fivdisc.errors import AnalysisError, SimulationError
 from fivdisc.model import layout as lay
 from fivdisc.model.build import Model
 
 # Relative tolerance of the located value of the key (Brent's method; the growth rate is
 # smooth in the key, so the root is found to about this, far inside the 1e-8 promised).
 KEY_TOLERANCE = 1e-12
+# Growth rates within this fraction of the largest eigenvalue's modulus are round-off: no
+# sign, no crossing (the eigenvalues are computed to about 2.2e-16 times it; an undamped
+# mode's growth rate of exactly 0 comes out as +-5e-13 beside a 3600 1/s slider rate).
+ROUND_OFF = 1e-12
 
 
 @dataclass(frozen=True)
@@ -122,11 +132,37 @@ def _full_layout(model: Model, eq: Equilibrium, vector: np.ndarray
 
 
 def _locate(points: ParameterPoints, key: str, lo: float, hi: float, lam_lo: complex,
-            lam_hi: complex, guess: Equilibrium) -> HopfPoint:
+            lam_hi: complex, guesses: list[Equilibrium], option: str) -> HopfPoint | None:
+    """The Hopf point between `lo` and `hi`, where the branch's eigenvalue goes from
+    `lam_lo` to `lam_hi`; None if the growth rates recomputed at the ends do not change
+    sign (a crossing at round-off level)."""
     from scipy.optimize import brentq
 
+    def linearise(value: float) -> tuple:
+        near = guesses if abs(value - lo) <= abs(value - hi) else guesses[::-1]
+        point = points.linearise((value,), near[0] if near else None)
+        if point is not None:
+            return point
+        # From the other end's equilibrium, or the rigid-disc guess: in a bracket spanning
+        # decades of the key the nearest end's may not converge.
+        model = points.model((value,))
+        for guess in [*near[1:], None]:
+            try:
+                eq = sliding_equilibrium(model, guess=guess)
+            except SimulationError as err:
+                failure = err
+                continue
+            jac = slip_jacobian(model, eq.state)
+            check_jacobian(model, jac, f"at {key} = {value:g}: ")
+            return model, eq, jac
+        raise AnalysisError(
+            f"{option} {key}: a complex pair crosses the imaginary axis between {lo:g} and "
+            f"{hi:g}, but the sliding equilibrium is not found at {value:g} in between "
+            f"({failure}); give values closer together there"
+        )
+
     def eig_near(value: float) -> tuple:
-        model, eq, jac = points.linearise((value,), guess)
+        model, eq, jac = linearise(value)
         lam, vec = np.linalg.eig(jac)
         t = (value - lo) / (hi - lo)
         i = int(np.argmin(np.abs(lam - (lam_lo + t * (lam_hi - lam_lo)))))
@@ -136,11 +172,16 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, lam_lo: com
         _, _, lam, _, i = eig_near(value)
         return float(lam[i].real)
 
+    if (growth(lo) < 0.0) == (growth(hi) < 0.0):
+        return None
     scale = max(abs(lo), abs(hi), abs(hi - lo))
     root = float(brentq(growth, lo, hi, xtol=KEY_TOLERANCE * scale, rtol=1e-15))
     model, eq, lam, vec, i = eig_near(root)
+    # The slope by a central difference, kept inside the bracket (a root at its end, such
+    # as a key's lowest allowed value, has no values beyond it).
     step = 1e-6 * abs(hi - lo)
-    rate = (growth(root + step) - growth(root - step)) / (2.0 * step)
+    a, b = max(min(lo, hi), root - step), min(max(lo, hi), root + step)
+    rate = (growth(b) - growth(a)) / (b - a)
     pick = i if lam[i].imag > 0 else int(np.argmin(np.abs(lam - np.conj(lam[i]))))
     others = np.delete(lam.real, [i, int(np.argmin(np.abs(lam - np.conj(lam[i]))))])
     state, vector = _full_layout(model, eq, vec[:, pick])
@@ -201,6 +242,10 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
     values = branches[key].values
     lam = branches["growth_rate"].values + 2j * np.pi * branches["frequency"].values
     points = ParameterPoints(case, [key])
+    with np.errstate(invalid="ignore"):
+        # Growth rates within round-off of zero have no sign (an undamped mode's are
+        # +-1e-13 at random): a crossing needs both sides beyond it.
+        noise = ROUND_OFF * np.nanmax(np.abs(lam), axis=1, initial=0.0)
     found = []
     for b in range(lam.shape[1]):
         re, im = lam[:, b].real, lam[:, b].imag
@@ -208,8 +253,12 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
             both = np.isfinite(re[i]) and np.isfinite(re[i + 1])
             if not both or (re[i] < 0.0) == (re[i + 1] < 0.0) or min(im[i], im[i + 1]) <= 0:
                 continue
-            guess = points.equilibrium(points.model((values[i],)))
-            found.append(_locate(points, key, values[i], values[i + 1], lam[i, b],
-                                 lam[i + 1, b], guess))
+            if abs(re[i]) <= noise[i] or abs(re[i + 1]) <= noise[i + 1]:
+                continue
+            guesses = [points.equilibrium(points.model((v,))) for v in values[i : i + 2]]
+            hopf = _locate(points, key, values[i], values[i + 1], lam[i, b], lam[i + 1, b],
+                           [g for g in guesses if g is not None], option)
+            if hopf is not None:
+                found.append(hopf)
     ascending = values[-1] > values[0]
     return sorted(found, key=lambda h: h.value, reverse=not ascending)

@@ -27,6 +27,7 @@ from os import PathLike
 
 import numpy as np
 
+from fivdisc.analysis.checks import check_tol
 from fivdisc.case import Case
 from fivdisc.engine.integration import Integration, tangent_step
 from fivdisc.errors import ConvergenceError, FivdiscError
@@ -531,7 +532,8 @@ def periodic_orbit(
         raise FivdiscError(f"periodic_orbit needs a constant disc speed (speed.profile = "
                            f"'constant'), not {case.speed.profile!r}: with a varying speed "
                            "the system is not autonomous and has no free period")
-    for name, value in (("tol", tol), ("window", window), ("time_budget", time_budget)):
+    check_tol("tol", tol)
+    for name, value in (("window", window), ("time_budget", time_budget)):
         _positive(name, value)
     if not (np.isfinite(rtol) and 0 < rtol < 1e-2):
         raise FivdiscError(f"rtol = {rtol!r} is invalid: must be in (0, 1e-2)")

@@ -13,7 +13,9 @@ import xarray as xr
 from fivdisc.analysis.points import (
     ParameterPoints,
     check_box,
+    check_jacobian,
     check_keys,
+    check_rates,
     check_values,
     slip_jacobian,
 )
@@ -160,10 +162,21 @@ def linear_stability(case: Case | Model) -> LinearStability:
     Returns
     -------
     LinearStability
+
+    Raises
+    ------
+    AnalysisError
+        A rate of the model too fast for its eigenvalues to decide stability
+        (:func:`~fivdisc.analysis.points.check_rates`), or a linearisation that is not
+        finite.
+    SimulationError
+        No sliding equilibrium.
     """
     model = case if isinstance(case, Model) else build_model(case)
+    check_rates(model)
     eq = sliding_equilibrium(model)
     jac = slip_jacobian(model, eq.state)
+    check_jacobian(model, jac)
     lam, vec = np.linalg.eig(jac)
     order = np.lexsort((-lam.imag, -lam.real))
     lam = lam[order]
@@ -291,8 +304,9 @@ def stability_map(
         f"a stability map of {' x '.join(str(len(v)) for _, v in axes)} points",
         "use fewer points per axis",
     )
-    check_keys(case, [key for key, _ in axes], ["x", "y", "curves"][: len(axes)])
-    check_box(case, axes)
+    names = ["x", "y", "curves"][: len(axes)]
+    check_keys(case, [key for key, _ in axes], names)
+    check_box(case, axes, names)
     cs = axes[2][1] if curves else [None]
     points = ParameterPoints(case, [key for key, _ in axes])
     growth = np.full((len(cs), ys.size, xs.size), np.nan)

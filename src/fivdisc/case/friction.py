@@ -125,6 +125,19 @@ class TableFriction(_FrictionLaw):
                 "values",
                 self.values,
             )
+        # The curve (monotone between the points, constant beyond) stays within the
+        # values: static friction is its upper limit, as for the other laws' kinetic
+        # coefficients.
+        top = max(range(len(self.values)), key=lambda i: self.values[i])
+        if self.static < self.values[top]:
+            raise rule(
+                f"must be >= every value of friction.values: friction.values[{top}] = "
+                f"{self.values[top]!r} at friction.speeds[{top}] = {self.speeds[top]!r} m/s "
+                "is above it (static friction is the upper limit of friction; a curve that "
+                'rises with speed beyond it: law = "stribeck" with viscous)',
+                "static",
+                self.static,
+            )
         return self
 
     def kinetic_at_rest(self) -> tuple[tuple[str, float], ...]:

@@ -12,6 +12,8 @@ from fivdisc.cli._case import CASE
 from fivdisc.continuation.settings import ContinuationSettings
 
 _DEFAULT = ContinuationSettings()
+# How the first orbit's search options are named in messages.
+_SEARCH_OPTIONS = ("--period", "--transient", "the search window", "--rtol")
 
 
 @click.command(name="continue")
@@ -170,9 +172,11 @@ def _start(case_file, from_file, which, key, target, rtol, transient, period):
     """The case, the orbit to start from (None: searched as fivdisc orbit does), the
     branch-switching direction, and the search's options; the key and the target are
     checked before any orbit is computed."""
+    from fivdisc.analysis.checks import check_period, check_time
     from fivdisc.analysis.orbits import periodic_orbit, saved_start
     from fivdisc.case import load_case
     from fivdisc.continuation.branch import CONTENT, open_branch
+    from fivdisc.continuation.checks import check_search
     from fivdisc.continuation.starts import doubled_start
     from fivdisc.errors import FivdiscError
 
@@ -181,7 +185,9 @@ def _start(case_file, from_file, which, key, target, rtol, transient, period):
     if from_file is None:
         if case is None:
             raise FivdiscError("continue needs CASE_FILE or --from FILE")
-        return _checked(case, key, target), None, None, search
+        _checked(case, key, target)
+        check_search(case, search, rtol, _SEARCH_OPTIONS)
+        return case, None, None, search
     from fivdisc.files import read_dataset
 
     if read_dataset(from_file, "--from").attrs.get("content") == CONTENT:
@@ -213,6 +219,9 @@ def _start(case_file, from_file, which, key, target, rtol, transient, period):
     if case is None:
         raise FivdiscError(f"--from {from_file} stores no case: give CASE_FILE")
     _checked(case, key, target)
+    if period is not None:  # no transient: the search starts from the file's state
+        check_time("--period", period)
+        check_period(case, period, "--period")
     orbit = periodic_orbit(case, state, period=period or saved_period, phases=phases,
                            rtol=rtol, start=start)
     return case, orbit, None, {}

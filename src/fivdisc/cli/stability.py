@@ -180,8 +180,17 @@ def _boundary(case, case_file, specs: tuple[str, str], output: Path | None) -> N
         _write(out, None, ds)
     curves = np.unique(ds["branch"].values)
     if curves.size == 0:
-        click.echo("no stability boundary in the box: the sliding equilibrium is "
-                   "stable or unstable throughout")
+        m = int(ds.attrs["seeds"])
+        counts = [(int(ds.attrs[f"seeds_{name}"]), words) for name, words in (
+            ("stable", "stable"), ("unstable", "unstable"),
+            ("without_equilibrium", "without a sliding equilibrium"))]
+        found = " and ".join(f"{words} at {n}" if n < m * m else f"{words} at all {n}"
+                             for n, words in counts if n)
+        spacing = ", ".join(f"{(hi - lo) / (m - 1):.3g} in {key}" for key, (lo, hi) in box)
+        click.echo(f"no stability boundary found at this resolution: the sliding equilibrium "
+                   f"is {found} of the {m} x {m} points of the seed grid (spacing {spacing}); "
+                   "a boundary around a region smaller than that is not seen: trace a "
+                   "smaller box to look closer")
     for b in curves:
         sel = ds["branch"].values == b
         freq = ds["frequency"].values[sel]
