@@ -38,6 +38,11 @@ class MissingExtraError(FivdiscError, ImportError):
     """An optional extra that a command or function needs is not installed."""
 
 
+class FivdiscWarning(UserWarning):
+    """Something the user should know before or after a long computation (its estimated
+    time, for one); the command line prints it as one line, ``warning: ...``."""
+
+
 def nearest(name: str, names: Iterable[str]) -> str:
     """The valid name closest to `name`, as the end of a message: ``"; did you mean
     'slider.mass'?"`` ("" if there are no names).

@@ -40,6 +40,7 @@ __all__ = [
     "check_raster",
     "check_simulation",
     "disc_problem",
+    "duration_words",
     "simulation_bytes",
 ]
 
@@ -82,6 +83,14 @@ def available_memory() -> int:
 
 def _size(nbytes: float) -> str:
     return f"{nbytes / _GiB:.3g} GiB"
+
+
+def duration_words(seconds: float) -> str:
+    """A duration in the unit a person reads it in: "40 s", "12 min", "3.2 h", "4.1 days"."""
+    for unit, size in (("days", 86400.0), ("h", 3600.0), ("min", 60.0)):
+        if seconds >= 2 * size:
+            return f"{seconds / size:.2g} {unit}"
+    return f"{seconds:.2g} s"
 
 
 def check_memory(nbytes: float, what: str, change: str) -> None:

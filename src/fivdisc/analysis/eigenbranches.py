@@ -16,10 +16,17 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
-from fivdisc.analysis.points import ParameterPoints, check_box, check_keys, check_values
+from fivdisc.analysis.points import (
+    ParameterPoints,
+    check_box,
+    check_keys,
+    check_values,
+    warn_if_long,
+)
 from fivdisc.analysis.stability import dominant_coordinates
 from fivdisc.case import Case
 from fivdisc.engine.equilibrium import Equilibrium
+from fivdisc.limits import check_memory
 
 # Two branches' frequencies count as merged (a coupling) within this fraction of the
 # frequency: inside a flutter region of an undamped system they are equal, damping
@@ -139,10 +146,14 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
         value.
     """
     values = check_values(option, key, values)
+    check_memory(branch_bytes(case) * values.size, f"{option} with {values.size} values",
+                 "use fewer values")
     check_keys(case, [key], [option])
     check_box(case, [(key, values)], [option])
     points = ParameterPoints(case, [key])
     points.require_equilibrium((values[0],), option)
+    warn_if_long(points, (values[0],), values.size, f"eigenvalue branches along {key}",
+                 f"fewer values of {option}")
     size, ns = points.size, points.base.n_sliders
     lam = np.full((values.size, size), np.nan + 1j * np.nan)
     force = np.full((values.size, ns), np.nan)
@@ -183,6 +194,14 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
     which = [int(np.argmin(np.abs(raw - v))) for v in start]
     modes = dominant_coordinates(first_model, first_vectors[:, which])
     return _dataset(case, key, values, lam, modes, force, angle, limits)
+
+
+def branch_bytes(case: Case) -> float:
+    """Memory of :func:`eigen_branches` per value of the key [bytes]: the eigenvalues
+    (complex), their copy followed into branches, the dataset's growth rates and
+    frequencies, the equilibrium's forces and angles, and the netCDF writer's copies."""
+    size = 2 * (sum(1 if l == 0 else 2 for _, l in case.disc.modes) + len(case.sliders))
+    return 2.0 * (16 * 2 * size + 16 * size + 16 * len(case.sliders) + 8)
 
 
 def _last_valid(lam: np.ndarray, i: int) -> int:

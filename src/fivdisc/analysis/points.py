@@ -19,6 +19,7 @@ from fivdisc.case import Case
 from fivdisc.core import dynamics as dyn
 from fivdisc.engine.equilibrium import Equilibrium, sliding_equilibrium, slip_phases
 from fivdisc.errors import AnalysisError, CaseError, SimulationError
+from fivdisc.limits import duration_words
 from fivdisc.model import layout as lay
 from fivdisc.model.build import Model, build_model, model_at
 
@@ -138,6 +139,39 @@ def slip_jacobian(model: Model, state: np.ndarray) -> np.ndarray:
     jac = dyn.complex_step_jacobian(0.0, state, ph, sg, model.kernel_args)
     idx = reduced_indices(model)
     return jac[idx][:, idx]
+
+
+#: A scan estimated to take longer than this [s] says so before it starts (a
+#: :class:`~fivdisc.errors.FivdiscWarning` with the estimate).
+LONG_SCAN = 60.0
+# Scans of fewer points are not timed beforehand (a point takes milliseconds).
+_TIMED_SCAN = 1000
+
+
+def warn_if_long(points: ParameterPoints, values: Sequence[float], count: int,
+                 what: str, fewer: str) -> None:
+    """Warn (:class:`~fivdisc.errors.FivdiscWarning`) before a scan of `count` points
+    whose time, measured on one point at `values`, exceeds :data:`LONG_SCAN`. `what`
+    names the scan, `fewer` what takes less time."""
+    import time
+    import warnings
+
+    from fivdisc.errors import FivdiscWarning
+
+    if count < _TIMED_SCAN:
+        return
+    seconds = []
+    for _ in range(2):  # the first may load the kernel
+        start = time.perf_counter()
+        point = points.linearise(values)
+        if point is not None:
+            np.linalg.eigvals(point[2])
+        seconds.append(time.perf_counter() - start)
+    total = count * seconds[-1]
+    if total > LONG_SCAN:
+        warnings.warn(f"{what} of {count:,} points takes about {duration_words(total)} "
+                      f"({seconds[-1] * 1e3:.2g} ms a point, measured on its first); "
+                      f"{fewer} take less", FivdiscWarning, stacklevel=3)
 
 
 def check_keys(case: Case, keys: Sequence[str], options: Sequence[str]) -> None:

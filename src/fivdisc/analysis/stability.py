@@ -18,6 +18,7 @@ from fivdisc.analysis.points import (
     check_rates,
     check_values,
     slip_jacobian,
+    warn_if_long,
 )
 from fivdisc.case import Case, is_case_key, keys_like, unit_of
 from fivdisc.engine.equilibrium import Equilibrium, sliding_equilibrium
@@ -297,18 +298,16 @@ def stability_map(
     if curves:
         axes.append((curves[0], np.asarray(curves[1], dtype=float)))
     (xkey, xs), (ykey, ys) = axes[:2]
-    size = math.prod(len(values) for _, values in axes)
-    n = 2 * sum(1 if l == 0 else 2 for _, l in case.disc.modes) + 2
-    check_memory(
-        _GRID_BYTES * size + 16.0 * xs.size * n * n,
-        f"a stability map of {' x '.join(str(len(v)) for _, v in axes)} points",
-        "use fewer points per axis",
-    )
+    check_map_size(case, [len(values) for _, values in axes])
     names = ["x", "y", "curves"][: len(axes)]
     check_keys(case, [key for key, _ in axes], names)
     check_box(case, axes, names)
     cs = axes[2][1] if curves else [None]
     points = ParameterPoints(case, [key for key, _ in axes])
+    warn_if_long(points, [values[0] for _, values in axes],
+                 math.prod(len(values) for _, values in axes),
+                 f"a stability map of {' x '.join(str(len(v)) for _, v in axes)}",
+                 "fewer points per axis")
     growth = np.full((len(cs), ys.size, xs.size), np.nan)
     bar = None
     if progress:
@@ -386,6 +385,37 @@ def stability_map(
     )
 
 
+def check_map_size(case: Case, sizes: Sequence[int]) -> None:
+    """Refuse a stability map of `sizes` points per axis (x, y and curves) whose memory
+    exceeds what the machine has, before any axis' values are made."""
+    n = 2 * sum(1 if l == 0 else 2 for _, l in case.disc.modes) + 2 * len(case.sliders)
+    check_memory(
+        _GRID_BYTES * math.prod(sizes) + 16.0 * sizes[0] * n * n + 8.0 * sum(sizes),
+        f"a stability map of {' x '.join(str(size) for size in sizes)} points",
+        "use fewer points per axis",
+    )
+
+
+def range_size(text: str, option: str) -> int:
+    """How many values ``KEY=START:STOP:N`` or ``KEY=v1,v2,...`` gives, without making
+    them (so that a size can be checked before they are); a usage error if `text` is
+    neither."""
+    usage = f"{option} = {text!r} is invalid: write KEY=START:STOP:N or KEY=v1,v2,..."
+    spec = text.split("=", 1)[1] if "=" in text else None
+    if spec is None:
+        raise CaseError(usage)
+    if ":" not in spec:
+        return spec.count(",") + 1
+    parts = spec.split(":")
+    try:
+        count = int(parts[2]) if len(parts) == 3 else -1
+    except ValueError:
+        raise CaseError(usage) from None
+    if count < 1:
+        raise CaseError(usage)
+    return count
+
+
 def resolve_key(key: str, option: str) -> str:
     """Full dotted case key from a dotted key or an unambiguous last part (``decay``).
 
@@ -407,8 +437,10 @@ def resolve_key(key: str, option: str) -> str:
                     "(every key, with its unit: fivdisc examples default)")
 
 
-def parse_range(text: str, option: str) -> tuple[str, np.ndarray]:
-    """Parse ``KEY=START:STOP:N`` (inclusive linspace) or ``KEY=v1,v2,...``."""
+def parse_range(text: str, option: str, per_value: float = 8.0) -> tuple[str, np.ndarray]:
+    """Parse ``KEY=START:STOP:N`` (inclusive linspace) or ``KEY=v1,v2,...``; refuse N
+    values whose memory, `per_value` bytes each (the work they are for, default the
+    values alone), exceeds what the machine has, before they are made."""
     usage = f"{option} = {text!r} is invalid: write KEY=START:STOP:N or KEY=v1,v2,..."
     if "=" not in text:
         raise CaseError(usage)
@@ -417,7 +449,7 @@ def parse_range(text: str, option: str) -> tuple[str, np.ndarray]:
         if ":" in spec:
             start, stop, num = spec.split(":")
             count = int(num)
-            check_memory(8.0 * count, f"{option} with N = {count} values", "lower N")
+            check_memory(per_value * count, f"{option} with N = {count} values", "lower N")
             values = np.linspace(float(start), float(stop), count)
         else:
             values = np.array([float(v) for v in spec.split(",")])

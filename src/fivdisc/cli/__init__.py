@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import gc
 import sys
+import warnings
 
 import click
 
-from fivdisc.errors import FivdiscError
+from fivdisc.errors import FivdiscError, FivdiscWarning
 
 # Allocations between young collections, young collections per middle one, middle per
 # full one (Python's defaults: 700, 10, 10).
@@ -26,8 +27,26 @@ def _fail(message: str) -> None:
     sys.exit(2)
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning of fivdisc as one line, ``warning: ...``, on stderr (others are left to
+    Python's display)."""
+    if issubclass(category, FivdiscWarning):
+        click.echo(f"warning: {' '.join(str(message).split())}", err=True)
+    else:
+        _python_show(message, category, filename, lineno, file, line)
+
+
+_python_show = warnings.showwarning
+
+
 class _Group(click.Group):
     def invoke(self, ctx: click.Context):
+        with warnings.catch_warnings():
+            warnings.showwarning = _show_warning
+            warnings.simplefilter("always", FivdiscWarning)
+            return self._invoke(ctx)
+
+    def _invoke(self, ctx: click.Context):
         try:
             return super().invoke(ctx)
         except FivdiscError as exc:

@@ -107,11 +107,11 @@ def _write(out: Path, figure, ds) -> None:
 def _branches(case, case_file, x_spec: str, output: Path | None, progress: bool) -> None:
     import numpy as np
 
-    from fivdisc.analysis.eigenbranches import eigen_branches
+    from fivdisc.analysis.eigenbranches import branch_bytes, eigen_branches
     from fivdisc.analysis.hopf import hopf_points
     from fivdisc.analysis.stability import parse_range
 
-    key, values = parse_range(x_spec, "--x")
+    key, values = parse_range(x_spec, "--x", branch_bytes(case))
     out, figure = _target(case_file, output, "branches.nc")
     ds = eigen_branches(case, key, values, option="--x", progress=progress)
     hopf = hopf_points(case, key, values, option="--x", branches=ds)
@@ -203,9 +203,17 @@ def _boundary(case, case_file, specs: tuple[str, str], output: Path | None) -> N
 def _map(case, case_file, x_spec, y_spec, curve_spec, output, progress) -> None:
     import numpy as np
 
-    from fivdisc.analysis.stability import parse_range, stability_map
+    from fivdisc.analysis.stability import (
+        check_map_size,
+        parse_range,
+        range_size,
+        stability_map,
+    )
 
     out, figure = _target(case_file, output, "stability.nc")
+    specs = {"--x": x_spec, "--y": y_spec, **({"--curves": curve_spec} if curve_spec else {})}
+    # The map's size before any axis' values are made.
+    check_map_size(case, [range_size(spec, option) for option, spec in specs.items()])
     axes = {"--x": parse_range(x_spec, "--x"), "--y": parse_range(y_spec, "--y")}
     if curve_spec is not None:
         axes["--curves"] = parse_range(curve_spec, "--curves")

@@ -8,6 +8,17 @@ from fivdisc.case import Case, is_case_key
 from fivdisc.errors import CaseError, FivdiscError
 
 
+def full_key(key: str, option: str = "key") -> str:
+    """The dotted case key of `key`, which may be its last part alone (``normal_damping``
+    for ``slider.normal_damping``), as the stability scans take it; a one-line error for
+    an unknown or ambiguous one."""
+    if is_case_key(key):
+        return key
+    from fivdisc.analysis.stability import resolve_key
+
+    return resolve_key(key, option)
+
+
 def check_key(case: Case, key: str, option: str = "key") -> float:
     """The current value of a numeric case key, or a one-line error.
 

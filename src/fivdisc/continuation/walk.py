@@ -51,7 +51,7 @@ from fivdisc.analysis.orbits import (
 )
 from fivdisc.case import Case
 from fivdisc.continuation.branch import Branch
-from fivdisc.continuation.checks import check_search, check_target, check_window
+from fivdisc.continuation.checks import check_search, check_target, check_window, full_key
 from fivdisc.continuation.detection import (
     Bifurcation,
     bifurcation_record,
@@ -156,6 +156,7 @@ def continue_orbit(
     step below ``min_step`` ends the branch as lost.
     """
     settings = ContinuationSettings.of(settings, options)
+    key = full_key(key)
     p0 = check_target(case, key, to)
     if back_to is None:
         back_to = p0
