@@ -115,15 +115,14 @@ def _continue(case_file: Path | None, key: str, target: float, back_to: float | 
               from_file: Path | None, which: int | None, hopf_spec: str | None, points: int,
               step: float, max_step: float, transient: float | None, period: float | None,
               rtol: float, as_json: bool, output: Path | None, progress: bool) -> None:
-    from fivdisc.analysis.stability import resolve_key
-    from fivdisc.continuation.checks import check_key, check_window
+    from fivdisc.continuation.checks import check_key, check_window, full_key
     from fivdisc.continuation.settings import INTERRUPTED
     from fivdisc.continuation.walk import continue_orbit
     from fivdisc.errors import ConvergenceError, FivdiscError
     from fivdisc.files import check_output
 
     # A key's last part alone (normal_damping), as fivdisc stability takes it.
-    key = resolve_key(key, "--key")
+    key = full_key(key, "--key")
     inputs = [p for p in (case_file, from_file) if p is not None]
     out = check_output(output, "-o", (".nc",), inputs=inputs) if output else None
     if which is not None and from_file is None:
