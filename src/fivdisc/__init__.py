@@ -41,6 +41,7 @@ _API = {
     "fivdisc.analysis.stability": ("LinearStability", "PerturbationTest", "linear_stability",
                                    "perturbation_test", "stability_map"),
     "fivdisc.analysis.boundary": ("stability_boundary",),
+    "fivdisc.analysis.codimension": ("hopf_curves",),
     "fivdisc.analysis.eigenbranches": ("eigen_branches",),
     "fivdisc.analysis.hopf": ("HopfPoint", "hopf_points"),
     "fivdisc.analysis.spectra": ("Peaks", "Periodicity", "Spectrum", "classify",

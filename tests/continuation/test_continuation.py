@@ -321,14 +321,14 @@ def test_orbit_and_branch_files_round_trip(tmp_path):
 def test_a_branch_rewritten_through_xarray_keeps_its_checksum(rigid_branch, tmp_path):
     # The rigid disc's branch has no bifurcation: its text tables (kind, note, the
     # signatures) are empty, which once made xarray's rewrite change the file's checksum.
-    from test_result_files import _through_xarray
-
     from fivdisc.files import check_netcdf
+
+    from support.files import through_xarray
 
     assert not rigid_branch.bifurcations()
     path = tmp_path / "branch.nc"
     rigid_branch.to_netcdf(path)
-    copy = _through_xarray(path, tmp_path / "copy.nc")
+    copy = through_xarray(path, tmp_path / "copy.nc")
     assert check_netcdf(copy)
     again = open_branch(copy)
     assert again.to_dict() == open_branch(path).to_dict()

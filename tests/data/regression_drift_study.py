@@ -25,8 +25,8 @@ from fivdisc.case import Case
 from fivdisc.engine.simulation import simulate
 
 HERE = Path(__file__).parent
-sys.path.insert(0, str(HERE.parent))
-from test_regression import _drift  # noqa: E402
+sys.path.insert(0, str(HERE.parent / "engine"))
+from test_single_slider_unchanged import _drift  # noqa: E402
 
 
 def _run(case: Case, initial: np.ndarray) -> xr.Dataset:

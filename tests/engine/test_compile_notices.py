@@ -172,7 +172,7 @@ def test_simulate_command_announces_compilation(tmp_path, monkeypatch, quiet):
 def test_orbit_command_without_progress_announces_the_tangent_kernel(tmp_path, monkeypatch):
     """--no-progress hides the Newton iterations, not the minutes of a first compilation
     (the trial of stop 33 met a silent 4 min 42 s in ``fivdisc continue``)."""
-    from test_orbits import RIGID
+    from support.cases import RIGID
 
     monkeypatch.setattr(compilation, "needs_compiling", lambda dispatcher: True)
     monkeypatch.setattr("fivdisc.engine.split_compile._cores", lambda: 1)

@@ -25,6 +25,7 @@ from fivdisc.errors import AnalysisError, FivdiscError
 from fivdisc.files import CHECKSUM, check_netcdf
 
 from support.cli import run_cli
+from support.files import through_xarray
 
 SHORT = Case(simulation={"duration": 0.01, "output_rate": 1000.0})
 BOUND = 60.0  # [s]
@@ -121,13 +122,6 @@ def test_a_stability_map_is_checked_by_plot(tmp_path: Path) -> None:
     assert "map.nc is damaged: its data do not match the checksum" in line
 
 
-def _through_xarray(path: Path, copy: Path) -> Path:
-    """What a user does to look at a file and keep it: open it with xarray, write a copy."""
-    import xarray as xr
-
-    with xr.open_dataset(path) as ds:
-        ds.load().to_netcdf(copy)
-    return copy
 
 
 def test_a_result_rewritten_through_xarray_keeps_its_checksum(result_file: Path,
@@ -141,7 +135,7 @@ def test_a_result_rewritten_through_xarray_keeps_its_checksum(result_file: Path,
     simulate(load_case(examples.path("fig04")).replace({"simulation.duration": 0.05})
              ).to_netcdf(quiet)
     for path in (result_file, quiet):
-        copy = _through_xarray(path, tmp_path / f"copy-{path.name}")
+        copy = through_xarray(path, tmp_path / f"copy-{path.name}")
         assert check_netcdf(copy)
         assert open_result(copy) == open_result(path)
     with netCDF4.Dataset(quiet) as ds:

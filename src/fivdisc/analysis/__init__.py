@@ -1,5 +1,6 @@
-"""Analyses of the slider-on-disc system: equilibrium, stability, Hopf points, spectra,
-trajectories, energy, periodic orbits, Lyapunov exponents.
+"""Analyses of the slider-on-disc system: equilibrium, stability, Hopf points and their
+first Lyapunov coefficients, spectra, trajectories, energy, periodic orbits, Lyapunov
+exponents.
 
 The names below are imported on first use, so that importing one analysis module (say
 :mod:`fivdisc.analysis.spectra`) does not import the others.
@@ -12,8 +13,10 @@ _API = {
     "fivdisc.analysis.stability": ("LinearStability", "PerturbationTest", "linear_stability",
                                    "perturbation_test", "stability_map"),
     "fivdisc.analysis.boundary": ("stability_boundary",),
+    "fivdisc.analysis.codimension": ("hopf_curve_lines", "hopf_curves"),
     "fivdisc.analysis.eigenbranches": ("eigen_branches",),
     "fivdisc.analysis.hopf": ("HopfPoint", "hopf_points"),
+    "fivdisc.analysis.normalform": ("FirstLyapunov", "first_lyapunov", "lyapunov_coefficient"),
     "fivdisc.analysis.spectra": ("Peaks", "Periodicity", "Spectrum", "classify",
                                  "dominant_frequency", "find_peaks", "spectrum", "stft"),
     "fivdisc.analysis.trajectories": ("friction_trajectory", "phase_portrait",

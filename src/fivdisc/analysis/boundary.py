@@ -210,6 +210,34 @@ def stability_boundary(
     CaseError
         Non-numeric or repeated keys, an empty range, an end outside a key's allowed
         values, too few seeds, or no sliding equilibrium at the box's first corner.
+
+    See Also
+    --------
+    fivdisc.stability_map : The growth rate sampled on a grid of the two keys (with a
+        boundary interpolated in each column).
+    fivdisc.plots.plot_stability_boundary : Draws the curves.
+
+    Examples
+    --------
+    A slider on a rigid disc (no modes) with the falling exponential friction law loses
+    stability where its rotational damping ``c`` falls below
+    ``r^2 N0 alpha (mu_0 - mu_1) exp(-alpha r Omega) = 1.25 exp(-0.1 Omega)``
+    [N m s/rad]. The traced curve runs from the box's left side (Omega = 1 rad/s) to
+    its bottom (c = 0.2 N m s/rad), on that closed form:
+
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []})
+    >>> curve = fivdisc.stability_boundary(rigid, ("speed.value", (1.0, 20.0)),
+    ...                                    ("slider.rotational_damping", (0.2, 1.5)))
+    >>> speed, damping = curve["speed.value"].values, curve["slider.rotational_damping"].values
+    >>> print(f"{speed.min():.4f} to {speed.max():.4f} rad/s, "
+    ...       f"{damping.max():.4f} to {damping.min():.4f} N m s/rad")
+    1.0000 to 18.3258 rad/s, 1.1310 to 0.2000 N m s/rad
+    >>> bool(np.abs(damping - 1.25 * np.exp(-0.1 * speed)).max() < 1e-8)
+    True
+    >>> print(f"{curve['frequency'].values[0]:.2f} Hz")  # sqrt(k_phi / I) / 2 pi
+    225.08 Hz
     """
     xkey, ykey = x[0], y[0]
     xr_, yr_ = check_values("x", xkey, x[1]), check_values("y", ykey, y[1])
@@ -253,7 +281,12 @@ def zero_curves(g, seeds: int = 12, step: float = 0.02
         e = 1e-7
         grad = np.array([(g(seed + e * d) - g(seed - e * d)) / (2 * e)
                          for d in (np.array([1.0, 0.0]), np.array([0.0, 1.0]))])
-        along = np.array([-grad[1], grad[0]])
+        if np.all(np.isfinite(grad)) and np.any(grad):
+            along = np.array([-grad[1], grad[0]])
+        else:
+            # g is undefined or flat beside the seed (a jump, where g is defined on one
+            # side only): start across the seed's edge.
+            along = np.array([0.0, 1.0]) if edge[0] == "h" else np.array([1.0, 0.0])
         path, closed = _trace(g, seed, along, step)
         if not closed:
             backward, _ = _trace(g, seed, -along, step)

@@ -144,6 +144,30 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
         A key that is not a number of this case, fewer than two values, an empty range,
         values outside the key's allowed range, or no sliding equilibrium at the first
         value.
+
+    See Also
+    --------
+    fivdisc.hopf_points : Where a complex pair of the branches crosses the imaginary
+        axis, located.
+    fivdisc.linear_stability : The eigenvalues at one value.
+    fivdisc.plots.plot_eigen_branches : Draws them.
+
+    Examples
+    --------
+    A slider on a rigid disc (no modes) has one complex pair, its own mode at
+    ``sqrt(k_phi / I) / 2 pi`` = 225 Hz; as the disc speeds up the friction law flattens
+    and the pair's growth rate falls through zero:
+
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> branches = fivdisc.eigen_branches(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> branches["growth_rate"].dims, branches["mode"].values.tolist()
+    (('speed.value', 'branch'), ['phi', 'phi'])
+    >>> print(branches["max_growth_rate"].values.round(2))  # [1/s]
+    [ 315.52  168.95   60.37  -20.08  -79.67 -123.81 -156.52]
+    >>> print(branches["frequency"].values[:, 0].round(1))  # [Hz]
+    [219.4 223.5 224.9 225.1 224.7 224.2 223.7]
     """
     values = check_values(option, key, values)
     check_memory(branch_bytes(case) * values.size, f"{option} with {values.size} values",

@@ -68,6 +68,26 @@ class LyapunovSpectrum:
     transient, duration, interval : float
         Length of the transient, of the measurement and the re-orthonormalisation
         interval [s].
+
+    See Also
+    --------
+    lyapunov : Makes it.
+
+    Examples
+    --------
+    A slider on a rigid disc (no modes) near its stable sliding equilibrium: both
+    exponents of its mode tend to the eigenvalues' real part, -61.75 1/s.
+
+    >>> import fivdisc
+    >>> case = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5},
+    ...                     speed={"value": 12.0}, simulation={"initial_state": "equilibrium"})
+    >>> spectrum = fivdisc.lyapunov(case, n=2, transient=0.05, duration=0.2)
+    >>> print(spectrum.times.round(2), spectrum.running.shape)  # every 0.05 s
+    [0.05 0.1  0.15 0.2 ] (4, 2)
+    >>> print(spectrum.exponents.round(0), spectrum.uncertainty.round(2), spectrum.conclusive)
+    [-62. -62.] [0.15 0.15] [ True  True]
+    >>> spectrum.to_dict()["conclusive"]
+    [True, True]
     """
 
     exponents: np.ndarray
@@ -204,9 +224,27 @@ def lyapunov(
     Returns
     -------
     LyapunovSpectrum
+        The exponents, largest first, with their uncertainties and running estimates.
+
+    See Also
+    --------
+    fivdisc.periodic_orbit : A periodic orbit and its Floquet multipliers, whose
+        ``ln|multiplier| / T`` are the Lyapunov exponents of the orbit.
+    fivdisc.linear_stability : At a stable sliding equilibrium, the eigenvalues'
+        real parts are the exponents.
 
     Notes
     -----
+    **Method.** ``n`` tangent vectors, the columns of ``V``, are carried with the state
+    by the linearised equations and across every switch by its saltation matrix. Every
+    ``interval`` they are orthonormalised, ``V = Q R``, ``V <- Q``; with ``R^(k)`` the
+    factor at the k-th time ``t_k`` of the measurement (``k = 1 ... m``, ``t_m = T``),
+
+    .. math::
+
+        \lambda_i = \frac{1}{T} \sum_{k=1}^{m} l_i^{(k)}, \qquad
+        l_i^{(k)} = \ln \lvert R_{ii}^{(k)} \rvert.
+
     **Alignment.** From random vectors, the QR method measures the exponents only once
     the vectors have turned into the most expanding directions. Until then the k-th
     vector grows more slowly than ``lambda_k``, and the deficit decays like
@@ -218,12 +256,10 @@ def lyapunov(
     discarded. The transient serves both purposes: the trajectory forgets its start on
     it, and so do the vectors.
 
-    **Uncertainty.** With a set's per-interval logarithms ``l_i^(k) = ln|R_ii|`` at the
-    times ``t_k`` (``k = 1 ... m``, ``t_m = T``), its exponent is
-    ``lambda_i = sum_k l_i^(k) / T``. For ``n > 1`` two sets from independent random
-    starts give ``lambda_i^a`` and ``lambda_i^b``, and the reported exponent and the
-    terms below are those of their mean; for ``n = 1`` the last term is 0. Split into
-    ``B = min(10, m)`` equal blocks of rates ``lambda_i^(b)``, its standard error is
+    **Uncertainty.** For ``n > 1`` two sets of vectors from independent random starts
+    give ``lambda_i^a`` and ``lambda_i^b``, and the reported exponent and the terms below
+    are those of their mean; for ``n = 1`` the last term is 0. Split into
+    ``B = min(10, m)`` equal blocks of rates ``lambda_i^(b)``, the standard error is
     ``s_i = std_b(lambda_i^(b)) / sqrt(B)`` (sample standard deviation); the estimate
     over the second half is ``lambda_i'' = sum_(k > m/2) l_i^(k) / (T - t_(m/2))``, and
 
@@ -238,30 +274,57 @@ def lyapunov(
     Where the estimate only fluctuates the drift is of the size of ``s_i``. The last
     term is what the random start still does to the estimate: once both sets have
     aligned they are the same vectors and it vanishes, chaotic or not; while they align
-    their deficits differ. On three sliders at a stable equilibrium
-    (``tests/analysis/test_lyapunov_against_references.py``, exponents -1.15, -1.15,
-    -1.63, -1.63 1/s)
-    with a transient of 0.5 s, far too short to align, the second exponent over 3 s was
-    8 of ``sqrt(s^2 + drift^2)`` away from its limit, and is 2.3 of ``u`` away. The
-    largest exponent alone is computed from one start: it is what sweeps compute at
-    every point, and a second set of vectors would cost a third more (below), for a
-    direction that the first vector, the fastest to align, finds soonest.
+    their deficits differ. The largest exponent alone is computed from one start: it is
+    what sweeps compute at every point, and a second set of vectors would add to the
+    cost of each, for a direction that the first vector, the fastest to align, finds
+    soonest.
 
     **Limits.** A vector whose start had almost nothing along its direction measures the
     next exponent until it turns, steadily, after about ``ln(1/p) / (lambda_k -
     lambda_(k+1))`` for a start's component ``p``; if every start is like that (a
     direction that random vectors in the energy norm barely touch) no estimate from the
-    run sees it. On the stick-slip orbit of that test file the third exponent, -1.95
-    1/s, took 15-20 s to turn from the next, -2.14 1/s. Doubling the transient and
-    comparing is the check.
+    run sees it. Doubling the transient and comparing is the check.
 
-    **Cost.** The transient costs the tangent kernel instead of a plain run, and for
-    ``n > 1`` twice the vectors: a step with one tangent vector costs about 1.8 plain
-    steps, with two 2.4, with four 3.4 (``benchmarks/bench_tangent.py``). Measured on
-    that three-slider case with a transient as long as the measurement, one exponent
-    takes 1.6 and four 3.3 times as long as with one set of vectors started at the
-    measurement (1.8 of that is the alignment, the rest the second start); with a
-    transient of a fifth of it, 1.1 and 2.2 times.
+    **Cost.** The transient runs with the tangent vectors instead of a plain run, and
+    for ``n > 1`` with twice the vectors; each vector carried adds to the cost of a step
+    (``benchmarks/bench_tangent.py`` measures it). The documentation's tutorial
+    "Periodic orbits, Floquet multipliers and Lyapunov exponents" gives the measured
+    costs and the checks of the uncertainty against known exponents.
+
+    Examples
+    --------
+    At a stable sliding equilibrium the exponents are the real parts of the
+    linearisation's eigenvalues. A slider on a rigid disc (no modes), started near its
+    equilibrium at 12 rad/s, where its rotational damping exceeds the friction's
+    negative damping:
+
+    >>> import fivdisc
+    >>> case = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5},
+    ...                     speed={"value": 12.0}, simulation={"initial_state": "equilibrium"})
+    >>> spectrum = fivdisc.lyapunov(case, transient=0.05, duration=0.2)
+    >>> print(f"{spectrum.largest:.0f} +- {spectrum.uncertainty[0]:.1f} 1/s, "
+    ...       f"conclusive: {bool(spectrum.conclusive[0])}")
+    -62 +- 0.3 1/s, conclusive: True
+    >>> print(f"{fivdisc.linear_stability(case).max_growth_rate:.2f} 1/s")
+    -61.75 1/s
+
+    On a periodic orbit they are its Floquet exponents: here the stick-slip orbit of a
+    slider with constant kinetic friction on a disc of one axisymmetric mode, whose
+    first exponent (the flow direction's) is 0 and whose next two (the disc mode's
+    pair) are -4.726 1/s. Over 2 s the first is still inconclusive, its uncertainty
+    larger than itself:
+
+    >>> orbit_case = fivdisc.Case(
+    ...     disc={"modes": [[0, 0]]},
+    ...     slider={"rotational_damping": 0.0, "normal_damping": 5.0},
+    ...     friction={"kinetic_max": 0.5, "kinetic_min": 0.5},
+    ...     speed={"value": 1.0},
+    ... )
+    >>> print(fivdisc.lyapunov(orbit_case, n=3, transient=1.0, duration=2.0))
+    Lyapunov exponents over 2 s after a 1 s transient (QR every 0.05 s) [1/s]:
+      lambda_1 = ... +- 2...  (inconclusive)
+      lambda_2 = -4.7... +- 0.06...
+      lambda_3 = -4.7... +- 0.06...
     """
     sim = case.simulation
     transient = 0.2 * sim.duration if transient is None else transient

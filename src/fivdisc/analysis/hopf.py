@@ -5,17 +5,22 @@ crosses the imaginary axis: there the equilibrium gains or loses stability and a
 of small periodic orbits is born, with the pair's angular frequency and along its
 eigenvector. The crossings are bracketed on the eigenvalue branches of
 :func:`~fivdisc.analysis.eigenbranches.eigen_branches` and located with Brent's method on
-the real part of the eigenvalue that continues the branch.
+the real part of the eigenvalue that continues the branch. Each point carries its first
+Lyapunov coefficient (:mod:`fivdisc.analysis.normalform`), whose sign says whether the
+orbits born there are stable (supercritical) or a threshold around stable sliding
+(subcritical).
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
 
+from fivdisc.analysis.normalform import first_lyapunov
 from fivdisc.analysis.points import (
     ParameterPoints,
     check_jacobian,
@@ -77,6 +82,33 @@ class HopfPoint:
         The sliding equilibrium at the point.
     case : Case
         The base case with the key set to `value`.
+    l1 : float
+        First Lyapunov coefficient [s^2] per (rad/s)^2 of the slip-speed amplitude of
+        the slider that moves most (:func:`~fivdisc.analysis.normalform.first_lyapunov`):
+        negative supercritical, positive subcritical.
+    l1_error : float
+        Its estimated absolute error [s^2].
+
+    See Also
+    --------
+    hopf_points : Makes them.
+    fivdisc.hopf_cycles : The periodic orbits born at one.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> (point,) = fivdisc.hopf_points(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> point.key, point.mode, point.direction, point.on_boundary
+    ('speed.value', 'phi', -1, True)
+    >>> print(f"{point.value:.6f} rad/s, {point.omega:.4f} rad/s, "
+    ...       f"period {2 * np.pi / point.omega * 1e3:.4f} ms")
+    9.162907 rad/s, 1414.2136 rad/s, period 4.4429 ms
+    >>> point.case.speed.value == point.value
+    True
+    >>> print(f"l1 = {point.l1:.6e} s^2: {point.criticality}")
+    l1 = 2.209709e-04 s^2: subcritical
     """
 
     key: str
@@ -91,6 +123,8 @@ class HopfPoint:
     on_boundary: bool
     equilibrium: Equilibrium
     case: Case
+    l1: float = math.nan
+    l1_error: float = math.nan
 
     @property
     def frequency(self) -> float:
@@ -102,12 +136,31 @@ class HopfPoint:
         """``2 pi / omega`` [s], the period of the orbits born here."""
         return 2.0 * np.pi / self.omega
 
+    @property
+    def criticality(self) -> str:
+        """By the sign of :attr:`l1`: ``"subcritical"`` (positive: small unstable orbits
+        on the side where the equilibrium is stable), ``"supercritical"`` (negative:
+        small stable orbits where it is unstable), or ``"degenerate"`` (zero within its
+        error, or not computed)."""
+        if not math.isfinite(self.l1) or abs(self.l1) <= self.l1_error:
+            return "degenerate"
+        return "subcritical" if self.l1 > 0.0 else "supercritical"
+
+    @property
+    def orbit_offset(self) -> float:
+        """``d p / d rho^2`` [unit of the key per (rad/s)^2]: a small orbit of slip-speed
+        amplitude ``rho`` lies at ``p = value + orbit_offset rho^2`` (from the normal
+        form, ``rate (p - value) + omega l1 rho^2 = 0``)."""
+        return -self.omega * self.l1 / self.rate
+
     def __str__(self) -> str:
         turn = "loses" if self.direction > 0 else "gains"
         where = "" if self.on_boundary else " (another mode stays unstable)"
+        kind = (f"; first Lyapunov coefficient l1 = {self.l1:.4g} s^2: {self.criticality}"
+                if math.isfinite(self.l1) else "")
         return (f"Hopf point at {self.key} = {self.value:.10g}: {self.mode} at "
                 f"{self.frequency:.6g} Hz ({self.omega:.6g} rad/s) {turn} stability as "
-                f"{self.key} increases{where}")
+                f"{self.key} increases{where}{kind}")
 
 
 def _full_layout(model: Model, eq: Equilibrium, vector: np.ndarray
@@ -166,17 +219,17 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, lam_lo: com
         lam, vec = np.linalg.eig(jac)
         t = (value - lo) / (hi - lo)
         i = int(np.argmin(np.abs(lam - (lam_lo + t * (lam_hi - lam_lo)))))
-        return model, eq, lam, vec, i
+        return model, eq, jac, lam, vec, i
 
     def growth(value: float) -> float:
-        _, _, lam, _, i = eig_near(value)
+        _, _, _, lam, _, i = eig_near(value)
         return float(lam[i].real)
 
     if (growth(lo) < 0.0) == (growth(hi) < 0.0):
         return None
     scale = max(abs(lo), abs(hi), abs(hi - lo))
     root = float(brentq(growth, lo, hi, xtol=KEY_TOLERANCE * scale, rtol=1e-15))
-    model, eq, lam, vec, i = eig_near(root)
+    model, eq, jac, lam, vec, i = eig_near(root)
     # The slope by a central difference, kept inside the bracket (a root at its end, such
     # as a key's lowest allowed value, has no values beyond it).
     step = 1e-6 * abs(hi - lo)
@@ -185,6 +238,7 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, lam_lo: com
     pick = i if lam[i].imag > 0 else int(np.argmin(np.abs(lam - np.conj(lam[i]))))
     others = np.delete(lam.real, [i, int(np.argmin(np.abs(lam - np.conj(lam[i]))))])
     state, vector = _full_layout(model, eq, vec[:, pick])
+    l1 = first_lyapunov(model, eq.state, float(lam[pick].imag), jac)
     return HopfPoint(
         key=key, value=root, omega=float(lam[pick].imag),
         direction=1 if (lam_hi.real - lam_lo.real) / (hi - lo) > 0.0 else -1,
@@ -192,7 +246,7 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, lam_lo: com
         eigenvalue=complex(lam[pick]), state=state, eigenvector=vector,
         mode=dominant_coordinates(model, vec[:, [pick]])[0],
         on_boundary=bool(np.all(others < 0.0)), equilibrium=eq,
-        case=points.case.replace({key: root}),
+        case=points.case.replace({key: root}), l1=l1.value, l1_error=l1.error,
     )
 
 
@@ -227,6 +281,12 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
     CaseError
         As :func:`~fivdisc.analysis.eigenbranches.eigen_branches`.
 
+    See Also
+    --------
+    fivdisc.eigen_branches : The eigenvalues along the key, from which the points are
+        located.
+    fivdisc.hopf_cycles : The periodic orbits born at a Hopf point.
+
     Notes
     -----
     At the point the growth rate ``g(p) = Re lambda(p)`` of the branch is zero; it is
@@ -234,6 +294,23 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
     :func:`scipy.optimize.brentq`, the eigenvalue at each trial value being the one
     nearest to the branch's linear interpolation. A real eigenvalue crossing zero (a
     fold of the equilibrium, not a Hopf point) is not reported.
+
+    Examples
+    --------
+    A slider on a rigid disc (no modes), with rotational damping ``c`` = 0.5 N m s/rad
+    and the falling exponential friction law: sliding turns stable where the friction's
+    negative damping ``r^2 N0 alpha (mu_0 - mu_1) exp(-alpha r Omega)`` drops below
+    ``c``, at ``Omega = 10 ln 2.5`` rad/s, and the pair crosses at
+    ``sqrt(k_phi / I)`` [rad/s]:
+
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> points = fivdisc.hopf_points(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> [(round(p.value, 6), round(p.omega, 3), p.direction) for p in points]
+    [(9.162907, 1414.214, -1)]
+    >>> print(f"{10 * np.log(2.5):.6f} {np.sqrt(2000 / (0.1 * 0.1**2)):.3f}")
+    9.162907 1414.214
     """
     from fivdisc.analysis.eigenbranches import eigen_branches
 

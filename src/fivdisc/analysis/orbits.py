@@ -85,6 +85,38 @@ class PeriodicOrbit:
     start : str
         Where the search started (a transient from the case's initial state, a given
         state, a file): coexisting orbits of nearly the same period are told apart by it.
+
+    See Also
+    --------
+    periodic_orbit : Makes it.
+    fivdisc.continue_orbit : Follows it as a case key changes.
+
+    Examples
+    --------
+    The stick-slip orbit of a slider with constant kinetic friction on a disc of one
+    axisymmetric mode (the textbook mass on a belt, whose orbit has a closed form):
+
+    >>> import fivdisc
+    >>> case = fivdisc.Case(
+    ...     disc={"modes": [[0, 0]]},
+    ...     slider={"rotational_damping": 0.0, "normal_damping": 5.0},
+    ...     friction={"kinetic_max": 0.5, "kinetic_min": 0.5},
+    ...     speed={"value": 1.0},
+    ... )
+    >>> orbit = fivdisc.periodic_orbit(case, transient=1.0)
+    >>> orbit.labels
+    ('q_C00', 'phi_0', 'z_0', 'q_C00_dot', 'phi_0_dot', 'z_0_dot')
+    >>> orbit.monodromy.shape, orbit.trivial, orbit.verdict
+    ((6, 6), 0, 'stable')
+
+    The Floquet exponents ``ln|multiplier| / T`` [1/s] of the disc mode's pair (the
+    first is the flow direction's, 0; the directions that sticking and the contact
+    collapse have multipliers 0, to round-off):
+
+    >>> print(orbit.exponents()[1:3].round(3))
+    [-4.726 -4.726]
+
+    ``orbit.to_dataset().to_netcdf("orbit.nc")`` keeps it with its monodromy matrix.
     """
 
     period: float
@@ -518,7 +550,7 @@ def periodic_orbit(
     start: str = "",
     progress: bool = False,
 ) -> PeriodicOrbit:
-    """Find a periodic orbit of a constant-speed case by shooting.
+    r"""Find a periodic orbit of a constant-speed case by shooting.
 
     Parameters
     ----------
@@ -542,11 +574,11 @@ def periodic_orbit(
         Integration tolerances of the shooting runs. The step size follows the state
         alone, so a tangent direction the orbit hardly excites (a disc mode at rest on
         the orbit) is integrated less accurately than the state, and its steps are capped
-        at 0.15 of the model's shortest time scale: on the rigid-disc stick-slip
-        oscillator the multipliers' moduli are off by 4e-6 at rtol 1e-10, 2e-7 at 1e-11
-        and below 1e-7 at 1e-12. The default 1e-12 makes them right to better than 1e-6,
-        enough to tell whether a multiplier 1e-4 from the unit circle lies inside or
-        outside it. ``atol`` defaults to ``1e-7 rtol``.
+        at 0.15 of the model's shortest time scale. The default 1e-12 makes the
+        multipliers' moduli right to better than 1e-6, enough to tell whether a
+        multiplier 1e-4 from the unit circle lies inside or outside it (the tutorial
+        "Periodic orbits, Floquet multipliers and Lyapunov exponents" measures the error
+        against a closed form at 1e-10 to 1e-12). ``atol`` defaults to ``1e-7 rtol``.
     tol : float
         Convergence: scaled residual ``|phi_T(x0) - x0|`` below this.
     max_iterations : int
@@ -573,6 +605,48 @@ def periodic_orbit(
         ``verdict`` is ``"not converged"``, and its ``reason`` says which budget ran out.
     FivdiscError
         A case that is not autonomous, or an invalid argument.
+
+    See Also
+    --------
+    fivdisc.continue_orbit : Follows an orbit, from this one, as a case key changes.
+    fivdisc.hopf_cycles : The small orbits born where sliding loses stability.
+    fivdisc.lyapunov : Lyapunov exponents of any motion, periodic or not.
+
+    Notes
+    -----
+    The unknowns are the free coordinates of a point ``x0`` on the orbit and the period
+    ``T``; Newton's method solves
+
+    .. math::
+
+        \varphi_T(x_0) - x_0 = 0, \qquad f(x_{ref}) \cdot (x_0 - x_{ref}) = 0,
+
+    the second (the phase condition) keeping the correction normal to the flow ``f``.
+    Its Jacobian holds the monodromy matrix ``M = d phi_T / d x0``, carried across every
+    switch by the saltation matrices, and ``d phi_T / dT = f(phi_T(x0))``. The Floquet
+    multipliers are the eigenvalues of ``M`` (the module :mod:`fivdisc.analysis.orbits`
+    says more).
+
+    Examples
+    --------
+    The stick-slip orbit of a slider with constant kinetic friction on a disc of one
+    axisymmetric mode: stick, then a free oscillation of the slider in slip, 59 times a
+    second. Its multipliers are the flow direction's 1, the disc mode's pair and zeros
+    (directions collapsed by sticking and by the contact):
+
+    >>> import fivdisc
+    >>> case = fivdisc.Case(
+    ...     disc={"modes": [[0, 0]]},
+    ...     slider={"rotational_damping": 0.0, "normal_damping": 5.0},
+    ...     friction={"kinetic_max": 0.5, "kinetic_min": 0.5},
+    ...     speed={"value": 1.0},
+    ... )
+    >>> orbit = fivdisc.periodic_orbit(case, transient=1.0)
+    >>> print(f"T = {orbit.period * 1e3:.6f} ms, {orbit.verdict}, "
+    ...       f"residual below 1e-8: {orbit.residual < 1e-8}")
+    T = 16.901572 ms, stable, residual below 1e-8: True
+    >>> print(orbit.moduli.round(6))
+    [1.       0.923224 0.923224 0.       0.       0.      ]
     """
     if case.speed.profile != "constant":
         raise FivdiscError(f"periodic_orbit needs a constant disc speed (speed.profile = "

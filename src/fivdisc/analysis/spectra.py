@@ -182,6 +182,24 @@ class Spectrum:
         The scipy window used as taper.
     floor : float
         Amplitude below which lines count as rounding noise [units].
+
+    See Also
+    --------
+    spectrum : Makes it.
+    find_peaks : Its strongest lines.
+
+    Examples
+    --------
+    The slider's angle over the last 40 ms of a 50 ms run (the paper's Table 1 case):
+
+    >>> import fivdisc
+    >>> result = fivdisc.simulate(fivdisc.Case(simulation={"duration": 0.05}))
+    >>> spec = fivdisc.spectrum(result, "phi", t0=0.01)
+    >>> spec.name, spec.units, spec.long_name
+    ('phi', 'rad', 'slider circumferential angle')
+    >>> print(f"{spec.resolution:.2f} Hz bins, {spec.frequencies.size} frequencies to "
+    ...       f"{spec.frequencies[-1]:.0f} Hz")
+    24.94 Hz bins, 1621 frequencies to 5000 Hz
     """
 
     frequencies: np.ndarray
@@ -208,6 +226,23 @@ class Peaks:
         Bin width of the spectrum they come from [Hz].
     units : str
         Units of ``amplitudes``.
+
+    See Also
+    --------
+    find_peaks : Makes them.
+    classify : What they say about the response.
+
+    Examples
+    --------
+    >>> import fivdisc
+    >>> result = fivdisc.simulate(fivdisc.Case(simulation={"duration": 0.05}))
+    >>> peaks = fivdisc.find_peaks(fivdisc.spectrum(result, "phi", t0=0.01))
+    >>> len(peaks), peaks.units
+    (2, 'rad')
+    >>> for f, a in zip(peaks.frequencies, peaks.amplitudes):
+    ...     print(f"{f:.1f} Hz: {a:.4f} rad")
+    180.6 Hz: 0.0089 rad
+    361.1 Hz: 0.0022 rad
     """
 
     frequencies: np.ndarray
@@ -244,6 +279,27 @@ class Periodicity:
         The peaks classified.
     tol : float
         Tolerance used [Hz].
+
+    See Also
+    --------
+    classify : Makes it.
+
+    Examples
+    --------
+    Two lines at 50 Hz and 50 sqrt(2) Hz, incommensurate, in 1 s sampled at 1 kHz:
+
+    >>> import numpy as np
+    >>> import xarray as xr
+    >>> import fivdisc
+    >>> t = np.arange(0.0, 1.0, 1e-3)
+    >>> x = 0.5 * np.sin(2 * np.pi * 50 * t) + 0.2 * np.sin(2 * np.pi * 50 * np.sqrt(2) * t)
+    >>> data = xr.Dataset({"x": ("time", x)}, coords={"time": t})
+    >>> verdict = fivdisc.classify(fivdisc.find_peaks(fivdisc.spectrum(data, "x")))
+    >>> verdict.kind, [round(f, 2) for f in verdict.frequencies]
+    ('quasi-periodic', [50.0, 70.71])
+    >>> print(verdict.orders)  # each peak as a combination of the generators
+    [[1 0]
+     [0 1]]
     """
 
     kind: Literal["periodic", "quasi-periodic", "irregular", "none"]
@@ -363,6 +419,25 @@ def stft(data: xr.Dataset | object, var: str = "phi", probe: int | None = None,
     AnalysisError
         On an unknown variable, a bad probe, window, segment or overlap, or a time
         window shorter than one segment.
+
+    See Also
+    --------
+    spectrum : One spectrum of a whole window, finer in frequency, for a stationary
+        stretch.
+    fivdisc.plots.plot_spectrogram : Draws it.
+
+    Examples
+    --------
+    The slider's angle in 20 ms segments (50 Hz resolution) overlapping by half: the
+    180 Hz stick-slip line stays in the 200 Hz bin after the first segment.
+
+    >>> import fivdisc
+    >>> result = fivdisc.simulate(fivdisc.Case(simulation={"duration": 0.05}))
+    >>> spectrogram = fivdisc.stft(result, "phi", segment=0.02, overlap=0.5)
+    >>> spectrogram.dims, spectrogram.shape
+    (('time', 'frequency'), (4, 101))
+    >>> print(spectrogram["time"].values, spectrogram.idxmax("frequency").values)
+    [0.01 0.02 0.03 0.04] [150. 200. 200. 200.]
     """
     from scipy import signal
 
@@ -445,6 +520,32 @@ def spectrum(data: xr.Dataset | object, var: str, probe: int | None = None,
     ------
     AnalysisError
         On an unknown variable, a bad probe, window, time window or oversample.
+
+    See Also
+    --------
+    stft : Spectra of short segments over time, for a response that changes (a
+        varying disc speed).
+    find_peaks : The strongest lines of the spectrum.
+    dominant_frequency : The strongest line's frequency alone.
+
+    Examples
+    --------
+    The slider's angle in the paper's Table 1 case, leaving out the first 10 ms: the
+    stick-slip line near 180 Hz and its second harmonic, each a few bins wide.
+
+    >>> import fivdisc
+    >>> result = fivdisc.simulate(fivdisc.Case(simulation={"duration": 0.05}))
+    >>> spec = fivdisc.spectrum(result, "phi", t0=0.01)
+    >>> strongest = spec.amplitude.argmax()
+    >>> print(f"{spec.frequencies[strongest]:.0f} Hz, {spec.amplitude[strongest]:.4f} "
+    ...       f"{spec.units}, bins of {spec.resolution:.1f} Hz")
+    182 Hz, 0.0089 rad, bins of 24.9 Hz
+
+    A variable with a second dimension takes an index along it: the disc's deflection
+    ``w`` [m] at the second probe.
+
+    >>> fivdisc.spectrum(result, "w", probe=1, t0=0.01).name
+    'w[probe=1]'
     """
     from scipy import signal
 
@@ -514,6 +615,25 @@ def find_peaks(spectrum: Spectrum, n: int = 10, min_rel_height: float = 0.05,
     ------
     AnalysisError
         On a bad ``n``, ``min_rel_height`` or band.
+
+    See Also
+    --------
+    dominant_frequency : The strongest line's frequency alone, from a result.
+    classify : Periodic, quasi-periodic or irregular, from the peaks.
+
+    Examples
+    --------
+    The stick-slip line of the paper's Table 1 case and its second harmonic, refined
+    to a fraction of the 25 Hz bin width:
+
+    >>> import fivdisc
+    >>> result = fivdisc.simulate(fivdisc.Case(simulation={"duration": 0.05}))
+    >>> spec = fivdisc.spectrum(result, "phi", t0=0.01)
+    >>> peaks = fivdisc.find_peaks(spec)
+    >>> print(peaks.frequencies.round(1), peaks.amplitudes.round(4), peaks.units)
+    [180.6 361.1] [0.0089 0.0022] rad
+    >>> print(fivdisc.find_peaks(spec, fmax=250.0).frequencies.round(1))
+    [180.6]
     """
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
         raise AnalysisError(f"n = {n!r} is invalid: must be an integer >= 1")
@@ -630,6 +750,33 @@ def classify(peaks: Peaks, tol: float | None = None, max_order: int = 4,
     ------
     AnalysisError
         On a bad ``tol``, ``max_order`` or ``max_generators``.
+
+    See Also
+    --------
+    find_peaks : The peaks classified.
+
+    Examples
+    --------
+    The stick-slip motion of the paper's Table 1 case, over 40 ms:
+
+    >>> import fivdisc
+    >>> result = fivdisc.simulate(fivdisc.Case(simulation={"duration": 0.05}))
+    >>> peaks = fivdisc.find_peaks(fivdisc.spectrum(result, "phi", t0=0.01))
+    >>> verdict = fivdisc.classify(peaks)
+    >>> print(f"{verdict.kind}, f0 = {verdict.fundamental:.0f} Hz")
+    periodic, f0 = 181 Hz
+
+    Lines at 50 Hz and 150 Hz are periodic, at 50 Hz and 50 sqrt(2) Hz quasi-periodic:
+
+    >>> import numpy as np
+    >>> import xarray as xr
+    >>> t = np.arange(0.0, 1.0, 1e-3)
+    >>> for second in (150.0, 50.0 * np.sqrt(2)):
+    ...     x = np.sin(2 * np.pi * 50.0 * t) + 0.5 * np.sin(2 * np.pi * second * t)
+    ...     data = xr.Dataset({"x": ("time", x)}, coords={"time": t})
+    ...     print(fivdisc.classify(fivdisc.find_peaks(fivdisc.spectrum(data, "x"))))
+    periodic: f0 = 50 Hz (2 peaks within 0.25 Hz of its multiples)
+    quasi-periodic: f1 = 50 Hz, f2 = 70.71 Hz (2 peaks within 0.25 Hz of their combinations)
     """
     for name, value in (("max_order", max_order), ("max_generators", max_generators)):
         if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
@@ -685,6 +832,19 @@ def dominant_frequency(data: xr.Dataset | object, var: str = "phi", probe: int |
     """Refined frequency [Hz] of the strongest spectral line; nan for a static response.
 
     Parameters are those of :func:`spectrum`.
+
+    See Also
+    --------
+    find_peaks : Every strong line, with its amplitude.
+
+    Examples
+    --------
+    The stick-slip frequency of the paper's Table 1 case [Hz]:
+
+    >>> import fivdisc
+    >>> result = fivdisc.simulate(fivdisc.Case(simulation={"duration": 0.05}))
+    >>> print(f"{fivdisc.dominant_frequency(result, 'phi', t0=0.01):.1f}")
+    180.6
     """
     peaks = find_peaks(spectrum(data, var, probe, t0, t1), n=1)
     return float(peaks.frequencies[0]) if len(peaks) else float("nan")

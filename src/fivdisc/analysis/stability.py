@@ -53,6 +53,24 @@ class LinearStability:
         Per eigenvalue, the coordinate (``"C01"``, ..., ``"phi"``; ``"phi0"``,
         ``"phi1"``, ... with several sliders) with the largest share of the
         eigenvector's kinetic energy.
+
+    See Also
+    --------
+    linear_stability : Makes it.
+
+    Examples
+    --------
+    In the paper's Table 1 case (Figs. 8 and 9) the slider's own mode is unstable,
+    through the falling friction law, at about 222 Hz:
+
+    >>> import fivdisc
+    >>> stability = fivdisc.linear_stability(fivdisc.Case())
+    >>> stability.stable, stability.dominant[0]
+    (False, 'phi')
+    >>> print(f"{stability.max_growth_rate:.2f} 1/s at {stability.frequencies[0]:.2f} Hz")
+    239.69 1/s at 221.82 Hz
+    >>> stability.jacobian.shape  # (q, phi, qdot, phidot): 7 modal coordinates, 1 slider
+    (16, 16)
     """
 
     equilibrium: Equilibrium
@@ -163,6 +181,8 @@ def linear_stability(case: Case | Model) -> LinearStability:
     Returns
     -------
     LinearStability
+        The equilibrium, the eigenvalues and eigenvectors, and the coordinate each
+        eigenvector moves most; ``print`` it for a table.
 
     Raises
     ------
@@ -172,6 +192,36 @@ def linear_stability(case: Case | Model) -> LinearStability:
         finite.
     SimulationError
         No sliding equilibrium.
+
+    See Also
+    --------
+    perturbation_test : The paper's test of the same question by simulation.
+    stability_map : The largest growth rate over a grid of two case keys.
+    eigen_branches : The eigenvalues followed along one key.
+
+    Examples
+    --------
+    The paper's Table 1 case is unstable through its slider mode; more rotational
+    damping and a little disc damping make it stable:
+
+    >>> import fivdisc
+    >>> print(fivdisc.linear_stability(fivdisc.Case()))
+    sliding equilibrium at Omega = 6.28319 rad/s:
+      phi = 0.0104946 rad, N = 434.226 N, f = 209.893 N
+     growth rate [1/s]  frequency [Hz]  mode
+               239.687         221.823  phi
+              0.391607         411.434  C03
+              0.270571         274.007  C02
+             0.0153899         238.644  C00
+            -0.0595182         241.543  D01
+             -0.314983         180.853  C01
+             -0.346412         290.487  D02
+             -0.446632         441.789  D03
+    unstable (max growth 239.7 1/s)
+    >>> damped = fivdisc.Case(slider={"rotational_damping": 2.0}, disc={"damping_ratio": 0.01})
+    >>> stability = fivdisc.linear_stability(damped)
+    >>> print(stability.stable, f"{stability.max_growth_rate:.3f} 1/s", stability.dominant[0])
+    True -7.390 1/s C01
     """
     model = case if isinstance(case, Model) else build_model(case)
     check_rates(model)
@@ -214,6 +264,17 @@ class PerturbationTest:
         ``log(final / initial) / duration`` [1/s], a rough envelope rate.
     decays : bool
         Whether the perturbation shrank.
+
+    See Also
+    --------
+    perturbation_test : Makes it.
+
+    Examples
+    --------
+    >>> import fivdisc
+    >>> test = fivdisc.perturbation_test(fivdisc.Case(), duration=0.05)
+    >>> print(test.decays, f"{test.initial_amplitude:.4f} -> {test.final_amplitude:.3f}")
+    False 0.0447 -> 0.490
     """
 
     initial_amplitude: float
@@ -232,6 +293,32 @@ def perturbation_test(case: Case, duration: float | None = None) -> Perturbation
     duration : float, optional
         Simulated time [s]; defaults to the case's ``simulation.duration``. Growth or decay
         slower than a few times 1/duration cannot be told apart from constancy.
+
+    Returns
+    -------
+    PerturbationTest
+        The perturbation's amplitude at the start and at the end, and whether it
+        decayed.
+
+    See Also
+    --------
+    linear_stability : The eigenvalues: growth rates however slow, without a
+        simulation.
+
+    Examples
+    --------
+    Over 50 ms the perturbation of the paper's Table 1 case grows into stick-slip, whose
+    amplitude the nonlinearity bounds (so the envelope rate is well below the
+    linearisation's 240 1/s), and dies out when the slider is damped:
+
+    >>> import fivdisc
+    >>> for damping in (0.1, 2.0):
+    ...     case = fivdisc.Case(slider={"rotational_damping": damping},
+    ...                         disc={"damping_ratio": 0.01})
+    ...     test = fivdisc.perturbation_test(case, duration=0.05)
+    ...     print(damping, test.decays, f"{test.growth_rate:.0f} 1/s")
+    0.1 False 48 1/s
+    2.0 True -77 1/s
     """
     from fivdisc.engine.simulation import simulate
 
@@ -293,6 +380,30 @@ def stability_map(
         boundary exactly, as curves. Attributes ``x_key``,
         ``y_key`` and (with `curves`) ``curve_key`` name the axes; the CF global
         attributes and the base case's TOML (``case``) are there too.
+
+    See Also
+    --------
+    stability_boundary : The boundary traced as curves, to the root finder's
+        tolerance, instead of sampled on a grid.
+    fivdisc.plots.plot_stability_map : Draws the map.
+
+    Examples
+    --------
+    A slider on a rigid disc (no modes) with the falling exponential friction law is
+    stable where its rotational damping ``c`` exceeds the friction's negative damping,
+    ``c > r^2 N0 alpha (mu_0 - mu_1) exp(-alpha r Omega) = 1.25 exp(-0.1 Omega)``
+    [N m s/rad]:
+
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []})
+    >>> grid = fivdisc.stability_map(rigid, ("speed.value", [2.0, 6.0, 10.0, 14.0]),
+    ...                              ("slider.rotational_damping", [0.25, 0.5, 1.0]))
+    >>> print(grid["stable"].values)
+    [[0 0 0 0]
+     [0 0 1 1]
+     [0 1 1 1]]
+    >>> print(grid["boundary"].values.round(4))  # the growth rate is linear in c here
+    [   nan 0.686  0.4598 0.3082]
     """
     axes = [(x[0], check_values("x", x[0], x[1])), (y[0], check_values("y", y[0], y[1]))]
     if curves:

@@ -61,6 +61,38 @@ class Case(Table):
         The disc speed profile Omega(t).
     simulation
         Run settings.
+
+    See Also
+    --------
+    load_case : A case from a TOML file.
+    fivdisc.examples.path : The files of the packaged example cases.
+
+    Examples
+    --------
+    Tables are given as dicts; the keys left out keep the defaults (the paper's Table 1):
+
+    >>> import fivdisc
+    >>> case = fivdisc.Case(slider={"normal_damping": 2.0}, speed={"value": 10.0})
+    >>> case.slider.normal_damping, case.slider.preload, case.speed.value
+    (2.0, 500.0, 10.0)
+
+    Cases are immutable: :meth:`replace` makes a new one from dotted keys.
+
+    >>> faster = case.replace({"speed.value": 12.0, "simulation.duration": 0.05})
+    >>> faster.get("speed.value"), faster == case
+    (12.0, False)
+    >>> print(faster.to_toml().split("[slider]")[0])
+    [disc]
+    inner_radius = 0.044
+    outer_radius = 0.12
+    thickness = 0.002
+    density = 7200.0
+    youngs_modulus = 150000000000.0
+    poisson_ratio = 0.211
+    modes = [[0, 0], [0, 1], [0, 2], [0, 3]]
+    damping_ratio = 0.0
+    damping_frame = "material"
+    <BLANKLINE>
     """
 
     _unions: ClassVar[Mapping[str, TaggedUnion]] = {"speed": SPEED, "friction": FRICTION}
@@ -361,6 +393,26 @@ def load_case(path: str | PathLike[str]) -> Case:
         The path is a directory, cannot be read, or is not UTF-8 text.
     FileNotFoundError
         The file does not exist.
+
+    See Also
+    --------
+    Case : A case built in Python; :meth:`Case.save` writes one to a file.
+
+    Examples
+    --------
+    The paper's Fig. 10 case, which ships with fivdisc:
+
+    >>> import fivdisc
+    >>> from fivdisc import examples
+    >>> case = fivdisc.load_case(examples.path("fig10"))
+    >>> case.speed
+    DeceleratingSpeed(profile='decelerating', initial=6.283185307179586, duration=35.0)
+
+    A case written with :meth:`Case.save` reads back equal:
+
+    >>> case.replace({"slider.preload": 300.0}).save("mycase.toml")
+    >>> fivdisc.load_case("mycase.toml") == case.replace({"slider.preload": 300.0})
+    True
     """
     return _parse(read_text(path), source=str(path))
 

@@ -20,16 +20,23 @@ from fivdisc.errors import FivdiscError
               help="One map and boundary curve per value, e.g. decay=0,1,10.")
 @click.option("--boundary", "boundary_spec", nargs=2, metavar="KEY1=START:STOP KEY2=START:STOP",
               help="Trace the exact stability boundary (Hopf curves) in this box.")
+@click.option("--hopf-curves", "hopf_spec", nargs=2, metavar="KEY1=START:STOP KEY2=START:STOP",
+              help="Trace every Hopf curve in this box (each eigenvalue pair's zero-growth "
+              "curve, with its first Lyapunov coefficient) and locate the codimension-two "
+              "points on them: Bautin (sub- and supercritical meet), double Hopf, "
+              "zero-Hopf, and where the equilibrium ceases to exist.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               help="map.nc (netCDF dataset) or a figure in any format matplotlib writes "
               "(map.png, map.pdf, map.svg, ...). Default: beside the case file, "
-              "CASE-branches.nc, CASE-stability.nc or CASE-boundary.nc.")
+              "CASE-branches.nc, CASE-stability.nc, CASE-boundary.nc or "
+              "CASE-hopf-curves.nc.")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the equilibrium and the eigenvalues as JSON (without a map).")
 @click.option("--progress/--no-progress", default=True, show_default=True)
 def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
               curve_spec: str | None, boundary_spec: tuple[str, str] | None,
-              output: Path | None, as_json: bool, progress: bool) -> None:
+              hopf_spec: tuple[str, str] | None, output: Path | None, as_json: bool,
+              progress: bool) -> None:
     """Stability of the sliding equilibrium of CASE_FILE (default: Table 1 at 2 pi rad/s).
 
     CASE_FILE is a TOML case file or the name of a packaged example (``fivdisc examples``).
@@ -38,19 +45,30 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
     couplings, Hopf points and limits of the equilibrium's existence. With --x and --y:
     the largest growth rate over the grid and where it changes sign. With --boundary:
     the exact boundary curves in a box of two keys (a figure draws them on a grid map).
+    With --hopf-curves: every Hopf curve in a box of two keys, solid where the Hopf
+    point is supercritical and dashed where subcritical (sliding stable, but a large
+    enough disturbance starts a vibration), with the Bautin, double Hopf and zero-Hopf
+    points and the ends of the equilibrium's existence (a figure draws them on a grid
+    map).
     """
     from fivdisc.analysis.stability import linear_stability
     from fivdisc.case import Case, load_case
 
     case = load_case(case_file) if case_file else Case()
-    if boundary_spec and (x_spec or y_spec or curve_spec):
-        raise FivdiscError("--boundary takes its own two keys: leave out --x, --y and --curves")
-    if x_spec is None and y_spec is None and not boundary_spec:
+    for name, spec in (("--boundary", boundary_spec), ("--hopf-curves", hopf_spec)):
+        if spec and (x_spec or y_spec or curve_spec):
+            raise FivdiscError(f"{name} takes its own two keys: leave out --x, --y and "
+                               "--curves")
+    if boundary_spec and hopf_spec:
+        raise FivdiscError("--boundary and --hopf-curves are two scans: give one (the Hopf "
+                           "curves hold the boundary: their on_boundary points)")
+    if x_spec is None and y_spec is None and not boundary_spec and not hopf_spec:
         if curve_spec is not None:
             raise FivdiscError("--curves is used only by a stability map: give --x and --y "
                                "too (KEY=START:STOP:N)")
         if output is not None:
-            raise FivdiscError("-o is used only by a scan: give --x (and --y) or --boundary")
+            raise FivdiscError("-o is used only by a scan: give --x (and --y), --boundary "
+                               "or --hopf-curves")
         res = linear_stability(case)
         if as_json:
             import json
@@ -60,8 +78,8 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
         click.echo(str(res))
         return
     if as_json:
-        raise FivdiscError("--json prints the equilibrium and eigenvalues: leave out --x, --y "
-                           "and --boundary")
+        raise FivdiscError("--json prints the equilibrium and eigenvalues: leave out --x, --y, "
+                           "--boundary and --hopf-curves")
     if y_spec is not None and x_spec is None:
         raise FivdiscError("--y needs --x too (KEY=START:STOP:N)")
     if x_spec is not None and y_spec is None:
@@ -70,6 +88,8 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
         _branches(case, case_file, x_spec, output, progress)
     elif boundary_spec:
         _boundary(case, case_file, boundary_spec, output)
+    elif hopf_spec:
+        _hopf_curves(case, case_file, hopf_spec, output)
     else:
         _map(case, case_file, x_spec, y_spec, curve_spec, output, progress)
 
@@ -123,6 +143,12 @@ def _branches(case, case_file, x_spec: str, output: Path | None, progress: bool)
                         {"units": "Hz", "long_name": "critical frequency"}),
         hopf_direction=(("hopf",), np.array([hp.direction for hp in hopf], dtype=np.int8),
                         {"long_name": "+1: the mode loses stability as the key increases"}),
+        hopf_l1=(("hopf",), np.array([hp.l1 for hp in hopf], dtype=float),
+                 {"units": "s2", "long_name": "first Lyapunov coefficient per (rad/s)^2 of "
+                                              "slip-speed amplitude (> 0: subcritical, < 0: "
+                                              "supercritical)"}),
+        hopf_l1_error=(("hopf",), np.array([hp.l1_error for hp in hopf], dtype=float),
+                       {"units": "s2", "long_name": "estimated error of hopf_l1"}),
     )
     if case_file is not None:
         ds.attrs["case_name"] = case_file.stem
@@ -148,15 +174,13 @@ def _branches(case, case_file, x_spec: str, output: Path | None, progress: bool)
         click.echo(f"no Hopf point between {key} = {values[0]:g} and {values[-1]:g}")
 
 
-def _boundary(case, case_file, specs: tuple[str, str], output: Path | None) -> None:
-    import numpy as np
-
-    from fivdisc.analysis.boundary import stability_boundary
-    from fivdisc.analysis.stability import resolve_key, stability_map
+def _box(specs: tuple[str, str], option: str) -> list[tuple[str, tuple[float, float]]]:
+    """The two ``KEY=START:STOP`` of a box, the keys resolved."""
+    from fivdisc.analysis.stability import resolve_key
 
     box = []
     for spec in specs:
-        usage = f"--boundary {spec!r} is invalid: write KEY=START:STOP"
+        usage = f"{option} {spec!r} is invalid: write KEY=START:STOP"
         if "=" not in spec or spec.split("=", 1)[1].count(":") != 1:
             raise FivdiscError(usage)
         key, ends = spec.split("=", 1)
@@ -164,7 +188,39 @@ def _boundary(case, case_file, specs: tuple[str, str], output: Path | None) -> N
             start, stop = (float(v) for v in ends.split(":"))
         except ValueError:
             raise FivdiscError(usage) from None
-        box.append((resolve_key(key.strip(), "--boundary"), (start, stop)))
+        box.append((resolve_key(key.strip(), option), (start, stop)))
+    return box
+
+
+def _hopf_curves(case, case_file, specs: tuple[str, str], output: Path | None) -> None:
+    import numpy as np
+
+    from fivdisc.analysis.codimension import hopf_curve_lines, hopf_curves
+    from fivdisc.analysis.stability import stability_map
+
+    box = _box(specs, "--hopf-curves")
+    out, figure = _target(case_file, output, "hopf-curves.nc")
+    ds = hopf_curves(case, box[0], box[1])
+    if case_file is not None:
+        ds.attrs["case_name"] = case_file.stem
+    if figure:
+        from fivdisc.plots.stability import plot_hopf_curves
+
+        grid = stability_map(case, *[(key, np.linspace(*ends, 40)) for key, ends in box])
+        _write(out, plot_hopf_curves(ds, grid=grid), ds)
+    else:
+        _write(out, None, ds)
+    for line in hopf_curve_lines(ds):
+        click.echo(line)
+
+
+def _boundary(case, case_file, specs: tuple[str, str], output: Path | None) -> None:
+    import numpy as np
+
+    from fivdisc.analysis.boundary import stability_boundary
+    from fivdisc.analysis.stability import stability_map
+
+    box = _box(specs, "--boundary")
     out, figure = _target(case_file, output, "boundary.nc")
     ds = stability_boundary(case, box[0], box[1])
     if case_file is not None:

@@ -38,6 +38,27 @@ class Branch:
         multipliers ``before`` and ``after`` it, signatures on either side, ``rotation``
         (torus), ``bifurcation_point`` (index of the point before it) and ``note``.
         Attributes: ``key``, ``case`` (TOML), ``stop_reason``, ``start``.
+
+    See Also
+    --------
+    fivdisc.continue_orbit, fivdisc.hopf_cycles : Make one.
+    open_branch : Reads one written by :meth:`to_netcdf`.
+
+    Examples
+    --------
+    The first orbits born at the Hopf point of a slider on a rigid disc (no modes):
+
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> (hopf,) = fivdisc.hopf_points(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> branch = fivdisc.hopf_cycles(hopf, 19.0, max_points=3)
+    >>> len(branch), branch.key, branch.signature(0), branch.stop_reason
+    (3, 'speed.value', ('slip+',), 'the largest number of points (3) is reached')
+    >>> dict(branch.dataset.sizes)
+    {'point': 3, 'coordinate': 4, 'slider': 1, 'multiplier': 4, 'bifurcation': 0}
+    >>> print(f"first orbit: {branch.parameter[0]:.4f} rad/s, T = {branch.period[0] * 1e3:.4f} ms")
+    first orbit: 9.1630 rad/s, T = 4.4429 ms
     """
 
     def __init__(self, dataset: xr.Dataset) -> None:
@@ -122,13 +143,17 @@ class Branch:
         nan if none) and whether its end away from the Hopf point is only a bound
         (``bistable_open``: the stick-slip orbits beyond a grazing are not followed),
         and whether a subcritical branch stopped before deciding it
-        (``bistable_undetermined``: no fold or grazing reached); else None."""
+        (``bistable_undetermined``: no fold or grazing reached); the point's first
+        Lyapunov coefficient ``l1`` [s^2] and ``l1_error`` (nan in files written before
+        they were stored); else None."""
         attrs = self.dataset.attrs
         if "criticality" not in attrs:
             return None
         return {"value": float(attrs["hopf_value"]), "omega": float(attrs["hopf_omega"]),
                 "direction": int(attrs["hopf_direction"]),
                 "criticality": str(attrs["criticality"]),
+                "l1": float(attrs.get("hopf_l1", math.nan)),
+                "l1_error": float(attrs.get("hopf_l1_error", math.nan)),
                 "bistable": (float(attrs["bistable_low"]), float(attrs["bistable_high"])),
                 "bistable_open": bool(attrs.get("bistable_open", 0)),
                 "bistable_undetermined": bool(attrs.get("bistable_undetermined", 0))}
@@ -292,7 +317,7 @@ class Branch:
         hopf = self.hopf()
         if hopf:
             lines.append(f"from the Hopf point at {self.key} = {hopf['value']:.9g}{unit}: "
-                         f"{hopf['criticality']}")
+                         f"{hopf['criticality']}{_l1_note(hopf)}")
             low, high = hopf["bistable"]
             if math.isnan(low) and hopf["bistable_undetermined"]:
                 reach = (f"not determined up to {self.key} = {p[-1]:.9g}{unit}: the "
@@ -319,6 +344,21 @@ class Branch:
         return "\n".join(lines)
 
 
+def _l1_note(hopf: dict[str, Any]) -> str:
+    """The first Lyapunov coefficient beside the orbits' verdict, and whether it agrees."""
+    l1, error = hopf["l1"], hopf["l1_error"]
+    if not math.isfinite(l1):
+        return ""
+    text = f" (first Lyapunov coefficient l1 = {l1:.4g} s^2"
+    if abs(l1) <= error:
+        return text + ", zero within its error: a Bautin point, where the orbits decide)"
+    if (l1 > 0.0) == (hopf["criticality"] == "subcritical"):
+        return text + ", agrees)"
+    return (text + ", says " + ("subcritical" if l1 > 0.0 else "supercritical")
+            + ": the first orbit is too large for the normal form to hold, take a "
+            "smaller --amplitude)")
+
+
 def open_branch(path: str | PathLike[str]) -> Branch:
     """Read a branch written by :meth:`Branch.to_netcdf` (``fivdisc continue -o``).
 
@@ -326,6 +366,22 @@ def open_branch(path: str | PathLike[str]) -> Branch:
     ------
     FivdiscError
         The file is not a branch.
+
+    See Also
+    --------
+    fivdisc.continue_orbit, fivdisc.hopf_cycles : Compute a branch instead.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> (hopf,) = fivdisc.hopf_points(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> branch = fivdisc.hopf_cycles(hopf, 19.0, max_points=3)
+    >>> branch.to_netcdf("branch.nc")
+    >>> again = fivdisc.open_branch("branch.nc")
+    >>> again.dataset.equals(branch.dataset), str(again) == str(branch)
+    (True, True)
     """
     from fivdisc.files import read_dataset
 

@@ -78,7 +78,9 @@ def hopf_cycles(
     Branch
         The branch of orbits from the Hopf point, with attributes ``hopf_value``,
         ``hopf_omega``, ``hopf_direction``, ``criticality`` (``"subcritical"`` or
-        ``"supercritical"``) and ``bistable_low``, ``bistable_high`` (nan if there is no
+        ``"supercritical"``, by the side the orbits lie on), ``hopf_l1`` and
+        ``hopf_l1_error`` (the point's first Lyapunov coefficient [s^2], whose sign
+        says the same for small orbits) and ``bistable_low``, ``bistable_high`` (nan if there is no
         bistable range) in its dataset, printed by ``str`` (see :meth:`Branch.hopf`).
 
     Raises
@@ -87,6 +89,13 @@ def hopf_cycles(
         A bad argument (one line, before any work).
     ConvergenceError
         The first orbit does not converge (take a smaller `amplitude`).
+
+    See Also
+    --------
+    fivdisc.hopf_points : The Hopf points of the sliding equilibrium along a key.
+    fivdisc.periodic_orbit : One orbit by shooting, from a transient run.
+    fivdisc.continue_orbit : A branch from an orbit found by shooting (a stick-slip
+        orbit, say) instead of from a Hopf point.
 
     Notes
     -----
@@ -109,6 +118,28 @@ def hopf_cycles(
     undetermined (``bistable_undetermined``): its unstable orbits bound the equilibrium's
     basin, and the motion beyond them may be a stable vibration coexisting with it. The
     equilibrium's stability beyond other Hopf points of the key is not checked.
+
+    Examples
+    --------
+    A slider on a rigid disc (no modes): sliding turns stable above the Hopf point at
+    9.1629 rad/s, and the small slipping orbits born there lie on that side and are
+    unstable, a subcritical Hopf point. Their speed offset follows the averaged
+    closed form ``Omega - Omega_H = r alpha V^2 / 8`` in their rate amplitude ``V``, and
+    their period starts at ``2 pi / omega``:
+
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> (hopf,) = fivdisc.hopf_points(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> cycles = fivdisc.hopf_cycles(hopf, 19.0, max_points=3)
+    >>> cycles.hopf()["criticality"], bool(cycles.stable.any())
+    ('subcritical', False)
+    >>> ds = cycles.dataset
+    >>> rate = 0.5 * float(ds["phi_dot_max"][0, 0] - ds["phi_dot_min"][0, 0])  # V [rad/s]
+    >>> print(f"{cycles.parameter[0] - hopf.value:.2e} {0.1 * rate**2 / 8:.2e}")
+    1.05e-04 1.05e-04
+    >>> print(f"{cycles.period[0] / (2 * np.pi / hopf.omega):.6f}")
+    1.000000
     """
     if not (np.isfinite(amplitude) and 0 < amplitude <= 0.5):
         raise FivdiscError(f"amplitude = {amplitude!r} is invalid: must be in (0, 0.5], a "
@@ -170,6 +201,8 @@ def _judge(result: Branch, hopf: HopfPoint) -> None:
     undetermined = bool(hopf.on_boundary and kind == "subcritical" and not coexist.size)
     result.dataset.attrs.update({"hopf_value": hopf.value, "hopf_omega": hopf.omega,
                                  "hopf_direction": hopf.direction, "criticality": kind,
+                                 "hopf_l1": getattr(hopf, "l1", np.nan),
+                                 "hopf_l1_error": getattr(hopf, "l1_error", np.nan),
                                  "bistable_low": low, "bistable_high": high,
                                  "bistable_open": int(open_end),
                                  "bistable_undetermined": int(undetermined)})

@@ -68,11 +68,23 @@ class ContinuationSettings:
     time_budget : float
         Wall time after which the continuation stops [s].
 
+    See Also
+    --------
+    fivdisc.continue_orbit, fivdisc.hopf_cycles : Take it as ``settings``, or its fields
+        as keyword arguments.
+
     Examples
     --------
-    >>> from fivdisc.continuation.settings import ContinuationSettings
-    >>> ContinuationSettings(max_points=50).replace(step=0.01).step
+    >>> import fivdisc
+    >>> fivdisc.ContinuationSettings()
+    ContinuationSettings(max_points=200, step=0.02, max_step=0.1, min_step=1e-06, rtol=1e-12,
+                         atol=None, tol=1e-08, time_budget=3600.0)
+    >>> fivdisc.ContinuationSettings(max_points=50).replace(step=0.01).step
     0.01
+    >>> fivdisc.ContinuationSettings(step=-1.0)
+    Traceback (most recent call last):
+        ...
+    fivdisc.errors.FivdiscError: step = -1.0 is invalid: must be a finite number > 0
     """
 
     max_points: int = 200

@@ -148,12 +148,43 @@ def continue_orbit(
     ConvergenceError
         No periodic orbit to start from.
 
+    See Also
+    --------
+    fivdisc.periodic_orbit : One orbit, at one value of the key.
+    fivdisc.hopf_cycles : A branch that starts at a Hopf point of the sliding
+        equilibrium instead of at an orbit.
+    fivdisc.plots.plot_branch : Draws a branch.
+
     Notes
     -----
     The method is in the module's docstring and on the documentation's continuation
     page. Step control: after a point that took at most 3 corrector iterations the step
     grows by 1.5, after 7 or more it halves; a refused or failed step is halved, and a
     step below ``min_step`` ends the branch as lost.
+
+    Examples
+    --------
+    The stick-slip orbit of a slider with constant kinetic friction on a disc of one
+    axisymmetric mode, followed from 1 to 1.1 rad/s: its period shortens, it stays
+    stable and keeps its sequence of phases (one stick and one slip), so no bifurcation
+    is met.
+
+    >>> import fivdisc
+    >>> case = fivdisc.Case(
+    ...     disc={"modes": [[0, 0]]},
+    ...     slider={"rotational_damping": 0.0, "normal_damping": 5.0},
+    ...     friction={"kinetic_max": 0.5, "kinetic_min": 0.5},
+    ...     speed={"value": 1.0},
+    ... )
+    >>> orbit = fivdisc.periodic_orbit(case, transient=1.0)
+    >>> branch = fivdisc.continue_orbit(case, "speed.value", 1.1, orbit=orbit, max_points=30)
+    >>> branch.stop_reason
+    'reached speed.value = 1.1'
+    >>> print(f"{branch.parameter[0]:.2f} -> {branch.parameter[-1]:.2f} rad/s: "
+    ...       f"T = {branch.period[0] * 1e3:.4f} -> {branch.period[-1] * 1e3:.4f} ms")
+    1.00 -> 1.10 rad/s: T = 16.9016 -> 15.5931 ms
+    >>> bool(branch.stable.all()), branch.signature(0), branch.bifurcations()
+    (True, ('slip+ > stick > slip+',), [])
     """
     settings = ContinuationSettings.of(settings, options)
     key = full_key(key)

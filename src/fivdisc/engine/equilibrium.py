@@ -39,6 +39,23 @@ class Equilibrium:
         The constant disc speed Omega_c [rad/s].
     state : ndarray
         The kernel state vector at equilibrium (velocities zero).
+
+    See Also
+    --------
+    sliding_equilibrium : Makes it.
+
+    Examples
+    --------
+    The preload presses the slider into the disc, which deflects under it; friction
+    turns the slider forward until its spring holds it:
+
+    >>> import fivdisc
+    >>> equilibrium = fivdisc.sliding_equilibrium(fivdisc.Case())
+    >>> print(f"phi = {equilibrium.phi[0]:.6f} rad, N = {equilibrium.normal_force[0]:.3f} N, "
+    ...       f"f = {equilibrium.friction_force[0]:.3f} N")
+    phi = 0.010495 rad, N = 434.226 N, f = 209.893 N
+    >>> print((equilibrium.q * 1e3).round(3))  # modal coordinates [mm]
+    [-0.674 -1.304 -0.007 -0.904 -0.01  -0.395 -0.007]
     """
 
     q: np.ndarray
@@ -100,11 +117,37 @@ def sliding_equilibrium(
         equations anyway, so that the limit of existence (a normal force reaching zero)
         can be located by a root finder.
 
+    Returns
+    -------
+    Equilibrium
+        The modal coordinates, the sliders' angles and their contact forces.
+
     Raises
     ------
     SimulationError
         If the speed is not constant or no equilibrium is found (with `contact`: or a
         normal force is not positive).
+
+    See Also
+    --------
+    fivdisc.linear_stability : The eigenvalues of the slip equations about it.
+
+    Examples
+    --------
+    While it slides, the slider's friction coefficient is the kinetic one at the sliding
+    speed ``u = r Omega``: ``mu_1 + (mu_0 - mu_1) exp(-alpha u)`` for the exponential law
+    of the paper's Table 1 case.
+
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> case = fivdisc.Case()
+    >>> equilibrium = fivdisc.sliding_equilibrium(case)
+    >>> u = case.slider.track_radius * case.speed.value  # [m/s]
+    >>> mu = case.friction
+    >>> print(f"{equilibrium.friction_force[0] / equilibrium.normal_force[0]:.10f}")
+    0.4833720228
+    >>> print(f"{mu.kinetic_min + (mu.kinetic_max - mu.kinetic_min) * np.exp(-mu.decay * u):.10f}")
+    0.4833720228
     """
     from scipy.optimize import root
 

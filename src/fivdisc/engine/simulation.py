@@ -67,6 +67,37 @@ def simulate(
         The recorded output would not fit in memory (see :mod:`fivdisc.limits`).
     CaseError
         `speed` is not a profile or a pair of callables, or cannot be represented.
+
+    See Also
+    --------
+    open_result : A result saved before, read back (``Result.to_netcdf``, ``fivdisc
+        simulate -o``).
+    fivdisc.sweep.run_sweep : Many simulations over a grid of case values.
+
+    Examples
+    --------
+    50 ms of the paper's Table 1 case: the slider sticks and slips about every 6 ms.
+
+    >>> import fivdisc
+    >>> case = fivdisc.Case(simulation={"duration": 0.05})
+    >>> result = fivdisc.simulate(case)
+    >>> result
+    <fivdisc.Result run: success, 0.05 s simulated, 1 slider(s), 501 samples, 18 events>
+    >>> print(result.summary())
+    status: success at t = 0.05 s
+    time in phase: slip 0.0237 s, stick 0.0263 s, separation 0 s
+    switches: 18, separations: 0, impacts: 0
+    peak normal force: 668.6... N, largest |w| at probes: 0.00434... m
+    note: the disc deflected by up to 4.34 mm, 2.17 times its thickness h = 2 mm; ...
+    wall time: ... s (integration only, without compiling the kernel)
+
+    A kick of the first disc mode's velocity makes the slider leave the disc; stop the
+    run there:
+
+    >>> kicked = fivdisc.simulate(case, initial={"q_dot": [5.0, 0, 0, 0, 0, 0, 0]},
+    ...                           stop_on=("separation",))
+    >>> print(kicked.status, f"{1e3 * kicked.events('separation')[0]:.2f} ms")
+    stopped 6.45 ms
     """
     if not isinstance(case, Case):
         raise SimulationError(

@@ -48,6 +48,21 @@ class Model:
         Disc speed.
     probe_shapes : ndarray
         ``(n_probe, n)``: ``w(r_p, theta_p) = probe_shapes @ q`` [-].
+
+    Examples
+    --------
+    The default case keeps the modes (0, 0) to (0, 3): one coordinate for the
+    axisymmetric mode, a cosine-sine pair (a doublet) for each of the others.
+
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> model = fivdisc.build_model(fivdisc.Case())
+    >>> model.labels
+    ('C00', 'C01', 'D01', 'C02', 'D02', 'C03', 'D03')
+    >>> print((model.omega / (2 * np.pi)).round(1))  # [Hz]
+    [237.4 241.4 241.4 290.3 290.3 441.5 441.5]
+    >>> print(model.shape.round(4))  # R(r) at the slider's track radius, 0.1 m
+    [[0.6748 0.6738 0.6738 0.6669 0.6669 0.6493 0.6493]]
     """
 
     case: Case
@@ -224,6 +239,24 @@ def build_model(case: Case, speed: SpeedProfile | None = None) -> Model:
         The case.
     speed : SpeedProfile, optional
         Overrides the case's ``[speed]`` table (for example a profile from callables).
+
+    Returns
+    -------
+    Model
+        The modes, the sliders' and the probes' mode shapes, and the arrays the compiled
+        kernels read.
+
+    Examples
+    --------
+    The modal masses [kg] and the radial mode shapes at the slider's track radius [-],
+    for two modes:
+
+    >>> import fivdisc
+    >>> model = fivdisc.build_model(fivdisc.Case(disc={"modes": [[0, 0], [0, 2]]}))
+    >>> model.labels, model.n, model.n_sliders
+    (('C00', 'C02', 'D02'), 3, 1)
+    >>> print(model.modal_mass.round(4), model.shape.round(4))
+    [0.1953 0.0963 0.0963] [[0.6748 0.6669 0.6669]]
     """
     disc, sliders, sim = case.disc, case.sliders, case.simulation
     plate = AnnularPlate.from_disc(disc)

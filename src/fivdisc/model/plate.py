@@ -352,11 +352,27 @@ class AnnularPlate:
     ModeError
         If a parameter is out of its range; the message names it.
 
+    See Also
+    --------
+    PlateMode : One mode of the plate.
+    fivdisc.build_model : The modes a case asks for, at its sliders and probes.
+
     Examples
     --------
-    >>> plate = AnnularPlate(0.044, 0.12, 0.002, 7200.0, 150e9, 0.211)  # the paper's Table 1
+    The paper's Table 1 disc and its first modes [Hz], ``(k, l)`` = (nodal circles, nodal
+    diameters):
+
+    >>> import fivdisc
+    >>> plate = fivdisc.AnnularPlate(0.044, 0.12, 0.002, 7200.0, 150e9, 0.211)
     >>> round(plate.mode(0, 2).omega)
     1824
+    >>> for mode in plate.modes([(0, 0), (0, 1), (0, 2), (0, 3), (1, 0)]):
+    ...     print(mode.k, mode.l, round(mode.frequency_hz, 1))
+    0 0 237.4
+    0 1 241.4
+    0 2 290.3
+    0 3 441.5
+    1 0 1551.5
     """
 
     inner_radius: float
@@ -524,6 +540,19 @@ class PlateMode:
     -----
     ``R`` is normalised so that ``max |R| = 1`` on ``[a, b]`` and ``R(b) > 0``; only
     ``R^2 / modal_mass`` enters the dynamics, and it does not depend on that choice.
+
+    Examples
+    --------
+    The two-nodal-diameter mode of the paper's Table 1 disc, clamped (``R = 0``) at the
+    inner radius 0.044 m and largest at the free outer one, 0.12 m:
+
+    >>> import fivdisc
+    >>> plate = fivdisc.AnnularPlate(0.044, 0.12, 0.002, 7200.0, 150e9, 0.211)
+    >>> mode = plate.mode(0, 2)
+    >>> mode.k, mode.l, round(mode.frequency_hz, 2), round(mode.modal_mass, 4)
+    (0, 2, 290.28, 0.0963)
+    >>> [round(mode.shape(r), 4) + 0.0 for r in (0.044, 0.1, 0.12)]
+    [0.0, 0.6669, 1.0]
     """
 
     k: int

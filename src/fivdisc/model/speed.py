@@ -68,6 +68,34 @@ class SpeedProfile:
     source : str
         Where the profile comes from, kept with a run's result: ``"callables"``
         (:meth:`from_callables`) or ``"profile"`` (any other).
+
+    See Also
+    --------
+    fivdisc.Case : A case's ``[speed]`` table, the usual way to set the speed.
+    fivdisc.simulate : Its ``speed`` argument overrides the case's with a profile.
+
+    Examples
+    --------
+    The paper's deceleration from 2 pi rad/s to rest in 35 s (Eq. 1) [rad/s]:
+
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> profile = fivdisc.SpeedProfile.decelerating(2 * np.pi, 35.0)
+    >>> print(profile.omega([0.0, 17.5, 35.0, 40.0]).round(4))
+    [6.2832 3.1416 0.     0.    ]
+    >>> print(profile.breakpoints, profile.is_constant())
+    [35.] False
+
+    Any smooth speed, from a pair of Python functions ``Omega(t)`` [rad/s] and its
+    derivative [rad/s^2], represented on ``[0, t_end]`` to ``rtol``:
+
+    >>> wobble = fivdisc.SpeedProfile.from_callables(
+    ...     lambda t: 10.0 + np.sin(50.0 * t), lambda t: 50.0 * np.cos(50.0 * t), t_end=0.05)
+    >>> print(f"{float(wobble.omega(0.01)):.7f} {10.0 + np.sin(0.5):.7f} {wobble.source}")
+    10.4794255 10.4794255 callables
+    >>> case = fivdisc.Case(simulation={"duration": 0.05})
+    >>> fivdisc.simulate(case, speed=wobble).status
+    'success'
     """
 
     knots: np.ndarray

@@ -11,7 +11,7 @@ import numpy as np
 import xarray as xr
 
 from fivdisc.paper.cases import PaperCase
-from fivdisc.paper.rows import _suptitle, _verdict
+from fivdisc.paper.rows import suptitle_of, verdict_of
 from fivdisc.paper.runs import Row, Runs
 
 if TYPE_CHECKING:
@@ -76,7 +76,7 @@ def _map_text(grid: xr.Dataset) -> tuple[str, bool]:
     return text, bool(up_x and up_y)
 
 
-def _sweep_compute(pc: PaperCase, runs: Runs) -> tuple[xr.DataTree, list[Row]]:
+def sweep_compute(pc: PaperCase, runs: Runs) -> tuple[xr.DataTree, list[Row]]:
     grids = {}
     with tempfile.TemporaryDirectory() as tmp:
         for printed in (False, True):
@@ -87,13 +87,13 @@ def _sweep_compute(pc: PaperCase, runs: Runs) -> tuple[xr.DataTree, list[Row]]:
     failed = sum(int(np.sum(g["error"].values != "")) for g in grids.values())
     table = [Row(pc.figure, "separation region over (Omega_0, t_max)",
                  "more likely at high Omega_0 and long t_max", text, text_bad,
-                 _verdict(ok, partly=bool(grids["skew"]["separated"].values.any())))]
+                 verdict_of(ok, partly=bool(grids["skew"]["separated"].values.any())))]
     if failed:
         table.append(Row(pc.figure, "failed sweep points", "", str(failed)))
     return xr.DataTree.from_dict(grids), table
 
 
-def _sweep_plot(data: xr.DataTree) -> Figure:
+def sweep_plot(data: xr.DataTree) -> Figure:
     from matplotlib.figure import Figure
 
     from fivdisc.plots.sweep import plot_separation_map
@@ -104,7 +104,7 @@ def _sweep_plot(data: xr.DataTree) -> Figure:
                               strict=True):
         plot_separation_map(data[key].to_dataset(), ax=ax)
         ax.set_title(title, fontsize="medium")
-    _suptitle(fig, data)
+    suptitle_of(fig, data)
     return fig
 
 

@@ -13,21 +13,21 @@ from fivdisc.analysis import linear_stability
 from fivdisc.paper import measure as ms
 from fivdisc.paper.cases import PaperCase
 from fivdisc.paper.rows import (
-    _analysis_window,
-    _lyapunov_row,
-    _omega_dot_row,
-    _per_window,
-    _printed_row,
-    _reference,
-    _separation_text,
-    _spectrogram,
-    _stability_row,
-    _suptitle,
-    _variance_row,
-    _verdict,
-    _window_text,
+    analysis_window,
+    lyapunov_row,
+    omega_dot_row,
+    per_window,
+    printed_row,
+    reference,
+    separation_text,
+    spectrogram,
+    stability_row,
+    suptitle_of,
+    variance_row,
+    verdict_of,
+    window_text,
 )
-from fivdisc.paper.runs import _FMAX, _FREQ_TOL, _WINDOW, Row, Runs, _labels, _pack, _unpack
+from fivdisc.paper.runs import FMAX, FREQ_TOL, WINDOW, Row, Runs, labels_of, pack, unpack
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -35,7 +35,7 @@ if TYPE_CHECKING:
 
 def _constant_rows(pc: PaperCase, ds: xr.Dataset, var: str, probe: int | None) -> list[Row]:
     """Stationarity, periodicity and common lines of a constant-speed run."""
-    t0, t1 = _analysis_window(ds)
+    t0, t1 = analysis_window(ds)
     verdict = ms.periodicity(ds, var, probe, t0, t1)
     mine = ms.lines(ds, var, probe, t0, t1, n=20, rel=0.01)
     other_var, other_probe = ("w", 1) if var == "phi" else ("phi", None)
@@ -44,22 +44,22 @@ def _constant_rows(pc: PaperCase, ds: xr.Dataset, var: str, probe: int | None) -
     common = ms.common_frequencies(mine, other, tol)
     sep = ms.separation(ds)
     until = sep["first"] if sep["count"] else None
-    stages = _per_window(ds, var, probe, until=until)
+    stages = per_window(ds, var, probe, until=until)
     spread = np.ptp([f for _, f in stages]) if stages else np.nan
     name = "slider angle phi" if var == "phi" else "disc w at (r0, 1 rad)"
     window = f"{t0:g}-{t1:g} s"
     table = [Row(pc.figure, f"stationarity: strongest line of {name} per 5 s",
                  "unchanged throughout the process",
-                 f"{_window_text(stages)} (spread {spread:.2f} Hz)",
-                 verdict=_verdict(spread < _FREQ_TOL))]
+                 f"{window_text(stages)} (spread {spread:.2f} Hz)",
+                 verdict=verdict_of(spread < FREQ_TOL))]
     if pc.figure in (8, 9):
-        has = [any(abs(c - f) < _FREQ_TOL for c in common) for f in (181.0, 290.5)]
+        has = [any(abs(c - f) < FREQ_TOL for c in common) for f in (181.0, 290.5)]
         table += [
             Row(pc.figure, f"{name}, {window}", "quasi-periodic", verdict.summary,
-                verdict=_verdict(verdict.kind == "quasi-periodic")),
+                verdict=verdict_of(verdict.kind == "quasi-periodic")),
             Row(pc.figure, f"lines common to phi and w (at least 1 % of the strongest), {window}",
                 "f1 = 181 Hz and f2 = 290.5 Hz", ms.hz(common),
-                verdict=_verdict(all(has), partly=any(has))),
+                verdict=verdict_of(all(has), partly=any(has))),
         ]
     else:
         f0 = verdict.fundamental
@@ -69,8 +69,8 @@ def _constant_rows(pc: PaperCase, ds: xr.Dataset, var: str, probe: int | None) -
             text += f"; strong lines at {', '.join(f'{m:.3f}' for m in multiples)} f0"
         table.append(Row(pc.figure, f"{name}, {window}",
                          "periodic: f0 = 206 Hz and its superharmonics n f0", text,
-                         verdict=_verdict(verdict.kind == "periodic"
-                                          and abs(f0 - 206.0) < _FREQ_TOL,
+                         verdict=verdict_of(verdict.kind == "periodic"
+                                          and abs(f0 - 206.0) < FREQ_TOL,
                                           partly=verdict.kind == "periodic")))
         if var == "w":
             f_phi = ms.periodicity(ds, "phi", None, t0, t1).fundamental
@@ -84,9 +84,9 @@ def _constant_rows(pc: PaperCase, ds: xr.Dataset, var: str, probe: int | None) -
                                        for r, a in zip(ratios, peaks.amplitudes, strict=True))
                              + f", f0 = {f_phi:.2f} Hz; the others are free disc modes (no "
                              "structural damping)",
-                             verdict=_verdict(whole.all(), partly=whole[0])))
+                             verdict=verdict_of(whole.all(), partly=whole[0])))
     table.append(Row(pc.figure, "separation at constant speed", "none (section 3.2, Fig. 24)",
-                     _separation_text(ds), verdict=_verdict(sep["count"] == 0)))
+                     separation_text(ds), verdict=verdict_of(sep["count"] == 0)))
     return table
 
 
@@ -97,34 +97,34 @@ def _decelerating_rows(pc: PaperCase, ds: xr.Dataset, ref: xr.Dataset, var: str,
     early_dec = ms.dominant(ds, var, probe, 1.0, 6.0)
     early_ref = ms.dominant(ref, var, probe, 1.0, 6.0)
     end = float(ds["time"].values[-1])
-    late = ms.dominant(ds, var, probe, end - _WINDOW, end)
+    late = ms.dominant(ds, var, probe, end - WINDOW, end)
     n_early = ms.line_count(ds, var, 1.0, 5.0, probe)
     n_late = ms.line_count(ds, var, end - 4.0, end, probe)
     _, r_dec = ms.ridge(ds, var, probe)
     _, r_ref = ms.ridge(ref, var, probe)
     return [
         Row(pc.figure, f"strongest line of {name} per 5 s", "time-variant",
-            _window_text(_per_window(ds, var, probe))),
-        _variance_row(pc, r_dec, r_ref, name),
+            window_text(per_window(ds, var, probe))),
+        variance_row(pc, r_dec, r_ref, name),
         Row(pc.figure, "early stage (1-6 s), strongest line vs constant speed",
             "similar to constant speed",
             f"{early_dec:.1f} Hz vs {early_ref:.1f} Hz",
-            verdict=_verdict(abs(early_dec - early_ref) < _FREQ_TOL)),
-        Row(pc.figure, f"final stage ({end - _WINDOW:g}-{end:g} s), strongest line",
+            verdict=verdict_of(abs(early_dec - early_ref) < FREQ_TOL)),
+        Row(pc.figure, f"final stage ({end - WINDOW:g}-{end:g} s), strongest line",
             "lower-frequency components arise", f"{late:.1f} Hz (early: {early_dec:.1f} Hz)",
-            verdict=_verdict(late < 0.95 * early_dec)),
+            verdict=verdict_of(late < 0.95 * early_dec)),
         Row(pc.figure, "lines of at least 5 % of the strongest, first 1-5 s vs last 4 s",
             "fuzzy and dense in the final stage", f"{n_early} vs {n_late}",
-            verdict=_verdict(n_late > n_early)),
+            verdict=verdict_of(n_late > n_early)),
     ]
-def _spectra_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
+def spectra_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
     ds = runs.get(pc.case)
     slider = pc.figure in (8, 10, 13, 15)
     var, probe = ("phi", None) if slider else ("w", 1)
     if pc.case.speed.profile == "constant":
         table = []
         if slider:
-            table.append(_stability_row(pc.figure, pc.case, "unstable"))
+            table.append(stability_row(pc.figure, pc.case, "unstable"))
             if pc.figure == 8:
                 stab = linear_stability(pc.case)
                 eigen = stab.to_dataframe()
@@ -132,21 +132,21 @@ def _spectra_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
                 table.append(Row(pc.figure, "linear eigenfrequencies C01 and D02",
                                  "f1 = 181 Hz, f2 = 290.5 Hz",
                                  f"{freq['C01']:.2f} Hz, {freq['D02']:.2f} Hz",
-                                 verdict=_verdict(abs(freq["C01"] - 181.0) < _FREQ_TOL
-                                                  and abs(freq["D02"] - 290.5) < _FREQ_TOL)))
+                                 verdict=verdict_of(abs(freq["C01"] - 181.0) < FREQ_TOL
+                                                  and abs(freq["D02"] - 290.5) < FREQ_TOL)))
         table += _constant_rows(pc, ds, var, probe)
         if pc.figure in (8, 13):
-            table.append(_lyapunov_row(pc, ds, *_analysis_window(ds)))
+            table.append(lyapunov_row(pc, ds, *analysis_window(ds)))
     else:
-        table = _decelerating_rows(pc, ds, runs.get(_reference(pc.case)), var, probe)
+        table = _decelerating_rows(pc, ds, runs.get(reference(pc.case)), var, probe)
         if pc.figure == 15:
             table += _segment_rows(pc, ds)
-        table += [Row(pc.figure, "separation", "not mentioned", _separation_text(ds)),
-                  _omega_dot_row(pc, runs)]
-    table.append(_printed_row(pc, runs))
-    data = _pack(pc, {"main": ds}, ("phi", "phi_dot") if slider else ("w",))
+        table += [Row(pc.figure, "separation", "not mentioned", separation_text(ds)),
+                  omega_dot_row(pc, runs)]
+    table.append(printed_row(pc, runs))
+    data = pack(pc, {"main": ds}, ("phi", "phi_dot") if slider else ("w",))
     data.attrs["profile"] = pc.case.speed.profile
-    data.attrs["analysis_window"] = list(_analysis_window(ds))
+    data.attrs["analysis_window"] = list(analysis_window(ds))
     return data, table
 
 
@@ -158,7 +158,7 @@ def _segment_rows(pc: PaperCase, ds: xr.Dataset) -> list[Row]:
                  "first segment 0-10 s, second 10-15 s",
                  f"the strongest line leaves {np.median(freqs[: freqs.size // 4]):.0f} Hz at "
                  f"t = {leave:.1f} s and then glides down as the disc slows",
-                 verdict=_verdict(10.0 <= leave <= 15.0))]
+                 verdict=verdict_of(10.0 <= leave <= 15.0))]
     previous = None
     for t0, t1 in pc.windows:
         inside = (times >= t0) & (times <= t1)
@@ -171,17 +171,17 @@ def _segment_rows(pc: PaperCase, ds: xr.Dataset) -> list[Row]:
         table.append(Row(pc.figure, f"segment {t0:g}-{t1:g} s", "a distinct frequency composition",
                          f"strongest line {f[0]:.0f} -> {f[-1]:.0f} Hz (median {median:.0f} Hz, "
                          f"0.5 s STFT); sticking {100 * stick:.0f} % of the time",
-                         verdict=_verdict(distinct, partly=moves)))
+                         verdict=verdict_of(distinct, partly=moves)))
         previous = median
     return table
 
 
-def _spectra_plot(data: xr.Dataset) -> Figure:
+def spectra_plot(data: xr.Dataset) -> Figure:
     from matplotlib.figure import Figure
 
     from fivdisc.plots.result import plot_spectrum, plot_timeseries
 
-    run = _unpack(data, "main")
+    run = unpack(data, "main")
     figure = int(data.attrs["figure"])
     slider = figure in (8, 10, 13, 15)
     constant = data.attrs["profile"] == "constant"
@@ -189,7 +189,7 @@ def _spectra_plot(data: xr.Dataset) -> Figure:
         fig = Figure(figsize=(10, 7), layout="constrained")
         ax_a, ax_b = fig.subplots(2, 1)
         plot_timeseries(run, "phi_dot", ax=ax_a)
-        _spectrogram(run, "phi", None, ax_b)
+        spectrogram(run, "phi", None, ax_b)
         ax_a.set_title("(a) circumferential angular velocity of the slider", fontsize="medium")
         ax_b.set_title("(b) time-frequency plot of the circumferential angle", fontsize="medium")
     else:
@@ -197,18 +197,18 @@ def _spectra_plot(data: xr.Dataset) -> Figure:
         axes = fig.subplots(3 if constant else 2, 1)
         plot_timeseries(run, "w", probe=1, ax=axes[0])
         axes[0].set_ylabel("w [m]")
-        _spectrogram(run, "w", 1, axes[1])
+        spectrogram(run, "w", 1, axes[1])
         axes[0].set_title("(a) transverse displacement of the disc at r = r0, theta = 1 rad",
                           fontsize="medium")
         axes[1].set_title("(b) time-frequency plot", fontsize="medium")
         if constant:
             t0, t1 = (float(t) for t in np.atleast_1d(data.attrs["analysis_window"]))
-            plot_spectrum(run, "w", probe=1, window=(t0, t1), fmax=_FMAX, ax=axes[2])
+            plot_spectrum(run, "w", probe=1, window=(t0, t1), fmax=FMAX, ax=axes[2])
             # plot_spectrum's title ends with the periodicity verdict
             verdict = axes[2].get_title().split("\n")[-1]
             axes[2].set_title(f"(b') amplitude spectrum, {t0:g}-{t1:g} s\n{verdict}",
                               fontsize="small")
-    _suptitle(fig, data)
+    suptitle_of(fig, data)
     return fig
 
 
@@ -233,7 +233,7 @@ def _window(ds: xr.Dataset, t0: float, t1: float) -> xr.Dataset:
     return ds.sel(time=slice(t0, t1)).isel(event=(times >= t0) & (times <= t1))
 
 
-def _windows_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
+def windows_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
     ds = runs.get(pc.case)
     table, freqs, sticks = [], [], []
     for t0, t1 in pc.windows:
@@ -245,7 +245,7 @@ def _windows_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
         a, b = freqs
         table.append(Row(pc.figure, "frequency of the slider's motion, early vs late span",
                          "varies during the process", f"{a:.1f} Hz vs {b:.1f} Hz",
-                         verdict=_verdict(abs(a - b) > 0.03 * a)))
+                         verdict=verdict_of(abs(a - b) > 0.03 * a)))
     else:
         # Lines closer than the 10 Hz resolution of a 0.1 s window are not told apart.
         distinct = len({round(f / 10.0) for f in freqs if np.isfinite(f)})
@@ -253,26 +253,26 @@ def _windows_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
                          "stick-slip with different periods in the six spans",
                          f"stick-slip in {sum(sticks)} of 6 spans; fundamental (or strongest) "
                          f"frequency {ms.hz(freqs)}: {distinct} distinct at 10 Hz resolution",
-                         verdict=_verdict(all(sticks) and distinct == 6,
+                         verdict=verdict_of(all(sticks) and distinct == 6,
                                           partly=any(sticks) and distinct > 1)))
     parts = [_window(ds, t0, t1) for t0, t1 in pc.windows]
-    data = _pack(pc, {f"w{i}": p for i, p in enumerate(parts)},
+    data = pack(pc, {f"w{i}": p for i, p in enumerate(parts)},
                  ("phi", "phi_dot", "friction_force", "disc_speed"))
     return data, table
 
 
-def _windows_plot(data: xr.Dataset) -> Figure:
+def windows_plot(data: xr.Dataset) -> Figure:
     from matplotlib.figure import Figure
 
     from fivdisc.plots.result import plot_friction, plot_phase_portrait, plot_timeseries
 
-    labels = _labels(data)
+    labels = labels_of(data)
     letters = "abcdefghijkl"
     if int(data.attrs["figure"]) == 12:
         fig = Figure(figsize=(10, 6.5), layout="constrained")
         axes = fig.subplots(2, len(labels))
         for i, label in enumerate(labels):
-            run = _unpack(data, label)
+            run = unpack(data, label)
             plot_timeseries(run, "phi_dot", ax=axes[0, i])
             plot_timeseries(run, "friction_force", ax=axes[1, i])
             axes[1, i].set_ylabel("friction force [N]")
@@ -282,7 +282,7 @@ def _windows_plot(data: xr.Dataset) -> Figure:
         fig = Figure(figsize=(10, 16), layout="constrained")
         axes = fig.subplots(len(labels), 2)
         for i, label in enumerate(labels):
-            run = _unpack(data, label)
+            run = unpack(data, label)
             t0, t1 = float(run["time"].values[0]), float(run["time"].values[-1])
             plot_phase_portrait(run, ax=axes[i, 0])
             plot_friction(run, ax=axes[i, 1])
@@ -290,7 +290,7 @@ def _windows_plot(data: xr.Dataset) -> Figure:
             axes[i, 0].set_title(f"({letters[2 * i]}) {t0:g} < t < {t1:g} s", fontsize="medium")
             axes[i, 1].set_title(f"({letters[2 * i + 1]}) {t0:g} < t < {t1:g} s",
                                  fontsize="medium")
-    _suptitle(fig, data)
+    suptitle_of(fig, data)
     return fig
 
 

@@ -11,14 +11,14 @@ from fivdisc.analysis import linear_stability, stability_map
 from fivdisc.analysis.boundary import stability_boundary
 from fivdisc.case import Case
 from fivdisc.paper.cases import FIGURES, PaperCase
-from fivdisc.paper.rows import _stability_row, _verdict
-from fivdisc.paper.runs import Row, Runs, _labels
+from fivdisc.paper.rows import stability_row, verdict_of
+from fivdisc.paper.runs import Row, Runs, labels_of
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 
-def _map_compute(pc: PaperCase, runs: Runs) -> tuple[xr.DataTree, list[Row]]:
+def map_compute(pc: PaperCase, runs: Runs) -> tuple[xr.DataTree, list[Row]]:
     (xkey, xs), (ykey, ys), (ckey, cs) = pc.axes
     maps = {label: stability_map(case, x=(xkey, xs), y=(ykey, ys), curves=(ckey, cs))
             for label, case in pc.runs.items()}
@@ -47,7 +47,7 @@ def _map_compute(pc: PaperCase, runs: Runs) -> tuple[xr.DataTree, list[Row]]:
                 f"boundary for c_z = {xs[cols[0]]:.2f}-{xs[cols[-1]]:.2f} N s/m, "
                 f"r0^2 c_phi from {np.nanmax(bound):.2f} down to {np.nanmin(bound):.2f} "
                 f"N m s/rad; stable above it in {sum(above)} of {cols.size} columns",
-                verdict=_verdict(all(above))))
+                verdict=verdict_of(all(above))))
     groups: dict[str, xr.Dataset] = {}
     for label, case in pc.runs.items():
         for i, alpha in enumerate(cs):
@@ -58,7 +58,7 @@ def _map_compute(pc: PaperCase, runs: Runs) -> tuple[xr.DataTree, list[Row]]:
             table.append(_exact_boundary_row(pc.figure, case, alpha, exact))
     for fig in (4, 6):
         point = FIGURES[fig].case
-        table.append(_stability_row(
+        table.append(stability_row(
             pc.figure, point, "stable",
             f"point of Fig. {fig} (c_z = {point.slider.normal_damping:g}, r0^2 c_phi = "
             f"{point.slider.rotational_damping:g}, alpha = {point.friction.decay:g}, "
@@ -101,19 +101,19 @@ def _point_against_boundary(figure: int, fig: int, point: Case, exact: xr.Datase
     what = f"exact boundary at the c_z of Fig. {fig} (alpha = {point.friction.decay:g})"
     if not crossings:
         return Row(figure, what, paper, "no boundary at this c_z in the box",
-                   verdict=_verdict(linear_stability(point).stable))
+                   verdict=verdict_of(linear_stability(point).stable))
     top = max(crossings)
     return Row(figure, what, paper,
                f"r0^2 c_phi = {top:.4f} N m s/rad on the boundary: the point lies "
-               f"{'above' if cphi > top else 'below'} it", verdict=_verdict(cphi > top))
+               f"{'above' if cphi > top else 'below'} it", verdict=verdict_of(cphi > top))
 
 
-def _map_plot(data: xr.DataTree) -> Figure:
+def map_plot(data: xr.DataTree) -> Figure:
     from matplotlib.figure import Figure
 
     from fivdisc.plots.stability import plot_stability_map
 
-    labels = _labels(data)
+    labels = labels_of(data)
     fig = Figure(figsize=(12, 5.5), layout="constrained")
     axes = fig.subplots(1, len(labels))
     for ax, label in zip(axes, labels, strict=True):

@@ -11,20 +11,20 @@ from fivdisc.analysis import linear_stability, sliding_equilibrium
 from fivdisc.paper import measure as ms
 from fivdisc.paper.cases import PaperCase
 from fivdisc.paper.rows import (
-    _omega_dot_row,
-    _printed_row,
-    _separation_text,
-    _stability_row,
-    _suptitle,
-    _verdict,
+    omega_dot_row,
+    printed_row,
+    separation_text,
+    stability_row,
+    suptitle_of,
+    verdict_of,
 )
-from fivdisc.paper.runs import Row, Runs, _pack, _unpack
+from fivdisc.paper.runs import Row, Runs, pack, unpack
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 
-def _decay_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
+def decay_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
     ds = runs.get(pc.case)
     stab = linear_stability(pc.case)
     eq = sliding_equilibrium(pc.case)
@@ -37,20 +37,20 @@ def _decay_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
     eigen = stab.to_dataframe()
     slowest = eigen[eigen["coordinate"] != "phi"].iloc[0]
     table = [
-        _stability_row(pc.figure, pc.case, "stable"),
+        stability_row(pc.figure, pc.case, "stable"),
         Row(pc.figure, "slider: decay of |phi - phi_eq|", "decays fast to the equilibrium",
             f"{initial:.1e} rad at t = 0, {after:.1e} rad at 1 s, {final:.1e} rad in the last "
-            "0.5 s", verdict=_verdict(after < 0.01 * initial)),
+            "0.5 s", verdict=verdict_of(after < 0.01 * initial)),
         Row(pc.figure, "disc at (r0, 0): decay of w",
             "decays fast to the equilibrium",
             f"peak-to-peak {w_range[0]:.2g} m in the first 0.5 s, {w_range[-1]:.2g} m in the "
             f"last: slow, the least damped disc mode ({slowest['coordinate']}, "
             f"{slowest['frequency_hz']:.1f} Hz) decays at {slowest['growth_rate']:.3g} 1/s "
             "(the disc has no structural damping)",
-            verdict=_verdict(w_range[-1] < 0.01 * w_range[0], partly=True)),
-        _printed_row(pc, runs),
+            verdict=verdict_of(w_range[-1] < 0.01 * w_range[0], partly=True)),
+        printed_row(pc, runs),
     ]
-    return _pack(pc, {"main": ds}, ("phi_dot", "w")), table
+    return pack(pc, {"main": ds}, ("phi_dot", "w")), table
 
 
 def _critical_speed(pc: PaperCase) -> tuple[float, float]:
@@ -76,7 +76,7 @@ def _critical_speed(pc: PaperCase) -> tuple[float, float]:
     return crit, float((crit - speed.initial) / speed.rate)
 
 
-def _transient_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
+def transient_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]]:
     ds = runs.get(pc.case, pc.start_from)
     centres, ranges = ms.envelope(ds, "phi_dot", width=0.1)
     # The first window holds the perturbation, which the slider's damping removes fast.
@@ -96,7 +96,7 @@ def _transient_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]
             f"peak-to-peak over 0.1 s: {ranges[0]:.2g} rad/s at first, minimum {r_min:.2g} "
             f"rad/s at {t_min:.2f} s (Omega = {omega_min:.2f} rad/s), then x{growth:.3g} to "
             f"{ranges[i_max]:.2g} rad/s at {centres[i_max]:.2f} s",
-            verdict=_verdict(ranges[0] > 3.0 * r_min and growth > 10.0)),
+            verdict=verdict_of(ranges[0] > 3.0 * r_min and growth > 10.0)),
         Row(pc.figure, "frozen-speed linear stability along the profile",
             "explains the growth (negative friction slope / moving load)",
             f"sliding equilibrium unstable {side} Omega = {crit:.2f} rad/s, reached at "
@@ -105,20 +105,20 @@ def _transient_compute(pc: PaperCase, runs: Runs) -> tuple[xr.Dataset, list[Row]
     if pc.figure == 5:
         table.append(Row(pc.figure, "stick-slip in the final stage", "induced",
                          f"first stick at t = {stick[0]:.2f} s, {stick.size} sticks" if stick.size
-                         else "no stick", verdict=_verdict(stick.size > 0)))
+                         else "no stick", verdict=verdict_of(stick.size > 0)))
     else:
-        table.append(Row(pc.figure, "separation", "not mentioned", _separation_text(ds)))
-    table += [_omega_dot_row(pc, runs), _printed_row(pc, runs)]
-    return _pack(pc, {"main": ds}, ("phi_dot", "w")), table
+        table.append(Row(pc.figure, "separation", "not mentioned", separation_text(ds)))
+    table += [omega_dot_row(pc, runs), printed_row(pc, runs)]
+    return pack(pc, {"main": ds}, ("phi_dot", "w")), table
 
 
-def _two_panel_plot(data: xr.Dataset) -> Figure:
+def two_panel_plot(data: xr.Dataset) -> Figure:
     """(a) the slider's angular velocity, (b) the disc at (r0, 0)."""
     from matplotlib.figure import Figure
 
     from fivdisc.plots.result import plot_timeseries
 
-    run = _unpack(data, "main")
+    run = unpack(data, "main")
     fig = Figure(figsize=(9, 6), layout="constrained")
     ax_a, ax_b = fig.subplots(2, 1, sharex=True)
     plot_timeseries(run, "phi_dot", ax=ax_a)
@@ -127,7 +127,7 @@ def _two_panel_plot(data: xr.Dataset) -> Figure:
     ax_a.set_title("(a) circumferential angular velocity of the slider", fontsize="medium")
     ax_b.set_title("(b) transverse displacement of the disc at r = r0, theta = 0",
                    fontsize="medium")
-    _suptitle(fig, data)
+    suptitle_of(fig, data)
     return fig
 
 

@@ -25,22 +25,22 @@ from typing import TYPE_CHECKING
 import xarray as xr
 
 from fivdisc.paper.cases import FIGURES, PaperCase
-from fivdisc.paper.fig_impact import _impact_compute, _impact_plot
+from fivdisc.paper.fig_impact import impact_compute, impact_plot
 from fivdisc.paper.fig_responses import (
-    _normal_compute,
-    _normal_plot,
-    _responses_compute,
-    _responses_plot,
+    normal_compute,
+    normal_plot,
+    responses_compute,
+    responses_plot,
 )
-from fivdisc.paper.fig_separation import _sweep_compute, _sweep_plot
+from fivdisc.paper.fig_separation import sweep_compute, sweep_plot
 from fivdisc.paper.fig_spectra import (
-    _spectra_compute,
-    _spectra_plot,
-    _windows_compute,
-    _windows_plot,
+    spectra_compute,
+    spectra_plot,
+    windows_compute,
+    windows_plot,
 )
-from fivdisc.paper.fig_stability import _map_compute, _map_plot
-from fivdisc.paper.fig_transients import _decay_compute, _transient_compute, _two_panel_plot
+from fivdisc.paper.fig_stability import map_compute, map_plot
+from fivdisc.paper.fig_transients import decay_compute, transient_compute, two_panel_plot
 from fivdisc.paper.runs import Row, Runs
 
 if TYPE_CHECKING:
@@ -112,17 +112,17 @@ _Compute = Callable[[PaperCase, Runs], tuple[xr.Dataset, list[Row]]]
 _Plot = Callable[[xr.Dataset], "Figure"]
 
 _KINDS: dict[int, tuple[_Compute, _Plot]] = {
-    3: (_map_compute, _map_plot),
-    4: (_decay_compute, _two_panel_plot),
-    5: (_transient_compute, _two_panel_plot),
-    6: (_decay_compute, _two_panel_plot),
-    7: (_transient_compute, _two_panel_plot),
-    **{n: (_spectra_compute, _spectra_plot) for n in (8, 9, 10, 11, 13, 14, 15, 16)},
-    12: (_windows_compute, _windows_plot),
-    17: (_windows_compute, _windows_plot),
-    **{n: (_normal_compute, _normal_plot) for n in (18, 19, 24)},
-    **{n: (_responses_compute, _responses_plot) for n in (20, 21, 22, 23, 25, 26)},
-    27: (_sweep_compute, _sweep_plot),
-    28: (_impact_compute, _impact_plot),
+    3: (map_compute, map_plot),
+    4: (decay_compute, two_panel_plot),
+    5: (transient_compute, two_panel_plot),
+    6: (decay_compute, two_panel_plot),
+    7: (transient_compute, two_panel_plot),
+    **{n: (spectra_compute, spectra_plot) for n in (8, 9, 10, 11, 13, 14, 15, 16)},
+    12: (windows_compute, windows_plot),
+    17: (windows_compute, windows_plot),
+    **{n: (normal_compute, normal_plot) for n in (18, 19, 24)},
+    **{n: (responses_compute, responses_plot) for n in (20, 21, 22, 23, 25, 26)},
+    27: (sweep_compute, sweep_plot),
+    28: (impact_compute, impact_plot),
 }
 

@@ -11,7 +11,7 @@ from fivdisc.analysis import linear_stability
 from fivdisc.case import Case
 from fivdisc.paper import measure as ms
 from fivdisc.paper.cases import PaperCase
-from fivdisc.paper.runs import _FMAX, _STFT_SEGMENT, _WINDOW, Row, Runs
+from fivdisc.paper.runs import FMAX, STFT_SEGMENT, WINDOW, Row, Runs
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 # --- rows shared by several figures ------------------------------------------------------------
 
 
-def _separation_text(ds: xr.Dataset) -> str:
+def separation_text(ds: xr.Dataset) -> str:
     sep = ms.separation(ds)
     if not sep["count"]:
         return f"no separation in {float(ds['time'].values[-1]):g} s"
@@ -28,7 +28,7 @@ def _separation_text(ds: xr.Dataset) -> str:
             f"{sep['last']:.2f} s ({100 * sep['fraction']:.0f} % of the time)")
 
 
-def _printed_text(ds: xr.Dataset) -> str:
+def printed_text(ds: xr.Dataset) -> str:
     """Separation and divergence of a printed-sign run."""
     _, end = ms.run_end(ds)
     sep = ms.separation(ds)
@@ -36,13 +36,13 @@ def _printed_text(ds: xr.Dataset) -> str:
     return f"{head}; {end}"
 
 
-def _printed_row(pc: PaperCase, runs: Runs) -> Row:
+def printed_row(pc: PaperCase, runs: Runs) -> Row:
     """What the printed gyroscopic sign does to the figure's runs."""
     parts_ok, parts_printed = [], []
     for label, case in pc.runs.items():
         lead = f"{label}: " if label else ""
-        parts_ok.append(lead + _separation_text(runs.get(case, pc.start_from)))
-        parts_printed.append(lead + _printed_text(runs.printed(case, pc.start_from)))
+        parts_ok.append(lead + separation_text(runs.get(case, pc.start_from)))
+        parts_printed.append(lead + printed_text(runs.printed(case, pc.start_from)))
     return Row(pc.figure, "separation and boundedness, skew vs printed gyroscopic sign",
                "(equations as printed: +2 l M Omega dC/dt in the D equation)",
                "; ".join(parts_ok), "; ".join(parts_printed))
@@ -66,7 +66,7 @@ def _divergence(first: xr.Dataset, second: xr.Dataset, span: float = 1.0) -> tup
     return float(np.max(diff) / peak), when
 
 
-def _omega_dot_row(pc: PaperCase, runs: Runs, label: str = "") -> Row:
+def omega_dot_row(pc: PaperCase, runs: Runs, label: str = "") -> Row:
     """Effect of the dOmega/dt terms (absent from the printed equations) on a run, next to
     the effect of a ten times tighter tolerance (the run's sensitivity)."""
     case = pc.runs[label]
@@ -100,19 +100,19 @@ def _stability_text(case: Case) -> tuple[str, bool]:
             f"({stab.dominant[0]})"), stab.stable
 
 
-def _stability_row(figure: int, case: Case, paper: str,
+def stability_row(figure: int, case: Case, paper: str,
                    quantity: str = "sliding equilibrium") -> Row:
     """Linear stability of `case` with the skew and the printed gyroscopic sign."""
     text, stable = _stability_text(case)
     printed, _ = _stability_text(case.replace({"simulation.printed_gyroscopic_sign": True}))
-    return Row(figure, quantity, paper, text, printed, _verdict(stable == (paper == "stable")))
+    return Row(figure, quantity, paper, text, printed, verdict_of(stable == (paper == "stable")))
 
 
-def _verdict(ok: bool, partly: bool = False) -> str:
+def verdict_of(ok: bool, partly: bool = False) -> str:
     return "agrees" if ok else ("partly" if partly else "differs")
 
 
-def _analysis_window(ds: xr.Dataset, length: float = 10.0) -> tuple[float, float]:
+def analysis_window(ds: xr.Dataset, length: float = 10.0) -> tuple[float, float]:
     """The opening stationary stretch of a constant-speed run: from 1 s (after the
     start-up transient) for `length` s (0.1 Hz resolution), ending before the first
     separation."""
@@ -128,7 +128,7 @@ _EXPONENTS = 3
 _PAPER_LABEL = {8: "quasi-periodic", 13: "periodic"}
 
 
-def _lyapunov_row(pc: PaperCase, ds: xr.Dataset, t0: float, t1: float) -> Row:
+def lyapunov_row(pc: PaperCase, ds: xr.Dataset, t0: float, t1: float) -> Row:
     """The spectral label of phi over [t0, t1] against the Lyapunov exponents of the
     same stretch (QR method with the saltation matrices at every switch)."""
     from fivdisc.analysis.exponents import lyapunov
@@ -138,40 +138,40 @@ def _lyapunov_row(pc: PaperCase, ds: xr.Dataset, t0: float, t1: float) -> Row:
     spec = lyapunov(pc.case, n=_EXPONENTS, transient=t0, duration=t1 - t0)
     regime = cross_check(spectral, spec)
     paper = _PAPER_LABEL.get(pc.figure, "")
-    verdict = (_verdict(regime.lyapunov == paper, partly=regime.consistent) if paper else "")
+    verdict = (verdict_of(regime.lyapunov == paper, partly=regime.consistent) if paper else "")
     return Row(pc.figure, f"Lyapunov exponents ({_EXPONENTS}, {t0:g}-{t1:g} s) against the "
                "spectral label of phi", paper or "(not stated)",
                regime.summary + "; exponents " + ", ".join(f"{e:+.3g}" for e in spec.exponents)
                + " 1/s", verdict=verdict)
 
 
-def _per_window(ds: xr.Dataset, var: str, probe: int | None = None,
-                width: float = _WINDOW, until: float | None = None) -> list[tuple[float, float]]:
+def per_window(ds: xr.Dataset, var: str, probe: int | None = None,
+                width: float = WINDOW, until: float | None = None) -> list[tuple[float, float]]:
     """(window start [s], dominant frequency [Hz]) per window of `width` s, up to `until`."""
     end = float(ds["time"].values[-1]) if until is None else until
     starts = np.arange(0.0, end - width + 1e-9, width)
     return [(float(t0), ms.dominant(ds, var, probe, t0, t0 + width)) for t0 in starts]
 
 
-def _window_text(values: list[tuple[float, float]], width: float = _WINDOW) -> str:
+def window_text(values: list[tuple[float, float]], width: float = WINDOW) -> str:
     return ", ".join(f"{t0:g}-{t0 + width:g} s: {f:.1f}" for t0, f in values) + " Hz"
 
 
-def _spectrogram(run: xr.Dataset, var: str, probe: int | None, ax: Axes) -> None:
+def spectrogram(run: xr.Dataset, var: str, probe: int | None, ax: Axes) -> None:
     """Time-frequency plot of one variable, with a short colour-bar label."""
     from fivdisc.plots.result import plot_spectrogram
 
-    plot_spectrogram(run, var, probe=probe, segment=_STFT_SEGMENT, fmax=_FMAX, ax=ax)
+    plot_spectrogram(run, var, probe=probe, segment=STFT_SEGMENT, fmax=FMAX, ax=ax)
     # plot_spectrogram adds the colour bar last; its long name would overlap the panels.
     unit = "rad" if var == "phi" else "m"
     ax.figure.axes[-1].set_ylabel(f"STFT magnitude of {var} [{unit}]")
 
 
-def _suptitle(fig: Figure, data: xr.DataTree) -> None:
+def suptitle_of(fig: Figure, data: xr.DataTree) -> None:
     fig.suptitle(f"Fig. {data.attrs['figure']}: {data.attrs['figure_title']}", fontsize="medium")
 
 
-def _reference(case: Case) -> Case:
+def reference(case: Case) -> Case:
     """The constant-speed case a variable-speed case is compared with: the same at its
     initial speed (2 pi or 6 pi rad/s)."""
     speed = case.speed
@@ -180,12 +180,12 @@ def _reference(case: Case) -> Case:
 
 
 
-def _variance_row(pc: PaperCase, r_dec: np.ndarray, r_ref: np.ndarray, name: str) -> Row:
+def variance_row(pc: PaperCase, r_dec: np.ndarray, r_ref: np.ndarray, name: str) -> Row:
     """How often the strongest line moves, decelerating vs constant speed."""
     dec, ref = ms.ridge_changes(r_dec), ms.ridge_changes(r_ref)
     return Row(pc.figure, f"time-variance: share of 0.5 s STFT slices where the strongest line "
                f"of {name} moves by more than 2 Hz, decelerating vs constant speed",
                "more time-variant than at constant speed",
-               f"{100 * dec:.0f} % vs {100 * ref:.0f} %", verdict=_verdict(dec > ref))
+               f"{100 * dec:.0f} % vs {100 * ref:.0f} %", verdict=verdict_of(dec > ref))
 
 

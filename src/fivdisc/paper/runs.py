@@ -26,10 +26,10 @@ _RUN_ATTRS = ("status", "message", "end_time", "impact", "case", "wall_time")
 # The variables of _KEEP that have a slider dimension in a result, and the event table.
 _PER_SLIDER = ("phi", "phi_dot", "normal_force", "friction_force", "phase")
 _EVENTS = ("phase", "event_time", "event_kind", "event_from", "event_slider")
-_STFT_SEGMENT = 0.2  # [s]: 5 Hz resolution, fine enough to tell the disc modes apart
-_FMAX = 1000.0  # [Hz], the Nyquist frequency of the 2 kHz output
-_WINDOW = 5.0  # [s], windows of the per-stage frequency lists
-_FREQ_TOL = 1.0  # [Hz], a fivdisc frequency "is" the paper's if this close
+STFT_SEGMENT = 0.2  # [s]: 5 Hz resolution, fine enough to tell the disc modes apart
+FMAX = 1000.0  # [Hz], the Nyquist frequency of the 2 kHz output
+WINDOW = 5.0  # [s], windows of the per-stage frequency lists
+FREQ_TOL = 1.0  # [Hz], a fivdisc frequency "is" the paper's if this close
 
 
 @dataclass(frozen=True)
@@ -124,7 +124,7 @@ def _with_slider(ds: xr.Dataset) -> xr.Dataset:
     return out.assign_coords({c: ("slider", [ds[c].item()], ds[c].attrs) for c in scalars})
 
 
-def _pack(pc: PaperCase, runs: dict[str, xr.Dataset], variables: tuple[str, ...]
+def pack(pc: PaperCase, runs: dict[str, xr.Dataset], variables: tuple[str, ...]
           ) -> xr.DataTree:
     """Runs as the groups of one tree, each in the result layout (see :func:`compute`)."""
     from fivdisc.engine.conventions import global_attrs
@@ -141,12 +141,12 @@ def _pack(pc: PaperCase, runs: dict[str, xr.Dataset], variables: tuple[str, ...]
     return xr.DataTree.from_dict(groups)
 
 
-def _unpack(data: xr.DataTree, label: str) -> xr.Dataset:
-    """One run of :func:`_pack`'s tree, slider 0 selected as :class:`Runs` keeps it."""
+def unpack(data: xr.DataTree, label: str) -> xr.Dataset:
+    """One run of :func:`pack`'s tree, slider 0 selected as :class:`Runs` keeps it."""
     return select_slider(data[label].to_dataset(), 0)
 
 
-def _labels(data: xr.DataTree) -> list[str]:
+def labels_of(data: xr.DataTree) -> list[str]:
     return list(data.children)
 
 

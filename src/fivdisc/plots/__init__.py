@@ -1,6 +1,6 @@
 """Matplotlib figures: simulation results (the paper's Figs. 4-26), stability maps and
-boundaries, eigenvalue branches, branches of periodic orbits, bifurcation diagrams and
-separation maps of sweeps.
+boundaries, Hopf curves with their codimension-two points, eigenvalue branches, branches
+of periodic orbits, bifurcation diagrams and separation maps of sweeps.
 
 Every function draws into ``ax`` (a new figure when None, where it takes one) and
 returns the Figure without showing it. Matplotlib (the ``plot`` extra) is imported only
@@ -14,8 +14,8 @@ _API = {
     "fivdisc.plots.result": ("plot_friction", "plot_kind", "plot_normal_force",
                              "plot_phase_portrait", "plot_spectrogram", "plot_spectrum",
                              "plot_timeseries"),
-    "fivdisc.plots.stability": ("plot_eigen_branches", "plot_stability_boundary",
-                                "plot_stability_map"),
+    "fivdisc.plots.stability": ("plot_eigen_branches", "plot_hopf_curves",
+                                "plot_stability_boundary", "plot_stability_map"),
     "fivdisc.plots.branch": ("plot_branch",),
     "fivdisc.plots.sweep": ("plot_bifurcation", "plot_separation_map"),
 }

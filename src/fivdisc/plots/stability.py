@@ -1,5 +1,6 @@
 """Figures of the sliding equilibrium's stability: maps over two keys (paper Fig. 3),
-the exact boundary, and eigenvalue branches along one key."""
+the exact boundary, every Hopf curve with its codimension-two points, and eigenvalue
+branches along one key."""
 
 from __future__ import annotations
 
@@ -16,7 +17,8 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 from fivdisc.plots.text import drawing, new_axes, set_title
 
-__all__ = ["plot_eigen_branches", "plot_stability_boundary", "plot_stability_map"]
+__all__ = ["plot_eigen_branches", "plot_hopf_curves", "plot_stability_boundary",
+           "plot_stability_map"]
 
 
 @drawing
@@ -190,4 +192,97 @@ def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None) -> Figure:
     set_title(top, ds, "eigenvalue branches (thick: unstable)",
            detail="dotted: mode coupling; dots: Hopf points" if len(ds["coupling"]) or marks
            else "")
+    return fig
+
+
+# Markers of the codimension-two points of plot_hopf_curves: marker, label, abbreviation.
+_CODIM2 = {"bautin": ("*", "Bautin (l1 = 0)", "GH"), "double_hopf": ("s", "double Hopf", "HH"),
+           "zero_hopf": ("^", "zero-Hopf", "ZH"),
+           "existence": ("X", "equilibrium ceases to exist", "E")}
+
+
+@drawing
+def plot_hopf_curves(ds: xr.Dataset, ax: Axes | None = None,
+                     grid: xr.Dataset | None = None) -> Figure:
+    """Every Hopf curve of :func:`fivdisc.analysis.codimension.hopf_curves` with its
+    codimension-two points.
+
+    One colour per mode, labelled with its frequencies; solid where the Hopf
+    point is supercritical (``l1 < 0``), dashed where subcritical (``l1 > 0``: sliding
+    is stable on one side but a large enough disturbance starts a vibration), thick
+    where the curve is the outer stability boundary. Bautin (GH), double Hopf (HH),
+    zero-Hopf (ZH) points and the ends of the equilibrium's existence (E) are marked
+    and named; the limit of existence is drawn in grey.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The curves' dataset.
+    ax : matplotlib Axes, optional
+        Where to draw.
+    grid : xarray.Dataset, optional
+        A :func:`fivdisc.analysis.stability.stability_map` over the same keys: its
+        stable and unstable regions are shaded underneath.
+    """
+    fig, ax = new_axes(ax)
+    xkey, ykey = ds.attrs["x_key"], ds.attrs["y_key"]
+    if grid is not None:
+        stable = grid["stable"].transpose(ykey, xkey).values.astype(float)
+        stable[np.isnan(grid["max_growth_rate"].transpose(ykey, xkey).values)] = np.nan
+        ax.contourf(grid[xkey].values, grid[ykey].values, stable, levels=[-0.5, 0.5, 1.5],
+                    colors=["#f4c7c3", "#c6e5c3"])
+        ax.plot([], [], color="#c6e5c3", lw=8, label="sliding stable")
+        ax.plot([], [], color="#f4c7c3", lw=8, label="sliding unstable")
+    x, y = ds[xkey].values, ds[ykey].values
+    from matplotlib import rcParams
+
+    cycle = rcParams["axes.prop_cycle"].by_key()["color"]
+    # One colour and one legend entry per mode (identical sliders give several curves of
+    # nearly one frequency).
+    modes = list(dict.fromkeys(str(m) for m in ds["curve_mode"].values))
+    for k, mode in enumerate(modes):
+        sel = np.isin(ds["hopf_curve"].values,
+                      np.flatnonzero(ds["curve_mode"].values == mode))
+        freq = ds["frequency"].values[sel]
+        span = (f"{np.median(freq):.5g} Hz" if np.ptp(freq) < 5e-4 * freq.max()
+                else f"{freq.min():.4g}-{freq.max():.4g} Hz")
+        ax.plot([], [], lw=1.5, color=cycle[k % len(cycle)], label=f"{mode}, {span}")
+    for c in range(ds.sizes["curve_index"]):
+        sel = np.flatnonzero(ds["hopf_curve"].values == c)
+        color = cycle[modes.index(str(ds["curve_mode"].values[c])) % len(cycle)]
+        sub = ds["l1"].values[sel] > 0.0
+        outer = ds["on_boundary"].values[sel].astype(bool)
+        for k in range(sel.size - 1):
+            i, j = sel[k], sel[k + 1]
+            ax.plot(x[[i, j]], y[[i, j]], color=color, ls="--" if sub[k] and sub[k + 1]
+                    else "-", lw=2.6 if outer[k] and outer[k + 1] else 1.2)
+    if ds.sizes["curve_index"]:
+        ax.plot([], [], color="0.3", lw=1.2, label="supercritical (l1 < 0)")
+        ax.plot([], [], color="0.3", lw=1.2, ls="--", label="subcritical (l1 > 0)")
+        ax.plot([], [], color="0.3", lw=2.6, label="on the stability boundary")
+    ex = ds["existence_branch"].values
+    for b in np.unique(ex):
+        sel = ex == b
+        ax.plot(ds["existence_x"].values[sel], ds["existence_y"].values[sel], color="0.5",
+                lw=2.0, label="limit of existence" if b == ex.min() else None)
+    kinds = ds["codim2_kind"].values
+    for kind, (marker, name, short) in _CODIM2.items():
+        sel = np.flatnonzero(kinds == kind)
+        if not sel.size:
+            continue
+        ax.plot(ds["codim2_x"].values[sel], ds["codim2_y"].values[sel], marker, ms=10,
+                color="k", mfc="gold" if kind == "bautin" else "w", label=f"{short}: {name}")
+        for i in sel:
+            ax.annotate(short, (ds["codim2_x"].values[i], ds["codim2_y"].values[i]),
+                        xytext=(6, 6), textcoords="offset points", fontsize="small")
+    ax.set_xlim(*ds.attrs["x_range"])
+    ax.set_ylim(*ds.attrs["y_range"])
+    ax.set_xlabel(axis_label(ds[xkey]))
+    ax.set_ylabel(axis_label(ds[ykey]))
+    if not ds.sizes["curve_index"]:
+        ax.text(0.5, 0.5, "no Hopf curve in the box", transform=ax.transAxes,
+                ha="center", va="center", fontsize="large", alpha=0.6)
+    ax.legend(loc="best", fontsize="small")
+    set_title(ax, ds, "Hopf curves of the sliding equilibrium",
+              detail="dashed: subcritical, where sliding is stable but not safe")
     return fig

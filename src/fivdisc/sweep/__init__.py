@@ -3,8 +3,10 @@
 >>> from fivdisc import examples
 >>> from fivdisc.sweep import load_sweep, run_sweep, open_sweep
 >>> spec = load_sweep(examples.path("sweep_fig27"))
+>>> spec.shape, spec.n_points
+((40, 40), 1600)
 >>> report = run_sweep(spec, "fig27.zarr")  # doctest: +SKIP
->>> open_sweep("fig27.zarr")["separated"]  # doctest: +SKIP  (on the grid's axes)
+>>> open_sweep("fig27.zarr")["separated"]  # on the grid's axes  # doctest: +SKIP
 
 See the documentation's page "Sweep files" (and :mod:`fivdisc.sweep.spec`) for the sweep
 file format and the store's layout (:mod:`fivdisc.sweep.store`),
