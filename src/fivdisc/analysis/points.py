@@ -169,7 +169,7 @@ def warn_if_long(points: ParameterPoints, values: Sequence[float], count: int,
         seconds.append(time.perf_counter() - start)
     total = count * seconds[-1]
     if total > LONG_SCAN:
-        warnings.warn(f"{what} of {count:,} points takes about {duration_words(total)} "
+        warnings.warn(f"{what} ({count:,} points) will take about {duration_words(total)} "
                       f"({seconds[-1] * 1e3:.2g} ms a point, measured on its first); "
                       f"{fewer} take less", FivdiscWarning, stacklevel=3)
 

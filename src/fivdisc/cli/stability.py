@@ -263,13 +263,20 @@ def _map(case, case_file, x_spec, y_spec, curve_spec, output, progress) -> None:
         check_map_size,
         parse_range,
         range_size,
+        resolve_key,
         stability_map,
     )
 
     out, figure = _target(case_file, output, "stability.nc")
     specs = {"--x": x_spec, "--y": y_spec, **({"--curves": curve_spec} if curve_spec else {})}
     # The map's size before any axis' values are made.
-    check_map_size(case, [range_size(spec, option) for option, spec in specs.items()])
+    sizes = [range_size(spec, option) for option, spec in specs.items()]
+    check_map_size(case, sizes)
+    if figure and curve_spec:
+        from fivdisc.plots.stability import check_curves
+
+        check_curves(sizes[2], resolve_key(curve_spec.split("=", 1)[0].strip(), "--curves"),
+                     "--curves")
     axes = {"--x": parse_range(x_spec, "--x"), "--y": parse_range(y_spec, "--y")}
     if curve_spec is not None:
         axes["--curves"] = parse_range(curve_spec, "--curves")
