@@ -33,7 +33,7 @@ def test_sliders_closer_than_a_micrometre_are_refused() -> None:
     _refused(["puts sliders.1 5e-07 m from sliders.0"],
              sliders=[{"angle": 1.0}, {"angle": 1.0, "track_radius": 0.1 + 5e-7}])
     # A micrometre and more apart, or on the other face, they are two sliders.
-    Case(sliders=[{"angle": 0.0}, {"angle": 1e-5}])
+    Case(sliders=[{"angle": 0.0}, {"angle": 1e-4}])
     Case(sliders=[{"angle": 0.0}, {"angle": 0.0, "face": "bottom"}])
 
 

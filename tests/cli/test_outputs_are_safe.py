@@ -265,7 +265,7 @@ def test_a_temporary_file_of_a_killed_write_is_removed_by_the_next(case_file: Pa
     assert killed.returncode == -9
     left = list(tmp_path.glob(".r.*.tmp.nc"))
     assert len(left) == 1 and not out.exists()
-    alive = tmp_path / f".r.{os.getpid()}.tmp.nc"  # a write under way in a live process
+    alive = tmp_path / f".r.{os.getppid()}.tmp.nc"  # a write under way in a live process
     alive.write_bytes(b"")
     mine = tmp_path / ".r.backup.tmp.nc"  # not a process id: a user's file
     mine.write_bytes(b"")

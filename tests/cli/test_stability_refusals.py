@@ -154,11 +154,10 @@ def test_a_scan_of_a_simulation_setting_is_refused(tmp_path: Path, option: str) 
     """The simulation settings do not change the linearisation (continue refused them)."""
     axes = {"--x": "speed.value=1:5:3", "--y": "normal_damping=0:1:3"}
     axes[option] = "simulation.rtol=1e-8:1e-6:3"
-    args = ["stability", "--x", axes["--x"], "-o", tmp_path / "m.nc", "--no-progress"]
-    if option == "--y":
-        args[4:4] = ["--y", axes["--y"]]
-    _refused(args, f"{option[2:]} = simulation.rtol is invalid: the simulation settings do "
-             "not change the sliding equilibrium")
+    given = ["--x", axes["--x"]] + (["--y", axes["--y"]] if option == "--y" else [])
+    _refused(["stability", *given, "-o", tmp_path / "m.nc", "--no-progress"],
+             f"{option[2:]} = simulation.rtol is invalid: the simulation settings do not change "
+             "the sliding equilibrium")
 
 
 def test_more_curves_than_a_figure_tells_apart_are_refused(tmp_path: Path) -> None:
