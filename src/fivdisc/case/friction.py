@@ -102,7 +102,7 @@ class TableFriction(_FrictionLaw):
     law
         "table".
     static
-        mu_s, static coefficient; not below the first tabulated value.
+        mu_s, static coefficient; not below any tabulated value.
     speeds
         Sliding speeds u [m/s]: start at 0, strictly increase, at least two.
     values

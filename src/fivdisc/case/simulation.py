@@ -43,7 +43,7 @@ class Simulation(Table):
         sliding equilibrium plus `perturbation`; constant speed only).
     probes
         (r [m], theta [rad]) points of the disc whose displacement w is recorded;
-        each r within [a, b].
+        each r within [a, b], each theta within +-1e6.
     omega_dot_terms
         Keep the disc's dOmega/dt terms (the paper's printed equations omit them).
     printed_gyroscopic_sign

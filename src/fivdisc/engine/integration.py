@@ -64,9 +64,9 @@ def time_scales(model: Model) -> list[tuple[str, float]]:
     labels = np.array(model.labels)
     scales = [(f"disc.modes {lab} natural frequency", w) for lab, w in zip(labels, model.omega,
                                                                           strict=True)]
-    scales += [(f"disc.damping_ratio of {lab}", 2.0 * z * w)
-               for lab, z, w in zip(labels, model.damping, model.omega, strict=True)]
-    with np.errstate(all="ignore"):
+    with np.errstate(all="ignore"):  # an overflow is an infinite rate, refused as such
+        scales += [(f"disc.damping_ratio of {lab}", float(2.0 * z * w))
+                   for lab, z, w in zip(labels, model.damping, model.omega, strict=True)]
         rows = [("sqrt(normal_stiffness / mass)", np.sqrt(kern.row("kz") / kern.row("mass"))),
                 ("sqrt(rotational_stiffness / inertia)",
                  np.sqrt(kern.row("kphi") / kern.row("inertia"))),
