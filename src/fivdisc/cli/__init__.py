@@ -27,24 +27,44 @@ def _fail(message: str) -> None:
     sys.exit(2)
 
 
-def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """A warning of fivdisc as one line, ``warning: ...``, on stderr (others are left to
-    Python's display)."""
-    if issubclass(category, FivdiscWarning):
-        click.echo(f"warning: {' '.join(str(message).split())}", err=True)
-    else:
-        _python_show(message, category, filename, lineno, file, line)
+class _Warnings:
+    """How a command shows warnings: fivdisc's at once, as one line ``warning: ...`` on
+    stderr; numerical RuntimeWarnings (numpy's overflow and the like, on the way to a
+    value a check then refuses) held until the command ends, and dropped if it ends
+    with an error, whose one line says what went wrong; any other as Python shows it."""
 
+    def __init__(self) -> None:
+        self.held: list[tuple] = []
+        self.python = warnings.showwarning
 
-_python_show = warnings.showwarning
+    def show(self, message, category, filename, lineno, file=None, line=None) -> None:
+        if issubclass(category, FivdiscWarning):
+            click.echo(f"warning: {' '.join(str(message).split())}", err=True)
+        elif issubclass(category, RuntimeWarning):
+            self.held.append((message, category, filename, lineno, file, line))
+        else:
+            self.python(message, category, filename, lineno, file, line)
+
+    def release(self) -> None:
+        for held in self.held:
+            self.python(*held)
+        self.held = []
 
 
 class _Group(click.Group):
     def invoke(self, ctx: click.Context):
+        shown = _Warnings()
         with warnings.catch_warnings():
-            warnings.showwarning = _show_warning
+            warnings.showwarning = shown.show
             warnings.simplefilter("always", FivdiscWarning)
-            return self._invoke(ctx)
+            try:
+                result = self._invoke(ctx)
+            except SystemExit as exc:
+                if exc.code in (0, None):
+                    shown.release()
+                raise
+            shown.release()
+            return result
 
     def _invoke(self, ctx: click.Context):
         try:
