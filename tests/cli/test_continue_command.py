@@ -105,3 +105,18 @@ def test_a_second_ctrl_c_during_continue_still_writes_the_branch(rigid_orbit_fil
     assert len(open_branch(out)) == 4
     # The handler is the one before the command again.
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_an_orbit_of_a_preload_below_any_physical_force_is_refused(tmp_path: Path) -> None:
+    """Found by the fuzz (item 3): a preload of 2.2e-308 N let the shooting run into
+    subnormal states, where the kernel divided by zero (ZeroDivisionError). As for a
+    preload of 0, nothing drives the disc: refused, for orbit and continue alike."""
+    from fivdisc import Case
+
+    path = tmp_path / "c.toml"
+    Case(slider={"preload": 2.2250738585072014e-308}).save(path)
+    words = ("slider.preload = 2.22507e-308 is invalid for a periodic orbit: must be > 1e-09 N "
+             "for some slider")
+    _refused(["orbit", path, "--no-progress", "--transient", "0.01"], words)
+    _refused(["continue", path, "--key", "speed.value", "--to", "7", "--no-progress",
+              "--transient", "0.01"], words)

@@ -22,6 +22,9 @@ from fivdisc.limits import (
 __all__ = ["MAX_RTOL", "MAX_TOL", "MIN_RTOL", "MIN_TOL", "check_orbit_request",
            "check_period", "check_time", "check_tol", "shortest_period"]
 
+# Below this preload [N] a normal force has no physical meaning (a millionth of a gram's
+# weight; fivdisc.engine.simulation._NO_FORCE, which calls such a run degenerate).
+_NO_FORCE = 1e-9
 #: Tolerances the shooting runs accept (:data:`fivdisc.limits.MIN_SHOOTING_RTOL`).
 MIN_RTOL = MIN_SHOOTING_RTOL
 MAX_RTOL = MAX_SHOOTING_RTOL
@@ -110,9 +113,16 @@ def check_orbit_request(case: Case, *, period: float | None = None,
     if not case.disc.modes:
         raise FivdiscError("disc.modes = [] is invalid for a periodic orbit: a rigid disc "
                            "has no disc coordinates to shoot on; give at least one mode")
-    if not any(s.preload for s in case.sliders):
-        raise FivdiscError("slider.preload = 0 is invalid for a periodic orbit: without a "
-                           "normal force nothing drives the disc, which stays at rest")
+    # As a run's degeneracy test (fivdisc.engine.simulation.degenerate) counts it: below
+    # a nanonewton a normal force has no physical meaning (2.2e-308 N drove the shooting
+    # to subnormal states, a ZeroDivisionError in the kernel).
+    strongest = max(range(len(case.sliders)), key=lambda j: case.sliders[j].preload)
+    preload = case.sliders[strongest].preload
+    if not preload > _NO_FORCE:
+        raise FivdiscError(f"{case.slider_key(strongest)}.preload = {preload:g} is invalid "
+                           f"for a periodic orbit: must be > {_NO_FORCE:g} N for some slider "
+                           "(without a normal force nothing drives the disc, which stays at "
+                           "rest)")
     if period is not None:
         check_period(case, period, p_name)
     else:
