@@ -48,7 +48,8 @@ def test_an_orbit_search_on_many_pads_warns_and_stops_at_its_budget(monkeypatch)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         with pytest.raises(ConvergenceError) as info:
-            periodic_orbit(case, time_budget=budget, tol=1e-14, max_iterations=10**6)
+            periodic_orbit(case, time_budget=budget, tol=1e-14, max_iterations=10**6,
+                           window=0.05)
     notes = [str(w.message) for w in caught if issubclass(w.category, FivdiscWarning)]
     assert any(n.startswith("each Newton iteration takes about ") and "carrying 54 tangent "
                "vectors: one per coordinate of 10 sliders and the disc" in n for n in notes), notes
