@@ -33,8 +33,10 @@ __all__ = [
     "figure_suffixes",
     "netcdf_checksum",
     "read_text",
+    "require_fivdisc_netcdf",
     "write_atomic",
     "write_netcdf",
+    "written_by_fivdisc",
 ]
 
 NETCDF = (".nc",)
@@ -310,6 +312,56 @@ def check_netcdf(path: str | PathLike[str]) -> bool:
         raise FivdiscError(f"{path} is damaged: its data do not match the checksum stored in "
                            f"it ({CHECKSUM}); write it again")
     return True
+
+
+def written_by_fivdisc(path: str | PathLike[str]) -> bool:
+    """Whether a netCDF file says fivdisc wrote it: it holds fivdisc's checksum
+    (:data:`CHECKSUM`), or, from a fivdisc before checksums, a ``source`` attribute
+    naming fivdisc, a ``fivdisc_kind`` or a branch's ``content`` (at the root, or in
+    each of its groups: runs gathered into one file).
+
+    Raises
+    ------
+    FivdiscError
+        The file cannot be read as netCDF; one line naming it.
+    """
+    import netCDF4
+
+    def ours(group: Any) -> bool:
+        attrs = {name: group.getncattr(name) for name in group.ncattrs()}
+        return (CHECKSUM in attrs or str(attrs.get("source", "")).startswith("fivdisc")
+                or "fivdisc_kind" in attrs or attrs.get("content") == "continuation branch")
+
+    try:
+        with netCDF4.Dataset(path) as root:
+            groups = list(root.groups.values())
+            return ours(root) or (bool(groups) and all(ours(g) for g in groups))
+    except (OSError, RuntimeError, ValueError) as exc:
+        raise FivdiscError(f"{path} cannot be read as a netCDF file "
+                           f"({' '.join(str(exc).split())[:120]})") from None
+
+
+def require_fivdisc_netcdf(path: str | PathLike[str], what: str) -> None:
+    """Refuse a netCDF file that fivdisc did not write (:func:`written_by_fivdisc`):
+    its variables may share a result's names without meaning what fivdisc's do.
+
+    Parameters
+    ----------
+    path
+        The file.
+    what
+        What reads it, for the message (``"fivdisc plot"``, ``"open_result"``).
+
+    Raises
+    ------
+    FivdiscError
+        One line naming the file and what it lacks.
+    """
+    if not written_by_fivdisc(path):
+        raise FivdiscError(f"{path} was not written by fivdisc (it holds no fivdisc checksum "
+                           f"or source attribute): {what} reads the netCDF files fivdisc "
+                           "writes (-o of its commands); read this one with "
+                           "xarray.open_dataset")
 
 
 def write_netcdf(path: str | PathLike[str], write: Callable[[Path], Any]) -> None:

@@ -132,9 +132,9 @@ def _eigen_rows():
         (FIG13.case, False, "phi", "39.9"), (FIG13.case, True, "D03", "+0.72"),
         (FIG18.runs["a"], False, "phi", "+33.2"), (FIG18.runs["a"], False, "C02", "+0.98"),
         (FIG18.runs["b"], False, "C02", "+0.58"),
-        (FIG18.runs["a"], True, "D01", "+6.6"), (FIG18.runs["b"], True, "D01", "+7.5"),
+        (FIG18.runs["a"], True, "C00", "+6.6"), (FIG18.runs["b"], True, "C00", "+7.5"),
         (FIG28.case, False, "phi", "+5.75"), (FIG28.case, False, "C03", "+1.44"),
-        (FIG28.case, True, "D03", "+98"), (FIG28.case, True, "D02", "+66"),
+        (FIG28.case, True, "D03", "+98"), (FIG28.case, True, "C02", "+66"),
     ]
 
 

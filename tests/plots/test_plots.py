@@ -78,8 +78,12 @@ def _close_figures():
 
 @pytest.fixture(scope="module")
 def result_file(tmp_path_factory):
+    """The synthetic result, written as fivdisc writes its files (with its checksum:
+    fivdisc plot refuses a netCDF file fivdisc did not write)."""
+    from fivdisc.files import write_netcdf
+
     path = tmp_path_factory.mktemp("plots") / "synthetic.nc"
-    _result().to_netcdf(path)
+    write_netcdf(path, _result().to_netcdf)
     return path
 
 

@@ -22,6 +22,22 @@ RIGID = Case(
 LIGHT = Case(disc={"density": 720.0, "modes": [[0, 0]]},
              slider={"mass": 1.0, "normal_damping": 20.0}, speed={"value": 1.0})
 
+# Issue 40's study: three identical pads at 0, 120 and 240 degrees on a damped disc
+# with Stribeck friction (issue 36's `bist-22-large.toml`, stable sliding at 22 rad/s).
+_PAD = {"face": "top", "track_radius": 0.1, "mass": 0.1, "normal_stiffness": 3e4,
+        "normal_damping": 0.1, "rotational_stiffness": 2e3, "rotational_damping": 0.1,
+        "preload": 500.0}
+THREE_PADS = Case(
+    disc={"modes": [[0, 0], [0, 1], [0, 2], [0, 3]], "damping_ratio": 0.003,
+          "damping_frame": "material"},
+    sliders=[{**_PAD, "angle": a} for a in (0.0, 2 * np.pi / 3, 4 * np.pi / 3)],
+    friction={"law": "stribeck", "static": 0.8, "kinetic_max": 0.6, "kinetic_min": 0.35,
+              "stribeck_velocity": 1.0, "stribeck_exponent": 2.0, "viscous": 0.0},
+    speed={"value": 22.0},
+    simulation={"duration": 3.0, "initial_state": "equilibrium", "output_rate": 10000.0,
+                "perturbation": {"phi": 0.0, "phi_dot": 14.0}},
+)
+
 
 def rigid_disc_closed_form(omega: float = OMEGA):
     """Period of the stick-slip cycle and the disc mode's multipliers, by hand.

@@ -480,6 +480,11 @@ def test_command_runs_the_sweep_and_draws_the_diagram(diagram, sweep_file) -> No
     from fivdisc.plots.sweep import _DOT
 
     assert top.lines[0].get_markersize() > 2 * _DOT  # few values: visible markers
+    # The dots have their entry in the key (issue 40, item 2), with a marker to see.
+    (entry,) = top.get_legend().legend_handles
+    assert top.get_legend().get_texts()[0].get_text() == (
+        "phi of slider 0 at the section, one dot per value")
+    assert entry.get_marker() == "." and entry.get_markersize() >= 6
     np.testing.assert_array_equal(ys, open_sweep(store)["phi_maxima"].values.ravel())
     # the zero line and the exponents
     assert any(np.all(np.asarray(line.get_ydata()) == 0.0) for line in bottom.lines)

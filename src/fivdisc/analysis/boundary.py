@@ -24,7 +24,7 @@ import numpy as np
 import xarray as xr
 
 from fivdisc.analysis.points import ParameterPoints, check_box, check_keys, check_values
-from fivdisc.analysis.stability import dominant_coordinates
+from fivdisc.analysis.stability import mode_labels
 from fivdisc.case import Case
 from fivdisc.errors import CaseError
 
@@ -58,12 +58,12 @@ class _Growth:
 
     def critical(self, u: np.ndarray) -> tuple[complex, str]:
         """The eigenvalue with the largest real part (positive imaginary part of a pair)
-        and its dominant coordinate."""
+        and its mode's label (:func:`~fivdisc.analysis.stability.mode_labels`)."""
         model, _, jac = self.points.linearise(self.values(u), self.guess)
         lam, vec = np.linalg.eig(jac)
         top = lam.real >= lam.real.max() - 1e-9 * np.abs(lam).max()
         i = int(np.argmax(np.where(top, lam.imag, -np.inf)))
-        return complex(lam[i]), dominant_coordinates(model, vec[:, [i]])[0]
+        return complex(lam[i]), mode_labels(model, lam, vec)[i]
 
 
 def _zero_between(g: _Growth, a: np.ndarray, b: np.ndarray, ga: float, gb: float
@@ -322,7 +322,7 @@ def _dataset(case: Case, g: _Growth, branches, x, y) -> xr.Dataset:
             "frequency": (("point",), np.array(cols[4], dtype=float), {
                 "units": "Hz", "long_name": "frequency of the critical eigenvalue"}),
             "mode": (("point",), np.array(cols[5], dtype=str), {
-                "long_name": "coordinate with most of the critical mode's kinetic energy"}),
+                "long_name": "label of the critical mode (mode_labels at the point)"}),
             "closed": (("curve",), np.array([c for _, c in branches], dtype=np.int8),
                        {"long_name": "the curve closes on itself inside the box"}),
         },

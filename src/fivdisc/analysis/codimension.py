@@ -39,7 +39,7 @@ import xarray as xr
 from fivdisc.analysis.boundary import zero_curves
 from fivdisc.analysis.normalform import first_lyapunov
 from fivdisc.analysis.points import ParameterPoints, check_box, check_keys, check_values
-from fivdisc.analysis.stability import dominant_coordinates
+from fivdisc.analysis.stability import mode_labels
 from fivdisc.case import Case
 from fivdisc.errors import CaseError
 
@@ -747,7 +747,7 @@ def _dataset(case: Case, box: _Box, curves: list[_Curve], l1s, specials: list[_S
             s = p.solve
             lam, vec = np.linalg.eig(s.jac)
             i = int(np.argmin(np.abs(lam - p.lam)))
-            mode = dominant_coordinates(s.model, vec[:, [i]])[0]
+            mode = mode_labels(s.model, lam, vec)[i]
             modes.append(mode)
             others = np.delete(lam.real, [i, int(np.argmin(np.abs(lam - np.conj(lam[i]))))])
             rows.append((*box.values(p.u), c, p.lam.imag / (2 * np.pi), mode, value, error,
@@ -764,7 +764,7 @@ def _dataset(case: Case, box: _Box, curves: list[_Curve], l1s, specials: list[_S
         s = sp.point.solve
         lam, vec = np.linalg.eig(s.jac)
         i = int(np.argmin(np.abs(lam - sp.point.lam)))
-        return dominant_coordinates(s.model, vec[:, [i]])[0]
+        return mode_labels(s.model, lam, vec)[i]
 
     return xr.Dataset(
         {

@@ -23,10 +23,12 @@ from fivdisc.analysis.points import (
     check_values,
     warn_if_long,
 )
-from fivdisc.analysis.stability import dominant_coordinates
+from fivdisc.analysis.stability import mode_labels
 from fivdisc.case import Case
-from fivdisc.engine.equilibrium import Equilibrium
+from fivdisc.engine.equilibrium import Equilibrium, _evaluate
 from fivdisc.limits import check_memory
+from fivdisc.model import layout as lay
+from fivdisc.model.build import Model
 
 # Two branches' frequencies count as merged (a coupling) within this fraction of the
 # frequency: inside a flutter region of an undamped system they are equal, damping
@@ -128,14 +130,17 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
         Dimension named after the key (with its units), ``branch`` (one per eigenvalue,
         ``2 (n + S)``) and ``slider``. Variables: ``growth_rate`` and ``frequency`` (key,
         branch) [1/s], [Hz]: the real part and the imaginary part / 2 pi (signed: each
-        complex pair has a positive and a negative branch); ``mode`` (branch): the
-        coordinate with most of the kinetic energy where the branch starts;
-        ``max_growth_rate`` (key); ``normal_force``, ``phi`` (key, slider): the
-        equilibrium (NaN where there is none); ``existence_limit`` (limit): the values
+        complex pair has a positive and a negative branch); ``mode`` (branch): its
+        mode's label (:func:`~fivdisc.analysis.stability.mode_labels`, one per mode,
+        the two branches of a pair sharing it) at the value nearest the case's own
+        value of the key (``mode.labelled_at``), carried along the branch;
+        ``max_growth_rate`` (key); ``normal_force``, ``phi``, ``w`` (key, slider): the
+        equilibrium's normal forces, slider angles and disc deflections under the
+        sliders (NaN where there is none); ``existence_limit`` (limit): the values
         of the key where a slider's normal force reaches zero and the equilibrium ceases
         to exist; ``coupling`` (coupling) with ``coupling_first``, ``coupling_second``:
-        the values (at the grid's resolution) where two branches' frequencies merge
-        within ``COUPLING_TOLERANCE`` while their growth rates part, and the branches.
+        the values (at the grid's resolution) where two branches' frequencies meet
+        (:func:`mode_couplings`) while their growth rates part, and the branches.
         Attributes ``x_key`` and the base case's TOML (``case``).
 
     Raises
@@ -182,7 +187,9 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
     lam = np.full((values.size, size), np.nan + 1j * np.nan)
     force = np.full((values.size, ns), np.nan)
     angle = np.full((values.size, ns), np.nan)
-    first_model = first_vectors = None
+    under = np.full((values.size, ns), np.nan)
+    own = float(case.get(key))
+    labelled = None  # (row, model, Jacobian) nearest the case's own value so far
     limits: list[float] = []
     guess = None
     bar = None
@@ -204,28 +211,44 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
             # The equilibrium reappears: the limit lies between the last two values.
             limits.append(_existence_limit(points, value, values[i - 1], eq))
         guess = eq
-        if first_model is None:
-            lam[i], first_vectors = np.linalg.eig(jac)
-            first_model = model
-        else:
-            lam[i] = np.linalg.eigvals(jac)
+        lam[i] = np.linalg.eigvals(jac)
+        if labelled is None or abs(value - own) < abs(values[labelled[0]] - own):
+            labelled = (i, model, jac)
         force[i], angle[i] = eq.normal_force, eq.phi
+        under[i] = _evaluate(model, eq.state)[1][lay.A_WC]
     if bar is not None:
         bar.close()
-    raw = lam[np.isfinite(lam).all(axis=1)][0]
     lam = follow(lam)
-    start = lam[np.isfinite(lam).all(axis=1)][0]
-    which = [int(np.argmin(np.abs(raw - v))) for v in start]
-    modes = dominant_coordinates(first_model, first_vectors[:, which])
-    return _dataset(case, key, values, lam, modes, force, angle, limits)
+    # The branches are named where the scan comes nearest the case's own value of the
+    # key (the first of two as near): a scan names its modes as ``fivdisc stability
+    # CASE`` does wherever its range holds that value, whatever else it spans.
+    row, model, jac = labelled
+    modes = _branch_labels(model, jac, lam[row])
+    ds = _dataset(case, key, values, lam, modes, force, angle, under, limits)
+    ds["mode"].attrs["labelled_at"] = float(values[row])
+    return ds
+
+
+def _branch_labels(model: Model, jac: np.ndarray, row: np.ndarray) -> tuple[str, ...]:
+    """The labels (:func:`~fivdisc.analysis.stability.mode_labels`) of the eigenvalues
+    of `jac`, in the order of the followed `row` (the same eigenvalues, reordered)."""
+    from scipy.optimize import linear_sum_assignment
+
+    lam, vec = np.linalg.eig(jac)
+    labels = mode_labels(model, lam, vec)
+    # The same Jacobian solved again: each followed eigenvalue is one of these to
+    # round-off; the assignment keeps a double eigenvalue's two apart.
+    _, order = linear_sum_assignment(np.abs(row[:, None] - lam[None, :]))
+    return tuple(labels[j] for j in order)
 
 
 def branch_bytes(case: Case) -> float:
     """Memory of :func:`eigen_branches` per value of the key [bytes]: the eigenvalues
     (complex), their copy followed into branches, the dataset's growth rates and
-    frequencies, the equilibrium's forces and angles, and the netCDF writer's copies."""
+    frequencies, the equilibrium's forces, angles and deflections, and the netCDF
+    writer's copies."""
     size = 2 * (sum(1 if l == 0 else 2 for _, l in case.disc.modes) + len(case.sliders))
-    return 2.0 * (16 * 2 * size + 16 * size + 16 * len(case.sliders) + 8)
+    return 2.0 * (16 * 2 * size + 16 * size + 24 * len(case.sliders) + 8)
 
 
 def _last_valid(lam: np.ndarray, i: int) -> int:
@@ -236,12 +259,21 @@ def _last_valid(lam: np.ndarray, i: int) -> int:
 def mode_couplings(lam: np.ndarray, tolerance: float = COUPLING_TOLERANCE
                    ) -> list[tuple[int, int, int]]:
     """Where pairs of branches couple: ``(index, first, second)`` at each edge of an
-    interval of values where the two positive frequencies agree within `tolerance`
-    (relative) and the growth rates are further apart than just outside it, where they
-    agree within `tolerance` of the frequency (the eigenvalues meet; modes already apart
-    in growth rate that cross in frequency do not couple); `index` is
-    the edge's value inside the interval (where the modes merge, and where they part
-    again).
+    interval of values where the two positive frequencies meet, and the growth rates are
+    further apart than just outside it, where they agree within `tolerance` of the
+    frequency (the eigenvalues meet; modes already apart in growth rate that cross in
+    frequency do not couple); `index` is the edge's value inside the interval (where the
+    modes merge, and where they part again).
+
+    Two frequencies meet where they agree within `tolerance` (relative) and lie closer
+    together than the growth rates: the pair of eigenvalues has turned from lying side
+    by side in frequency to lying side by side in growth rate, as coupled modes do (in
+    an undamped flutter the frequencies are then equal; damping leaves them apart by
+    less than the growth rates). The growth rates must also have parted by at least
+    their mean distance from zero, what it takes for the coupling to drive one of them
+    through zero. Two modes that only approach, 1 % apart in frequency and further apart
+    than their growth rates, do not couple; nor do the near-equal modes of identical
+    pads, whose growth rates shuffle by a few per cent of their size.
 
     Parameters
     ----------
@@ -253,25 +285,29 @@ def mode_couplings(lam: np.ndarray, tolerance: float = COUPLING_TOLERANCE
     for ia, a in enumerate(upper):
         for b in upper[ia + 1:]:
             wa, wb = lam[:, a].imag, lam[:, b].imag
-            merged = np.abs(wa - wb) <= tolerance * np.maximum(np.abs(wa), np.abs(wb))
             split = np.abs(lam[:, a].real - lam[:, b].real)
+            gap = np.abs(wa - wb)
+            merged = (gap <= tolerance * np.maximum(np.abs(wa), np.abs(wb))) & (gap <= split)
+            mean = 0.5 * np.abs(lam[:, a].real + lam[:, b].real)
             for i in range(1, lam.shape[0]):
                 if merged[i] == merged[i - 1] or not np.isfinite(wa[i - 1] + wb[i]):
                     continue
                 inside, outside = (i, i - 1) if merged[i] else (i - 1, i)
                 # The growth rates part on the merged side (a coupling, not a veering),
-                # and just outside it they agree as closely as the frequencies do: the
-                # eigenvalues meet. Modes whose growth rates are already apart only
-                # cross in frequency.
+                # by at least their mean distance from zero, and just outside it they
+                # agree as closely as the frequencies do: the eigenvalues meet. Modes
+                # whose growth rates are already apart only cross in frequency.
                 near = tolerance * max(abs(wa[outside]), abs(wb[outside]))
-                if split[outside] <= near and split[inside] > split[outside]:
+                if (split[outside] <= near and split[inside] > split[outside]
+                        and split[inside] >= mean[inside]):
                     found.append((inside, a, b))
-    return sorted(found)
+    # An interval of one value is entered and left there: one coupling.
+    return sorted(set(found))
 
 
 def _dataset(case: Case, key: str, values: np.ndarray, lam: np.ndarray,
              modes: tuple[str, ...], force: np.ndarray, angle: np.ndarray,
-             limits: list[float]) -> xr.Dataset:
+             under: np.ndarray, limits: list[float]) -> xr.Dataset:
     from fivdisc.engine.conventions import global_attrs, key_attrs
 
     couplings = mode_couplings(lam)
@@ -292,6 +328,9 @@ def _dataset(case: Case, key: str, values: np.ndarray, lam: np.ndarray,
                 "units": "N", "long_name": "normal force at the sliding equilibrium"}),
             "phi": ((key, "slider"), angle, {
                 "units": "rad", "long_name": "slider angle at the sliding equilibrium"}),
+            "w": ((key, "slider"), under, {
+                "units": "m", "long_name": "disc deflection under the slider at the sliding "
+                                           "equilibrium"}),
             "existence_limit": (("limit",), np.array(limits, dtype=float), {
                 "units": key_attrs(key)["units"],
                 "long_name": "where a slider's normal force at the equilibrium reaches "

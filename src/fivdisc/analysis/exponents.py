@@ -33,6 +33,12 @@ from fivdisc.model.build import Model, build_model
 
 __all__ = ["LyapunovSpectrum", "lyapunov"]
 
+#: The verdicts of :meth:`LyapunovSpectrum.verdict`.
+POSITIVE, ZERO, NEGATIVE, UNDECIDED = "positive", "zero", "negative", "undecided"
+# How many uncertainties from zero (or apart) decide a sign (or resolve two exponents):
+# the reference tests find the estimates within three of their limits.
+SIGNIFICANCE = 3.0
+
 # Blocks of the run whose exponents give the uncertainty (their spread).
 _BLOCKS = 10
 # Sets of tangent vectors from independent random starts for more than one exponent: the
@@ -105,32 +111,140 @@ class LyapunovSpectrum:
 
     @property
     def conclusive(self) -> np.ndarray:
-        """``(n,)`` whether each exponent is known: its uncertainty is finite and smaller
-        than its magnitude (else even its sign is not; a collapsed direction's -inf is
-        known)."""
+        """``(n,)`` whether each exponent's sign is known at one uncertainty: its
+        uncertainty is finite and smaller than its magnitude (a collapsed direction's
+        -inf is known). What sweeps store as ``largest_lyapunov_inconclusive``; the
+        verdict (:meth:`verdict`) asks for more."""
         e, u = self.exponents, self.uncertainty
         with np.errstate(invalid="ignore"):
             return np.isneginf(e) | (np.isfinite(e) & np.isfinite(u) & (u < np.abs(e)))
 
+    @property
+    def verdicts(self) -> tuple[str, ...]:
+        """Each exponent's :meth:`verdict`."""
+        return tuple(self.verdict(i) for i in range(self.exponents.size))
+
+    @property
+    def decided(self) -> np.ndarray:
+        """``(n,)`` whether each exponent's verdict is decided (not ``"undecided"``)."""
+        return np.array([v != UNDECIDED for v in self.verdicts], dtype=bool)
+
+    def bounds(self, i: int, k: float = SIGNIFICANCE) -> tuple[float, float]:
+        """Where the i-th largest exponent lies if each estimate lies within ``k`` of its
+        uncertainties of its limit: between the i-th largest of the estimates' lower
+        ends and the i-th largest of their upper ends (a finite run may measure the
+        exponents in another order than their limits'). An unknown uncertainty leaves
+        that exponent anywhere; -inf stays -inf."""
+        e, u = self.exponents, self.uncertainty
+        with np.errstate(invalid="ignore"):
+            unknown = ~np.isfinite(u) & ~np.isneginf(e)
+            low = np.where(unknown, -np.inf, np.where(np.isneginf(e), -np.inf, e - k * u))
+            high = np.where(unknown, np.inf, np.where(np.isneginf(e), -np.inf, e + k * u))
+        return float(np.sort(low)[::-1][i]), float(np.sort(high)[::-1][i])
+
     def verdict(self, i: int) -> str:
-        """Why exponent ``i`` is inconclusive ("" if it is not)."""
-        if self.conclusive[i]:
-            return ""
-        e, u = self.exponents[i], self.uncertainty[i]
+        """What exponent ``i`` is at this length of measurement: ``"positive"``,
+        ``"negative"``, ``"zero"`` (consistent with zero) or ``"undecided"``.
+
+        With ``u`` the uncertainties, each limit is taken to lie within ``3 u`` of its
+        estimate (how far the estimates of the reference tests lie from their limits at
+        most), so that the i-th largest exponent lies within :meth:`bounds`: it is
+        positive or negative where those exclude zero (a collapsed direction's -inf is
+        negative). It is zero where the bounds at one uncertainty hold zero and another
+        exponent, decided positive or negative, has bounds apart from its own: the
+        interval around zero is then narrow against a rate the motion does have (on a
+        periodic orbit, the flow direction's 0 against the slowest attraction).
+        Otherwise it is undecided: an uncertainty is unknown, it lies between one and
+        three uncertainties from zero (neither near it nor clearly away), or no other
+        exponent measures the scale (with one exponent, none: compute two). A longer
+        measurement shrinks ``u`` and decides it.
+        """
+        low, high = self.bounds(i)
+        if low > 0:
+            return POSITIVE
+        if high < 0:
+            return NEGATIVE
+        near_low, near_high = self.bounds(i, 1.0)
+        if near_low <= 0 <= near_high and np.isfinite(near_high - near_low) and (
+                self._resolved_by(i) is not None):
+            return ZERO
+        return UNDECIDED
+
+    def _resolved_by(self, i: int) -> int | None:
+        """The exponent nearest to exponent ``i`` of those decided positive or negative
+        whose :meth:`bounds` are apart from exponent ``i``'s (None if none)."""
+        low, high = self.bounds(i)
+        best = None
+        for j in range(self.exponents.size):
+            if j == i:
+                continue
+            other_low, other_high = self.bounds(j)
+            decided = other_low > 0 or other_high < 0
+            if decided and np.isfinite(other_high) and (other_high < low or other_low > high):
+                if best is None or abs(j - i) < abs(best - i):
+                    best = j
+        return best
+
+    def explain(self, i: int) -> str:
+        """Exponent ``i``, its verdict and what the verdict rests on, in one line."""
+        e, u = float(self.exponents[i]), float(self.uncertainty[i])
+        name = f"lambda_{i + 1}"
+        verdict = self.verdict(i)
+        low, high = self.bounds(i)
+        if np.isneginf(e) and verdict == NEGATIVE:
+            return f"{name} = -inf: negative (a direction collapsed by sticking or impact)"
+        head = (f"{name} = {e:+.6g} +- {u:.2g} 1/s" if np.isfinite(u)
+                else f"{name} = {e:+.6g} 1/s")
+        if verdict in (POSITIVE, NEGATIVE):
+            return (f"{head}: {verdict} (between {low:+.3g} and {high:+.3g} 1/s at "
+                    f"{SIGNIFICANCE:g} uncertainties)")
+        if verdict == ZERO:
+            j = self._resolved_by(i)
+            return (f"{head}: consistent with zero (within one uncertainty, and resolved "
+                    f"from lambda_{j + 1} = {self.exponents[j]:+.6g} 1/s)")
+        few = ("too few re-orthonormalisations: lengthen the measurement or shorten the "
+               "interval")
         if not np.isfinite(u):
-            return (f"lambda_{i + 1} = {e:+.6g} 1/s has no uncertainty estimate (too few "
-                    "re-orthonormalisations: lengthen the measurement or shorten the interval)")
-        return (f"lambda_{i + 1} = {e:+.6g} 1/s has an uncertainty of {u:.2g} 1/s, more than "
-                "its magnitude (lengthen the measurement, or the transient if the estimate "
-                "still drifts)")
+            return f"{head}: undecided, no uncertainty estimate ({few})"
+        if not np.all(np.isfinite(self.uncertainty) | np.isneginf(self.exponents)):
+            return (f"{head}: undecided: another exponent has no uncertainty estimate, so "
+                    f"that this one's place in their order is unknown ({few})")
+        near_low, near_high = self.bounds(i, 1.0)
+        if near_low <= 0 <= near_high and self.exponents.size == 1:
+            return (f"{head}: undecided: within one uncertainty of zero, and no other "
+                    "exponent tells how narrow that is; compute two (n = 2, --n 2)")
+        where = (f"it lies between {low:+.3g} and {high:+.3g} 1/s (at {SIGNIFICANCE:g} "
+                 "uncertainties, the estimates taken in any order)")
+        if not near_low <= 0 <= near_high:
+            why = f"{where}, not within one uncertainty of zero"
+        else:
+            why = (f"{where}, within one uncertainty of zero but not resolved from an "
+                   "exponent decided non-zero")
+        return (f"{head}: undecided at this length: {why}; lengthen the measurement, or "
+                "the transient if the estimate still drifts")
+
+    def _word(self, i: int) -> str:
+        """The verdict as the text output shows it."""
+        verdict = self.verdict(i)
+        if verdict == ZERO:
+            return "consistent with zero"
+        if verdict != UNDECIDED:
+            return verdict
+        near_low, near_high = self.bounds(i, 1.0)
+        if self.exponents.size == 1 and near_low <= 0 <= near_high < np.inf:
+            return "undecided (one exponent: compute two)"
+        return "undecided at this length"
 
     def to_dict(self) -> dict:
-        """Exponents [1/s] (largest first) and their uncertainty as plain JSON types
-        (-inf, for a collapsed direction, as ``null``)."""
+        """Exponents [1/s] (largest first), their uncertainty and verdicts as plain JSON
+        types (-inf, for a collapsed direction, as ``null``); ``verdict`` is the largest
+        exponent's."""
         def plain(values):
             return [float(v) if np.isfinite(v) else None for v in values]
 
+        verdicts = list(self.verdicts)
         return {"exponents": plain(self.exponents), "uncertainty": plain(self.uncertainty),
+                "verdicts": verdicts, "verdict": verdicts[0],
                 "conclusive": [bool(c) for c in self.conclusive],
                 "transient": self.transient, "duration": self.duration,
                 "interval": self.interval}
@@ -166,8 +280,7 @@ class LyapunovSpectrum:
         lines = [f"Lyapunov exponents over {self.duration:g} s after a {self.transient:g} s "
                  f"transient (QR every {self.interval:g} s) [1/s]:"]
         for i, (e, u) in enumerate(zip(self.exponents, self.uncertainty, strict=True)):
-            mark = "" if self.conclusive[i] else "  (inconclusive)"
-            lines.append(f"  lambda_{i + 1} = {e:+.6g} +- {u:.2g}{mark}")
+            lines.append(f"  lambda_{i + 1} = {e:+.6g} +- {u:.2g}  {self._word(i)}")
         return "\n".join(lines)
 
 
@@ -303,16 +416,17 @@ def lyapunov(
     ...                     speed={"value": 12.0}, simulation={"initial_state": "equilibrium"})
     >>> spectrum = fivdisc.lyapunov(case, transient=0.05, duration=0.2)
     >>> print(f"{spectrum.largest:.0f} +- {spectrum.uncertainty[0]:.1f} 1/s, "
-    ...       f"conclusive: {bool(spectrum.conclusive[0])}")
-    -62 +- 0.3 1/s, conclusive: True
+    ...       f"{spectrum.verdict(0)}")
+    -62 +- 0.3 1/s, negative
     >>> print(f"{fivdisc.linear_stability(case).max_growth_rate:.2f} 1/s")
     -61.75 1/s
 
     On a periodic orbit they are its Floquet exponents: here the stick-slip orbit of a
     slider with constant kinetic friction on a disc of one axisymmetric mode, whose
     first exponent (the flow direction's) is 0 and whose next two (the disc mode's
-    pair) are -4.726 1/s. Over 2 s the first is still inconclusive, its uncertainty
-    larger than itself:
+    pair) are -4.726 1/s. Over 2 s the first is undecided, its range (2.4 1/s either
+    way) reaching the next; over 5 s it is resolved from them (its verdict,
+    :meth:`LyapunovSpectrum.verdict`):
 
     >>> orbit_case = fivdisc.Case(
     ...     disc={"modes": [[0, 0]]},
@@ -322,9 +436,11 @@ def lyapunov(
     ... )
     >>> print(fivdisc.lyapunov(orbit_case, n=3, transient=1.0, duration=2.0))
     Lyapunov exponents over 2 s after a 1 s transient (QR every 0.05 s) [1/s]:
-      lambda_1 = ... +- 2...  (inconclusive)
-      lambda_2 = -4.7... +- 0.06...
-      lambda_3 = -4.7... +- 0.06...
+      lambda_1 = ... +- 2...  undecided at this length
+      lambda_2 = -4.7... +- 0.06...  negative
+      lambda_3 = -4.7... +- 0.06...  negative
+    >>> fivdisc.lyapunov(orbit_case, n=3, transient=1.0, duration=5.0).verdicts
+    ('zero', 'negative', 'negative')
     """
     sim = case.simulation
     transient = 0.2 * sim.duration if transient is None else transient

@@ -13,6 +13,7 @@ orbits born there are stable (supercritical) or a threshold around stable slidin
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -27,7 +28,6 @@ from fivdisc.analysis.points import (
     reduced_indices,
     slip_jacobian,
 )
-from fivdisc.analysis.stability import dominant_coordinates
 from fivdisc.case import Case
 from fivdisc.core import tangent as tan
 from fivdisc.engine.equilibrium import Equilibrium, _evaluate, sliding_equilibrium, slip_phases
@@ -74,7 +74,10 @@ class HopfPoint:
         largest component is real and positive. A small orbit starts at
         ``state + eps * Re(eigenvector)``.
     mode : str
-        Coordinate with most of the eigenvector's kinetic energy.
+        The label of the pair's eigenvalue branch (the ``mode`` of
+        :func:`~fivdisc.analysis.eigenbranches.eigen_branches` along the same values:
+        :func:`~fivdisc.analysis.stability.mode_labels` where the values come nearest
+        the case's own value of the key).
     on_boundary : bool
         Whether every other eigenvalue has a negative real part there: the equilibrium
         changes stability at this point (else it stays unstable on both sides).
@@ -82,6 +85,9 @@ class HopfPoint:
         The sliding equilibrium at the point.
     case : Case
         The base case with the key set to `value`.
+    unstable_modes : tuple of str
+        The labels of the other modes that are unstable there (empty where
+        `on_boundary`): while one is, every small orbit born here is unstable too.
     l1 : float
         First Lyapunov coefficient [s^2] per (rad/s)^2 of the slip-speed amplitude of
         the slider that moves most (:func:`~fivdisc.analysis.normalform.first_lyapunov`):
@@ -125,6 +131,7 @@ class HopfPoint:
     case: Case
     l1: float = math.nan
     l1_error: float = math.nan
+    unstable_modes: tuple[str, ...] = ()
 
     @property
     def frequency(self) -> float:
@@ -155,7 +162,9 @@ class HopfPoint:
 
     def __str__(self) -> str:
         turn = "loses" if self.direction > 0 else "gains"
-        where = "" if self.on_boundary else " (another mode stays unstable)"
+        others = ", ".join(self.unstable_modes) or "another mode"
+        verb = "stay" if len(self.unstable_modes) > 1 else "stays"
+        where = "" if self.on_boundary else f" ({others} {verb} unstable)"
         kind = (f"; first Lyapunov coefficient l1 = {self.l1:.4g} s^2: {self.criticality}"
                 if math.isfinite(self.l1) else "")
         return (f"Hopf point at {self.key} = {self.value:.10g}: {self.mode} at "
@@ -184,21 +193,26 @@ def _full_layout(model: Model, eq: Equilibrium, vector: np.ndarray
     return state, vec
 
 
-def _locate(points: ParameterPoints, key: str, lo: float, hi: float, lam_lo: complex,
-            lam_hi: complex, guesses: list[Equilibrium], option: str) -> HopfPoint | None:
-    """The Hopf point between `lo` and `hi`, where the branch's eigenvalue goes from
-    `lam_lo` to `lam_hi`; None if the growth rates recomputed at the ends do not change
-    sign (a crossing at round-off level)."""
-    from scipy.optimize import brentq
+def _locate(points: ParameterPoints, key: str, lo: float, hi: float, row_lo: np.ndarray,
+            row_hi: np.ndarray, b: int, labels: Sequence[str],
+            guesses: Sequence[Equilibrium], option: str) -> HopfPoint | None:
+    """The Hopf point of branch `b` between `lo` and `hi` (its followed rows of
+    eigenvalues there `row_lo`, `row_hi`), its other modes named by `labels`; None if
+    the growth rates recomputed at the ends do not change sign (a crossing at round-off
+    level). `guesses` are the equilibria at the ends (those found)."""
+    from scipy.optimize import brentq, linear_sum_assignment
+
+    lam_lo, lam_hi = row_lo[b], row_hi[b]
 
     def linearise(value: float) -> tuple:
-        near = guesses if abs(value - lo) <= abs(value - hi) else guesses[::-1]
+        near = list(guesses if abs(value - lo) <= abs(value - hi) else guesses[::-1])
         point = points.linearise((value,), near[0] if near else None)
         if point is not None:
             return point
         # From the other end's equilibrium, or the rigid-disc guess: in a bracket spanning
         # decades of the key the nearest end's may not converge.
         model = points.model((value,))
+        failure: Exception | None = None
         for guess in [*near[1:], None]:
             try:
                 eq = sliding_equilibrium(model, guess=guess)
@@ -215,11 +229,15 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, lam_lo: com
         )
 
     def eig_near(value: float) -> tuple:
+        """The eigen-solution at `value` and which eigenvalue continues branch `b`: all
+        of them matched to the branches interpolated there (so that near-equal
+        eigenvalues, as identical pads have, each keep their own branch)."""
         model, eq, jac = linearise(value)
         lam, vec = np.linalg.eig(jac)
         t = (value - lo) / (hi - lo)
-        i = int(np.argmin(np.abs(lam - (lam_lo + t * (lam_hi - lam_lo)))))
-        return model, eq, jac, lam, vec, i
+        _, column = linear_sum_assignment(
+            np.abs((row_lo + t * (row_hi - row_lo))[:, None] - lam[None, :]))
+        return model, eq, jac, lam, vec, int(column[b])
 
     def growth(value: float) -> float:
         _, _, _, lam, _, i = eig_near(value)
@@ -233,10 +251,19 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, lam_lo: com
     # The slope by a central difference, kept inside the bracket (a root at its end, such
     # as a key's lowest allowed value, has no values beyond it).
     step = 1e-6 * abs(hi - lo)
-    a, b = max(min(lo, hi), root - step), min(max(lo, hi), root + step)
-    rate = (growth(b) - growth(a)) / (b - a)
+    a, c = max(min(lo, hi), root - step), min(max(lo, hi), root + step)
+    rate = (growth(c) - growth(a)) / (c - a)
     pick = i if lam[i].imag > 0 else int(np.argmin(np.abs(lam - np.conj(lam[i]))))
-    others = np.delete(lam.real, [i, int(np.argmin(np.abs(lam - np.conj(lam[i]))))])
+    pair = [i, int(np.argmin(np.abs(lam - np.conj(lam[i]))))]
+    others = np.delete(lam.real, pair)
+    # Each eigenvalue at the point is matched to the branch it continues (the branches
+    # interpolated to the point), which names it.
+    t = (root - lo) / (hi - lo)
+    _, branch_of = linear_sum_assignment(
+        np.abs(lam[:, None] - (row_lo + t * (row_hi - row_lo))[None, :]))
+    branch_of[i] = b
+    unstable = [labels[branch_of[j]] for j in np.argsort(-lam.real)
+                if j not in pair and lam[j].real >= 0.0 and lam[j].imag >= 0.0]
     state, vector = _full_layout(model, eq, vec[:, pick])
     l1 = first_lyapunov(model, eq.state, float(lam[pick].imag), jac)
     return HopfPoint(
@@ -244,9 +271,10 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, lam_lo: com
         direction=1 if (lam_hi.real - lam_lo.real) / (hi - lo) > 0.0 else -1,
         rate=float(rate),
         eigenvalue=complex(lam[pick]), state=state, eigenvector=vector,
-        mode=dominant_coordinates(model, vec[:, [pick]])[0],
-        on_boundary=bool(np.all(others < 0.0)), equilibrium=eq,
-        case=points.case.replace({key: root}), l1=l1.value, l1_error=l1.error,
+        mode=str(labels[b]), on_boundary=bool(np.all(others < 0.0)), equilibrium=eq,
+        case=points.case.replace({key: root}),
+        unstable_modes=tuple(dict.fromkeys(unstable)),
+        l1=l1.value, l1_error=l1.error,
     )
 
 
@@ -290,9 +318,12 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
     Notes
     -----
     At the point the growth rate ``g(p) = Re lambda(p)`` of the branch is zero; it is
-    bracketed by a change of sign between neighbouring values and found with
-    :func:`scipy.optimize.brentq`, the eigenvalue at each trial value being the one
-    nearest to the branch's linear interpolation. A real eigenvalue crossing zero (a
+    bracketed by a change of sign between neighbouring values, the branches are followed
+    again between them in steps over which every eigenvalue moves less than a quarter
+    of the least distance between two (near-equal eigenvalues, as identical pads have,
+    each keep their own branch: up to 64 steps), and each crossing is found with
+    :func:`scipy.optimize.brentq` on its step, the eigenvalues at each trial value being
+    matched to the branches' linear interpolation. A real eigenvalue crossing zero (a
     fold of the equilibrium, not a Hopf point) is not reported.
 
     Examples
@@ -318,24 +349,123 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
         branches = eigen_branches(case, key, values, option=option)
     values = branches[key].values
     lam = branches["growth_rate"].values + 2j * np.pi * branches["frequency"].values
+    labels = [str(m) for m in branches["mode"].values]
     points = ParameterPoints(case, [key])
-    with np.errstate(invalid="ignore"):
-        # Growth rates within round-off of zero have no sign (an undamped mode's are
-        # +-1e-13 at random): a crossing needs both sides beyond it.
-        noise = ROUND_OFF * np.nanmax(np.abs(lam), axis=1, initial=0.0)
     found = []
-    for b in range(lam.shape[1]):
-        re, im = lam[:, b].real, lam[:, b].imag
-        for i in range(values.size - 1):
-            both = np.isfinite(re[i]) and np.isfinite(re[i + 1])
-            if not both or (re[i] < 0.0) == (re[i + 1] < 0.0) or min(im[i], im[i + 1]) <= 0:
-                continue
-            if abs(re[i]) <= noise[i] or abs(re[i + 1]) <= noise[i + 1]:
-                continue
-            guesses = [points.equilibrium(points.model((v,))) for v in values[i : i + 2]]
-            hopf = _locate(points, key, values[i], values[i + 1], lam[i, b], lam[i + 1, b],
-                           [g for g in guesses if g is not None], option)
-            if hopf is not None:
-                found.append(hopf)
+    for i in range(values.size - 1):
+        if not _crossed(lam[i], lam[i + 1]):
+            continue
+        ends = [points.equilibrium(points.model((v,))) for v in values[i : i + 2]]
+        guess = ends[0]
+        # Between the two values the branches are followed again in steps short enough
+        # to keep near-equal eigenvalues apart (identical pads), from the first value's
+        # order, and each crossing is located on its own sub-step.
+        sub, rows = _refine(points, values[i], values[i + 1], lam[i], lam[i + 1], guess)
+        for k in range(sub.size - 1):
+            for b in _crossed(rows[k], rows[k + 1]):
+                hopf = _locate(points, key, sub[k], sub[k + 1], rows[k], rows[k + 1], b,
+                               labels, [e for e in ends if e is not None], option)
+                if hopf is not None:
+                    found.append(hopf)
     ascending = values[-1] > values[0]
     return sorted(found, key=lambda h: h.value, reverse=not ascending)
+
+
+# Most sub-steps between two values of a scan in which hopf_points follows the branches
+# again (doubled from 2 until each eigenvalue moves less than _STEP_SHARE of the least
+# distance between two of them).
+_MAX_SUBSTEPS = 64
+_STEP_SHARE = 0.25
+
+
+def _crossed(row: np.ndarray, after: np.ndarray) -> list[int]:
+    """The branches whose complex eigenvalue (positive imaginary part) crosses the
+    imaginary axis from `row` to `after`. Growth rates within round-off of zero
+    (:data:`ROUND_OFF` of the largest eigenvalue's modulus) have no sign: an undamped
+    mode's come out as +-5e-13 at random, and are no crossing."""
+    if not (np.isfinite(row).all() and np.isfinite(after).all()):
+        return []
+    noise = ROUND_OFF * max(float(np.max(np.abs(row))), float(np.max(np.abs(after))))
+    return [b for b in range(row.size)
+            if (row[b].real < 0.0) != (after[b].real < 0.0)
+            and min(row[b].imag, after[b].imag) > 0
+            and min(abs(row[b].real), abs(after[b].real)) > noise]
+
+
+def _refine(points: ParameterPoints, lo: float, hi: float, row_lo: np.ndarray,
+            row_hi: np.ndarray, guess: Equilibrium) -> tuple[np.ndarray, list[np.ndarray]]:
+    """Values from `lo` to `hi` and the eigenvalues there in the order of `row_lo`'s
+    branches, followed in steps over which each moves less than a quarter of the least
+    distance between two of them."""
+    from scipy.optimize import linear_sum_assignment
+
+    def spread(row: np.ndarray) -> float:
+        d = np.abs(row[:, None] - row[None, :])
+        return float(np.min(d[~np.eye(row.size, dtype=bool)], initial=np.inf))
+
+    m = 2
+    while True:
+        sub = np.linspace(lo, hi, m + 1)
+        raw = [row_lo]
+        for value in sub[1:-1]:
+            point = points.linearise((value,), guess)
+            if point is None:  # no equilibrium inside: the coarse step it is
+                return np.array([lo, hi]), [row_lo, row_hi]
+            raw.append(np.linalg.eigvals(point[2]))
+        raw.append(row_hi)
+        rows = [row_lo]
+        for row in raw[1:]:
+            ahead = rows[-1] if len(rows) < 2 else 2.0 * rows[-1] - rows[-2]
+            _, order = linear_sum_assignment(np.abs(ahead[:, None] - row[None, :]))
+            rows.append(row[order])
+        moves = max(float(np.max(np.abs(b - a))) for a, b in itertools.pairwise(rows))
+        if moves < _STEP_SHARE * min(spread(r) for r in rows) or m >= _MAX_SUBSTEPS:
+            return sub, rows
+        m *= 2
+
+
+def with_hopf_points(branches: xr.Dataset, hopf: Sequence[HopfPoint]) -> xr.Dataset:
+    """The branches of :func:`~fivdisc.analysis.eigenbranches.eigen_branches` with their
+    Hopf points (what ``fivdisc stability --x`` writes).
+
+    Parameters
+    ----------
+    branches : xarray.Dataset
+        The branches.
+    hopf : sequence of HopfPoint
+        Their Hopf points (:func:`hopf_points` over the same key and values).
+
+    Returns
+    -------
+    xarray.Dataset
+        `branches` with, along a dimension ``hopf``: ``hopf`` (the key's value),
+        ``hopf_frequency`` [Hz], ``hopf_direction`` (+1: the mode loses stability as the
+        key increases), ``hopf_mode`` (the branch's label, as ``mode``),
+        ``hopf_on_boundary`` (1: the equilibrium changes stability there),
+        ``hopf_unstable_modes`` (the other modes unstable there, comma-separated) and
+        ``hopf_l1``, ``hopf_l1_error`` (the first Lyapunov coefficient and its error).
+    """
+    key = branches.attrs["x_key"]
+    return branches.assign(
+        hopf=(("hopf",), np.array([hp.value for hp in hopf], dtype=float),
+              {**branches[key].attrs, "long_name": "Hopf points: where a complex pair "
+                                                    "crosses the imaginary axis"}),
+        hopf_frequency=(("hopf",), np.array([hp.frequency for hp in hopf], dtype=float),
+                        {"units": "Hz", "long_name": "critical frequency"}),
+        hopf_direction=(("hopf",), np.array([hp.direction for hp in hopf], dtype=np.int8),
+                        {"long_name": "+1: the mode loses stability as the key increases"}),
+        hopf_mode=(("hopf",), np.array([hp.mode for hp in hopf], dtype=str),
+                   {"long_name": "label of the critical mode's branch (as mode)"}),
+        hopf_on_boundary=(("hopf",), np.array([hp.on_boundary for hp in hopf], dtype=np.int8),
+                          {"long_name": "1: the equilibrium changes stability here; 0: "
+                                        "another mode stays unstable on both sides"}),
+        hopf_unstable_modes=(("hopf",), np.array([", ".join(hp.unstable_modes)
+                                                  for hp in hopf], dtype=str),
+                             {"long_name": "the other modes unstable here"}),
+        hopf_l1=(("hopf",), np.array([hp.l1 for hp in hopf], dtype=float),
+                 {"units": "s2", "long_name": "first Lyapunov coefficient per (rad/s)^2 of "
+                                              "slip-speed amplitude (> 0: subcritical, < 0: "
+                                              "supercritical)"}),
+        hopf_l1_error=(("hopf",), np.array([hp.l1_error for hp in hopf], dtype=float),
+                       {"units": "s2", "long_name": "estimated error of hopf_l1"}),
+    )

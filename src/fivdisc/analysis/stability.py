@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -29,6 +30,10 @@ from fivdisc.model.build import Model, build_model
 if TYPE_CHECKING:
     import pandas as pd
 
+#: Difference of energy shares below which two modes' labels follow their frequencies
+#: (:func:`mode_labels`).
+LABEL_TIE = 0.1
+
 # Bytes per grid point of a stability map: growth rate and stability flag, and the
 # dataset's and the netCDF writer's copies of them.
 _GRID_BYTES = 3 * (8 + 1)
@@ -50,9 +55,10 @@ class LinearStability:
     eigenvectors : ndarray
         Right eigenvectors (columns), in the order of ``eigenvalues``.
     dominant : tuple of str
-        Per eigenvalue, the coordinate (``"C01"``, ..., ``"phi"``; ``"phi0"``,
-        ``"phi1"``, ... with several sliders) with the largest share of the
-        eigenvector's kinetic energy.
+        Per eigenvalue, its mode's label (:func:`mode_labels`): a coordinate
+        (``"C01"``, ..., ``"phi"``; ``"phi0"``, ``"phi1"``, ... with several sliders)
+        with a large share of the eigenvector's kinetic energy, a different one for
+        every mode (the two eigenvalues of a complex pair share theirs).
 
     See Also
     --------
@@ -99,7 +105,7 @@ class LinearStability:
         part (one of each complex pair), in order of decreasing growth rate.
 
         Columns: ``growth_rate`` [1/s] (the real part), ``frequency_hz`` [Hz] (the damped
-        frequency) and ``coordinate`` (the dominant one, see :attr:`dominant`).
+        frequency) and ``coordinate`` (its mode's label, :attr:`dominant`).
         """
         import pandas as pd
 
@@ -232,18 +238,114 @@ def linear_stability(case: Case | Model) -> LinearStability:
     order = np.lexsort((-lam.imag, -lam.real))
     lam = lam[order]
     vec = vec[:, order]
-    return LinearStability(eq, jac, lam, vec, dominant_coordinates(model, vec))
+    return LinearStability(eq, jac, lam, vec, mode_labels(model, lam, vec))
 
 
-def dominant_coordinates(model: Model, vectors: np.ndarray) -> tuple[str, ...]:
-    """Per eigenvector (columns, variables ``(q, phi, qdot, phidot)``), the coordinate
-    with the largest share of its kinetic energy (``"C01"``, ..., ``"phi"``)."""
+def coordinate_names(model: Model) -> tuple[str, ...]:
+    """The model's coordinates in the order of the slip equations' variables: the disc's
+    modal coordinates (``"C00"``, ``"C01"``, ``"D01"``, ...), then the sliders' angles
+    (``"phi"``; ``"phi0"``, ``"phi1"``, ... with several sliders)."""
+    return (*model.labels, *_angle_names(model))
+
+
+def energy_shares(model: Model, vectors: np.ndarray) -> np.ndarray:
+    """``(coordinates, vectors)``: each coordinate's share of each eigenvector's kinetic
+    energy (columns sum to 1; variables ``(q, phi, qdot, phidot)``, coordinates as
+    :func:`coordinate_names`)."""
     size = model.n + model.n_sliders
     inertia = np.append(model.modal_mass, model.kernel.row("inertia"))
     # Velocity part of an eigenvector is lambda times its displacement part.
     energy = inertia[:, None] * np.abs(vectors[size:, :]) ** 2
-    names = (*model.labels, *_angle_names(model))
-    return tuple(names[i] for i in np.argmax(energy, axis=0))
+    total = energy.sum(axis=0)
+    return energy / np.where(total > 0, total, 1.0)
+
+
+def dominant_coordinates(model: Model, vectors: np.ndarray) -> tuple[str, ...]:
+    """Per eigenvector (columns, variables ``(q, phi, qdot, phidot)``), the coordinate
+    with the largest share of its kinetic energy (``"C01"``, ..., ``"phi"``). Two
+    eigenvectors may share one; :func:`mode_labels` names every mode apart."""
+    names = coordinate_names(model)
+    return tuple(names[i] for i in np.argmax(energy_shares(model, vectors), axis=0))
+
+
+def mode_labels(model: Model, eigenvalues: np.ndarray, vectors: np.ndarray
+                ) -> tuple[str, ...]:
+    """One label per eigenvalue, a different one for every mode: a complex pair is one
+    mode (both its eigenvalues get its label), a real eigenvalue another.
+
+    Each coordinate (:func:`coordinate_names`) names at most one mode: the modes are
+    matched to the coordinates so that the sum of the named coordinates' shares of the
+    modes' kinetic energy (:func:`energy_shares`) is largest (an assignment problem,
+    :func:`scipy.optimize.linear_sum_assignment`). The two modes of a disc mode with
+    nodal diameters, which the sliders mix into travelling waves, are then ``C0l`` and
+    ``D0l``, never both ``C0l``; identical pads' modes, each spread over every pad, are
+    ``phi0``, ``phi1``, ``phi2``. Where two modes' shares leave the choice open (they
+    would give up less than :data:`LABEL_TIE` of their shares by trading names: the two
+    halves of travelling waves, identical pads) the lower frequency takes the
+    coordinate listed first, so that labels do not turn on round-off. A mode left
+    without a coordinate (real eigenvalues
+    outnumber what is left: an overdamped coordinate has two) takes its dominant
+    coordinate's name with a prime per earlier use (``"phi0'"``).
+
+    Parameters
+    ----------
+    model : Model
+        The model the eigenvectors belong to.
+    eigenvalues : ndarray
+        ``(k,)`` complex eigenvalues of the slip equations.
+    vectors : ndarray
+        ``(2 (n + S), k)`` their right eigenvectors (columns).
+
+    Returns
+    -------
+    tuple of str
+        In the order of `eigenvalues`.
+    """
+    from scipy.optimize import linear_sum_assignment
+
+    lam = np.asarray(eigenvalues, dtype=complex)
+    names = coordinate_names(model)
+    scale = max(float(np.abs(lam).max(initial=0.0)), 1e-300)
+    # One representative per mode: the eigenvalue with a positive imaginary part of a
+    # pair, and each real eigenvalue; the other of a pair is its conjugate.
+    real = np.abs(lam.imag) <= 1e-12 * scale
+    modes = [i for i in range(lam.size) if real[i] or lam[i].imag > 0]
+    shares = energy_shares(model, vectors[:, modes])
+    rows, cols = linear_sum_assignment(-shares)
+    coordinate = dict(zip(cols.tolist(), rows.tolist(), strict=True))  # mode -> coordinate
+    # Near-ties follow the frequencies: where two modes would give up less than
+    # LABEL_TIE of their shares by trading names (a travelling wave's C and D halves,
+    # identical pads), the lower frequency takes the coordinate listed first. The
+    # labels are then the same for eigenvectors equal to round-off, as the same
+    # eigenvalue met in two scans is.
+    order = [(abs(lam[i].imag), lam[i].real) for i in modes]
+    for _ in range(len(modes) ** 2):
+        swapped = False
+        for a, b in itertools.combinations(sorted(coordinate), 2):
+            ca, cb = coordinate[a], coordinate[b]
+            loss = shares[ca, a] + shares[cb, b] - shares[cb, a] - shares[ca, b]
+            if loss < LABEL_TIE and (order[a] < order[b]) != (ca < cb):
+                coordinate[a], coordinate[b] = cb, ca
+                swapped = True
+        if not swapped:
+            break
+    label = {modes[c]: names[r] for c, r in coordinate.items()}
+    used = {name: 1 for name in label.values()}
+    for k, i in enumerate(modes):
+        if i not in label:
+            base = names[int(np.argmax(shares[:, k]))]
+            label[i] = base + "'" * used.get(base, 0)
+            used[base] = used.get(base, 0) + 1
+    out = []
+    for i in range(lam.size):
+        if i in label:
+            out.append(label[i])
+        else:
+            # The lower eigenvalue of a pair: its conjugate's label.
+            partner = min((j for j in modes if not real[j]),
+                          key=lambda j: abs(lam[j] - np.conj(lam[i])))
+            out.append(label[partner])
+    return tuple(out)
 
 
 @dataclass(frozen=True)

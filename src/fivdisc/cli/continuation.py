@@ -41,9 +41,10 @@ _SEARCH_OPTIONS = ("--period", "--transient", "the search window", "--rtol")
               "doubling, continue the branch of doubled orbits born there.")
 @click.option("--from-hopf", "hopf_spec", metavar="START:STOP:N",
               help="Start from the orbits born at a Hopf point of the sliding equilibrium "
-              "in --key, searched on N values from START to STOP (the first where the "
-              "equilibrium changes stability): says whether it is sub- or supercritical "
-              "and the bistable range.")
+              "in --key, searched on N values from START to STOP: the first where the "
+              "equilibrium changes stability, else the first found, with a warning (its "
+              "orbits are unstable). Says which it takes, whether it is sub- or "
+              "supercritical and the bistable range.")
 @click.option("--points", type=int, default=_DEFAULT.max_points, show_default=True,
               help="Most points on the branch.")
 @click.option("--step", type=float, default=_DEFAULT.step, show_default=True,
@@ -139,14 +140,14 @@ def _continue(case_file: Path | None, key: str, target: float, back_to: float | 
                 or back_to is not None):
             raise FivdiscError("--from-hopf starts at a Hopf point: leave out --from, "
                                "--transient, --period and --back-to")
-        branch = _from_hopf(case_file, key, target, hopf_spec, settings, progress)
+        branch = _from_hopf(case_file, key, target, hopf_spec, settings, progress, as_json)
         if out is not None:
             branch.to_netcdf(out)
         click.echo(branch.to_json() if as_json else str(branch))
         sys.exit(130 if branch.stop_reason == INTERRUPTED else 1 if branch.lost else 0)
     try:
-        case, orbit, along, search = _start(case_file, from_file, which, key, target, rtol,
-                                            transient, period)
+        case, orbit, along, search, source = _start(case_file, from_file, which, key,
+                                                    target, rtol, transient, period)
         if back_to is not None:
             check_window(key, check_key(case, key), target, back_to, "--back-to")
         branch = continue_orbit(case, key, target, orbit=orbit, along=along,
@@ -155,6 +156,12 @@ def _continue(case_file: Path | None, key: str, target: float, back_to: float | 
     except ConvergenceError as exc:
         click.echo(f"error: no periodic orbit to start from: {exc}", err=True)
         sys.exit(1)
+    if source is not None:
+        from fivdisc.continuation.from_hopf import restate_hopf
+
+        # The same orbits, on from a branch born at a Hopf point: its kind and the
+        # bistable range over both.
+        restate_hopf(branch, source)
     if out is not None:
         branch.to_netcdf(out)
     click.echo(branch.to_json() if as_json else str(branch))
@@ -165,8 +172,9 @@ def _continue(case_file: Path | None, key: str, target: float, back_to: float | 
 
 
 def _from_hopf(case_file: Path | None, key: str, target: float, spec: str,
-               settings: ContinuationSettings, progress: bool):
-    """The branch of orbits from the first Hopf point on ``spec``'s values of ``key``."""
+               settings: ContinuationSettings, progress: bool, as_json: bool = False):
+    """The branch of orbits from the first Hopf point on ``spec``'s values of ``key``
+    (which one, on stdout, or on stderr under --json, whose stdout is the JSON)."""
     import numpy as np
 
     from fivdisc.analysis.eigenbranches import branch_bytes
@@ -200,8 +208,31 @@ def _from_hopf(case_file: Path | None, key: str, target: float, spec: str,
         raise FivdiscError(f"--from-hopf {spec}: no Hopf point of the sliding equilibrium in "
                            f"{key} between {values[0]:g} and {values[-1]:g}")
     hopf = next((h for h in found if h.on_boundary), found[0])
-    click.echo(str(hopf))
+    click.echo(hopf_choice(found, hopf, key, values), err=as_json)
+    if not hopf.on_boundary:
+        others = ", ".join(hopf.unstable_modes) or "another mode"
+        click.echo(f"warning: at {key} = {hopf.value:.10g} {others} of the sliding "
+                   "equilibrium stay unstable: every orbit born there is unstable, and "
+                   "no Hopf point between "
+                   f"{values[0]:g} and {values[-1]:g} changes the equilibrium's stability "
+                   "(widen START:STOP to find one)", err=True)
     return hopf_cycles(hopf, target, settings=settings, progress=progress)
+
+
+def hopf_choice(found, hopf, key: str, values) -> str:
+    """Which of the Hopf points `found` on `values` of `key` is taken, and why: the
+    points listed (numbered from 0) when there are several."""
+    lines = []
+    if len(found) > 1:
+        lines.append(f"{len(found)} Hopf points in {key} between {values[0]:g} and "
+                     f"{values[-1]:g}:")
+        lines += [f"  [{k}] {h}" for k, h in enumerate(found)]
+    k = found.index(hopf)
+    why = ("the first where the equilibrium changes stability" if hopf.on_boundary
+           else "the first found: none changes the equilibrium's stability")
+    lines.append(f"taking [{k}]: {hopf} ({why})" if len(found) > 1
+                 else f"taking the {hopf} ({why})")
+    return "\n".join(lines)
 
 
 def _checked(case, key: str, target: float):
@@ -223,8 +254,10 @@ def _checked(case, key: str, target: float):
 
 def _start(case_file, from_file, which, key, target, rtol, transient, period):
     """The case, the orbit to start from (None: searched as fivdisc orbit does), the
-    branch-switching direction, and the search's options; the key and the target are
-    checked before any orbit is computed."""
+    branch-switching direction, the search's options, and the branch whose orbits the
+    new one continues (None unless from a branch, at its end or at a bifurcation other
+    than a period doubling); the key and the target are checked before any orbit is
+    computed."""
     from fivdisc.analysis.checks import check_period, check_time
     from fivdisc.analysis.orbits import periodic_orbit, saved_start
     from fivdisc.case import load_case
@@ -240,7 +273,7 @@ def _start(case_file, from_file, which, key, target, rtol, transient, period):
             raise FivdiscError("continue needs CASE_FILE or --from FILE")
         _checked(case, key, target)
         check_search(case, search, rtol, _SEARCH_OPTIONS)
-        return case, None, None, search
+        return case, None, None, search, None
     from fivdisc.files import read_dataset
 
     if read_dataset(from_file, "--from").attrs.get("content") == CONTENT:
@@ -263,10 +296,10 @@ def _start(case_file, from_file, which, key, target, rtol, transient, period):
         case = _checked(case, key, target).replace({key: value})
         if kind == "period doubling":
             orbit, along = doubled_start(case, state, per, phases, rtol=rtol)
-            return case, orbit, along, {}
+            return case, orbit, along, {}, None
         orbit = periodic_orbit(case, state, period=per, phases=phases, rtol=rtol,
                                start=f"from the branch in {from_file}")
-        return case, orbit, None, {}
+        return case, orbit, None, {}, br
     stored, state, phases, saved_period, start = saved_start(from_file)
     case = case or stored
     if case is None:
@@ -277,4 +310,4 @@ def _start(case_file, from_file, which, key, target, rtol, transient, period):
         check_period(case, period, "--period")
     orbit = periodic_orbit(case, state, period=period or saved_period, phases=phases,
                            rtol=rtol, start=start)
-    return case, orbit, None, {}
+    return case, orbit, None, {}, None

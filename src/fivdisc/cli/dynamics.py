@@ -95,8 +95,9 @@ def orbit(case_file: Path | None, period: float | None, transient: float | None,
 
 @click.command()
 @click.argument("case_file", type=CASE)
-@click.option("--n", "count", type=int, default=1, show_default=True,
-              help="How many exponents (largest first).")
+@click.option("--n", "count", type=int, default=2, show_default=True,
+              help="How many exponents (largest first). The second gives the first's "
+              "verdict its scale: with --n 1 an exponent near zero stays undecided.")
 @click.option("--transient", type=float,
               help="Simulated time before the measurement, over which the tangent vectors "
               "align [s] (default: a fifth of the case's simulation.duration).")
@@ -106,7 +107,7 @@ def orbit(case_file: Path | None, period: float | None, transient: float | None,
               help="Re-orthonormalisation interval [s] (default: 0.05, or the duration "
               "when shorter).")
 @click.option("--json", "as_json", is_flag=True,
-              help="Print the exponents [1/s] and their uncertainty as JSON.")
+              help="Print the exponents [1/s], their uncertainty and verdicts as JSON.")
 @click.option("-o", "--output", type=_NC,
               help="Write the exponents and their running estimates to netCDF (.nc).")
 @click.option("--progress/--no-progress", default=True, show_default=True,
@@ -118,10 +119,13 @@ def lyapunov(case_file: Path, count: int, transient: float | None, duration: flo
     The tangent vectors are carried across every switch by its saltation matrix, and
     through the transient so that they align before the measurement; for --n above 1,
     two sets from independent random starts. Each exponent is printed with its
-    uncertainty: standard error of ten blocks, drift of the estimate and difference
-    between the starts.
-    CASE_FILE is a TOML file or a packaged example. Exits with status 1 when the largest
-    exponent is inconclusive (its uncertainty unknown or larger than itself).
+    uncertainty u (standard error of ten blocks, drift of the estimate and difference
+    between the starts) and a verdict: positive or negative (more than 3 u from zero),
+    consistent with zero (within u of zero, and resolved from another exponent decided
+    non-zero, as the flow direction's 0 of a periodic orbit is from the next), or
+    undecided at this length.
+    CASE_FILE is a TOML file or a packaged example. Exits with status 0 when the largest
+    exponent is decided, 1 when it is undecided (with what would decide it).
     """
     from fivdisc.analysis.exponents import lyapunov as compute
     from fivdisc.case import load_case
@@ -132,6 +136,6 @@ def lyapunov(case_file: Path, count: int, transient: float | None, duration: flo
     res = compute(case, n=count, transient=transient, duration=duration, interval=interval,
                   progress=progress)
     _report(res, case, as_json, out)
-    if not res.conclusive[0]:
-        click.echo(f"error: the largest exponent is inconclusive: {res.verdict(0)}", err=True)
+    if not res.decided[0]:
+        click.echo(f"error: {res.explain(0)}", err=True)
         sys.exit(1)

@@ -106,11 +106,18 @@ def _check(ds, kind: str, var: str | None, probe: int | None) -> str | None:
               "length and the frequencies shown].")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               help="Figure file; the format follows the extension [default: RESULT-KIND.png].")
+@click.option("--growth-scale", type=click.Choice(("auto", "linear", "symlog")),
+              default=None, help="Eigenvalue branches (fivdisc stability --x): the "
+              "growth-rate axis [default: auto, symmetric log where a small rate would "
+              "be a flat line beside the largest].")
+@click.option("--equilibrium", is_flag=True,
+              help="A branch of periodic orbits: draw the sliding equilibrium's branch "
+              "too (stable solid, unstable dashed) where its measure has a value.")
 @click.option("--dpi", type=click.IntRange(min=10), default=150, show_default=True,
               help="Resolution of raster formats.")
 def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int | None,
          slider: int, window_text: str | None, fmax: float | None, segment: float | None,
-         output: Path | None, dpi: int) -> None:
+         output: Path | None, growth_scale: str | None, equilibrium: bool, dpi: int) -> None:
     """Draw RESULT, a netCDF file that fivdisc wrote, to a figure file.
 
     A simulation result (``fivdisc simulate``, or a run of ``fivdisc reproduce``) is drawn
@@ -126,26 +133,37 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
 
     from fivdisc import plots
     from fivdisc.engine.result import open_result, run_groups
-    from fivdisc.files import check_netcdf, check_output, figure_suffixes, read_dataset
+    from fivdisc.files import (
+        check_netcdf,
+        check_output,
+        figure_suffixes,
+        read_dataset,
+        require_fivdisc_netcdf,
+    )
     from fivdisc.plots.result import check_fmax
 
     if not result.exists():
         raise FileNotFoundError(2, "No such file", str(result))
     from fivdisc.continuation.branch import CONTENT
 
+    given = click.get_current_context().get_parameter_source
+    default = click.core.ParameterSource.DEFAULT
+    kind_given = None if given("kind") == default else kind
+    slider_given = None if given("slider") == default else slider
     if read_dataset(result, "plot").attrs.get("content") == CONTENT:
-        given = click.get_current_context().get_parameter_source
-        default = click.core.ParameterSource.DEFAULT
         out = check_output(output or result.with_name(f"{result.stem}-{var or 'period'}.png"),
                            "-o", figure_suffixes(), inputs=[result])
         fig = _branch(result, var, slider, (("--run", run), ("--probe", probe),
                                             ("--window", window_text), ("--fmax", fmax),
-                                            ("--segment", segment),
-                                            ("--kind", None if given("kind") == default
-                                             else kind)),
-                      slider_given=given("slider") != default)
+                                            ("--segment", segment), ("--kind", kind_given),
+                                            ("--growth-scale", growth_scale)),
+                      slider_given=slider_given is not None, equilibrium=equilibrium)
         _save(fig, out, dpi)
         return
+    require_fivdisc_netcdf(result, "fivdisc plot")
+    if equilibrium:
+        raise FivdiscError(f"--equilibrium is not used for {result}: only for a branch of "
+                           "periodic orbits (fivdisc continue -o)")
     out = check_output(output or result.with_name(f"{result.stem}-{kind}.png"), "-o",
                        figure_suffixes(), inputs=[result])
     groups = _groups(result, run_groups)
@@ -160,15 +178,27 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
     with xr.open_dataset(result, group=run) as stored:
         what = stored.attrs.get("fivdisc_kind", "simulation")
     if what in ("stability_map", "sweep", "eigen_branches", "stability_boundary"):
-        given = [name for name, value in (("--var", var), ("--probe", probe),
-                                          ("--window", window_text), ("--fmax", fmax),
-                                          ("--segment", segment)) if value is not None]
-        if given:
-            raise FivdiscError(f"{given[0]} is not used for {result}: it is a map, drawn whole")
+        unused = [name for name, value in (("--kind", kind_given), ("--var", var),
+                                           ("--probe", probe), ("--slider", slider_given),
+                                           ("--window", window_text), ("--fmax", fmax),
+                                           ("--segment", segment)) if value is not None]
+        if growth_scale is not None and what != "eigen_branches":
+            unused.append("--growth-scale")
+        if unused:
+            drawn = {"stability_map": "a stability map", "sweep": "a sweep's map",
+                     "eigen_branches": "eigenvalue branches",
+                     "stability_boundary": "a stability boundary"}[what]
+            choices = (" (--kind chooses among the figures of a simulation result)"
+                       if unused[0] == "--kind" else "")
+            raise FivdiscError(f"{unused[0]} is not used for {result}: it is {drawn}, drawn "
+                               f"whole{choices}")
         check_netcdf(result)
         with xr.open_dataset(result, group=run) as stored:
-            fig = _map(stored.load(), result)
+            fig = _map(stored.load(), result, growth_scale or "auto")
     else:
+        if growth_scale is not None:
+            raise FivdiscError(f"--growth-scale is not used for {result}: only for "
+                               "eigenvalue branches (fivdisc stability --x -o FILE.nc)")
         ds = open_result(result, run).dataset
         count = ds.sizes.get("slider", 1)
         if not 0 <= slider < count:
@@ -216,7 +246,8 @@ def _save(fig, out: Path, dpi: int) -> None:
     click.echo(f"wrote {out}")
 
 
-def _branch(path: Path, var: str | None, slider: int, unused, slider_given: bool):
+def _branch(path: Path, var: str | None, slider: int, unused, slider_given: bool,
+            equilibrium: bool = False):
     """The figure of a branch (fivdisc continue -o): --var is the measure."""
     from fivdisc.continuation.branch import open_branch
     from fivdisc.plots.branch import BRANCH_MEASURES, plot_branch
@@ -232,7 +263,7 @@ def _branch(path: Path, var: str | None, slider: int, unused, slider_given: bool
     if measure == "period" and slider_given:
         raise FivdiscError("--slider is not used for --var period: the period is the "
                            "orbit's, not a slider's (give a measure such as phi_dot)")
-    return plot_branch(open_branch(path), measure, slider)
+    return plot_branch(open_branch(path), measure, slider, equilibrium=equilibrium)
 
 
 def _groups(path: Path, run_groups) -> list[str]:
@@ -242,14 +273,15 @@ def _groups(path: Path, run_groups) -> list[str]:
         raise FivdiscError(f"cannot read {path} as a netCDF file of fivdisc: {exc}") from None
 
 
-def _map(ds, path: Path):
+def _map(ds, path: Path, growth_scale: str = "auto"):
     """The figure of a stability map, branches, a boundary or a separation map."""
     kind = ds.attrs.get("fivdisc_kind")
     if kind in ("stability_map", "eigen_branches", "stability_boundary"):
         from fivdisc import plots
 
+        if kind == "eigen_branches":
+            return plots.plot_eigen_branches(ds, growth_scale=growth_scale)
         draw = {"stability_map": plots.plot_stability_map,
-                "eigen_branches": plots.plot_eigen_branches,
                 "stability_boundary": plots.plot_stability_boundary}[kind]
         return draw(ds)
     if "separated" not in ds:

@@ -32,10 +32,15 @@ from fivdisc.errors import FivdiscError
               "CASE-hopf-curves.nc.")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the equilibrium and the eigenvalues as JSON (without a map).")
+@click.option("--growth-scale", type=click.Choice(("auto", "linear", "symlog")),
+              default=None, help="With --x and a figure: the growth-rate axis, symmetric "
+              "log (linear near zero) or linear [default: auto, symlog where a small "
+              "rate would be a flat line beside the largest].")
 @click.option("--progress/--no-progress", default=True, show_default=True)
 def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
               curve_spec: str | None, boundary_spec: tuple[str, str] | None,
               hopf_spec: tuple[str, str] | None, output: Path | None, as_json: bool,
+              growth_scale: str | None,
               progress: bool) -> None:
     """Stability of the sliding equilibrium of CASE_FILE (default: Table 1 at 2 pi rad/s).
 
@@ -55,6 +60,11 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
     from fivdisc.case import Case, load_case
 
     case = load_case(case_file) if case_file else Case()
+    if growth_scale is not None and not (x_spec is not None and y_spec is None
+                                         and output is not None
+                                         and output.suffix.lower() != ".nc"):
+        raise FivdiscError("--growth-scale is used only by the figure of --x alone (the "
+                           "eigenvalue branches): give -o FIGURE.png")
     for name, spec in (("--boundary", boundary_spec), ("--hopf-curves", hopf_spec)):
         if spec and (x_spec or y_spec or curve_spec):
             raise FivdiscError(f"{name} takes its own two keys: leave out --x, --y and "
@@ -85,7 +95,7 @@ def stability(case_file: Path | None, x_spec: str | None, y_spec: str | None,
     if x_spec is not None and y_spec is None:
         if curve_spec is not None:
             raise FivdiscError("--curves is used only by a map: give --y too")
-        _branches(case, case_file, x_spec, output, progress)
+        _branches(case, case_file, x_spec, output, progress, growth_scale or "auto")
     elif boundary_spec:
         _boundary(case, case_file, boundary_spec, output)
     elif hopf_spec:
@@ -124,38 +134,24 @@ def _write(out: Path, figure, ds) -> None:
     click.echo(f"wrote {out}")
 
 
-def _branches(case, case_file, x_spec: str, output: Path | None, progress: bool) -> None:
-    import numpy as np
+def _branches(case, case_file, x_spec: str, output: Path | None, progress: bool,
+              growth_scale: str = "auto") -> None:
 
     from fivdisc.analysis.eigenbranches import branch_bytes, eigen_branches
-    from fivdisc.analysis.hopf import hopf_points
+    from fivdisc.analysis.hopf import hopf_points, with_hopf_points
     from fivdisc.analysis.stability import parse_range
 
     key, values = parse_range(x_spec, "--x", branch_bytes(case))
     out, figure = _target(case_file, output, "branches.nc")
     ds = eigen_branches(case, key, values, option="--x", progress=progress)
     hopf = hopf_points(case, key, values, option="--x", branches=ds)
-    ds = ds.assign(
-        hopf=(("hopf",), [hp.value for hp in hopf],
-              {**ds[key].attrs, "long_name": "Hopf points: where a complex pair crosses the "
-                                             "imaginary axis"}),
-        hopf_frequency=(("hopf",), [hp.frequency for hp in hopf],
-                        {"units": "Hz", "long_name": "critical frequency"}),
-        hopf_direction=(("hopf",), np.array([hp.direction for hp in hopf], dtype=np.int8),
-                        {"long_name": "+1: the mode loses stability as the key increases"}),
-        hopf_l1=(("hopf",), np.array([hp.l1 for hp in hopf], dtype=float),
-                 {"units": "s2", "long_name": "first Lyapunov coefficient per (rad/s)^2 of "
-                                              "slip-speed amplitude (> 0: subcritical, < 0: "
-                                              "supercritical)"}),
-        hopf_l1_error=(("hopf",), np.array([hp.l1_error for hp in hopf], dtype=float),
-                       {"units": "s2", "long_name": "estimated error of hopf_l1"}),
-    )
+    ds = with_hopf_points(ds, hopf)
     if case_file is not None:
         ds.attrs["case_name"] = case_file.stem
     if figure:
         from fivdisc.plots.stability import plot_eigen_branches
 
-        _write(out, plot_eigen_branches(ds, hopf), ds)
+        _write(out, plot_eigen_branches(ds, hopf, growth_scale=growth_scale), ds)
     else:
         _write(out, None, ds)
     unstable = ds["max_growth_rate"].values > 0.0

@@ -145,10 +145,15 @@ class Branch:
         and whether a subcritical branch stopped before deciding it
         (``bistable_undetermined``: no fold or grazing reached); the point's first
         Lyapunov coefficient ``l1`` [s^2] and ``l1_error`` (nan in files written before
-        they were stored); else None."""
+        they were stored); the Hopf point's ``mode`` (its branch's label), whether the
+        equilibrium changes stability there (``on_boundary``; else ``unstable_modes``
+        stay unstable, and every orbit born there is unstable), and whether this branch
+        ``continued`` one from the point
+        (:func:`~fivdisc.continuation.from_hopf.restate_hopf`); else None."""
         attrs = self.dataset.attrs
         if "criticality" not in attrs:
             return None
+        unstable = str(attrs.get("hopf_unstable_modes", ""))
         return {"value": float(attrs["hopf_value"]), "omega": float(attrs["hopf_omega"]),
                 "direction": int(attrs["hopf_direction"]),
                 "criticality": str(attrs["criticality"]),
@@ -156,7 +161,11 @@ class Branch:
                 "l1_error": float(attrs.get("hopf_l1_error", math.nan)),
                 "bistable": (float(attrs["bistable_low"]), float(attrs["bistable_high"])),
                 "bistable_open": bool(attrs.get("bistable_open", 0)),
-                "bistable_undetermined": bool(attrs.get("bistable_undetermined", 0))}
+                "bistable_undetermined": bool(attrs.get("bistable_undetermined", 0)),
+                "on_boundary": bool(attrs.get("hopf_on_boundary", 1)),
+                "mode": str(attrs.get("hopf_mode", "")),
+                "unstable_modes": tuple(unstable.split(", ")) if unstable else (),
+                "continued": bool(attrs.get("hopf_continued", 0))}
 
     # --- writing ------------------------------------------------------------------------
 
@@ -316,10 +325,17 @@ class Branch:
                  f"stopped: {self.stop_reason}"]
         hopf = self.hopf()
         if hopf:
-            lines.append(f"from the Hopf point at {self.key} = {hopf['value']:.9g}{unit}: "
-                         f"{hopf['criticality']}{_l1_note(hopf)}")
+            where = "continues the branch from" if hopf["continued"] else "from"
+            mode = f" ({hopf['mode']})" if hopf["mode"] else ""
+            lines.append(f"{where} the Hopf point at {self.key} = {hopf['value']:.9g}{unit}"
+                         f"{mode}: {hopf['criticality']}{_l1_note(hopf)}")
             low, high = hopf["bistable"]
-            if math.isnan(low) and hopf["bistable_undetermined"]:
+            if not hopf["on_boundary"]:
+                others = ", ".join(hopf["unstable_modes"]) or "another mode"
+                reach = (f"none: {others} of the sliding equilibrium stay unstable at the "
+                         "Hopf point, so the orbits born there are unstable and sliding is "
+                         "stable on neither side")
+            elif math.isnan(low) and hopf["bistable_undetermined"]:
                 reach = (f"not determined up to {self.key} = {p[-1]:.9g}{unit}: the "
                          "slipping orbits there are unstable and have neither folded nor "
                          "grazed; they bound the basin of stable sliding, and the motion "

@@ -167,12 +167,34 @@ def hopf_cycles(
     return result
 
 
-def _judge(result: Branch, hopf: HopfPoint) -> None:
-    """The Hopf point's kind and the bistable range, in the branch's attributes."""
+def restate_hopf(result: Branch, source: Branch) -> None:
+    """Give `result`, which continues `source` (a branch from
+    :func:`hopf_cycles`, or itself such a continuation), the Hopf point's kind and the
+    bistable range over both branches' orbits (what ``fivdisc continue --from hopf.nc``
+    prints); nothing if `source` is not from a Hopf point."""
+    import types
+
+    info = source.hopf()
+    if info is None:
+        return
+    hopf = types.SimpleNamespace(**{k: info[k] for k in (
+        "value", "omega", "direction", "on_boundary", "mode", "unstable_modes", "l1",
+        "l1_error")})
+    _judge(result, hopf, earlier=info)
+    result.dataset.attrs["hopf_continued"] = 1
+
+
+def _judge(result: Branch, hopf: Any, earlier: dict[str, Any] | None = None) -> None:
+    """The Hopf point's kind and the bistable range, in the branch's attributes; for a
+    branch that continues another from the Hopf point, `earlier` is that one's
+    :meth:`~fivdisc.continuation.branch.Branch.hopf`: its kind stands, and its range
+    joins this branch's."""
     p = result.parameter
     unstable_side = float(hopf.direction)
     side = np.sign(p[0] - hopf.value)
     kind = "supercritical" if side == unstable_side else "subcritical"
+    if earlier is not None:
+        kind = earlier["criticality"]
     # Orbits on the side where the equilibrium is stable, and stable themselves.
     stable_side = (p - hopf.value) * unstable_side < 0
     coexist = list(p[result.stable & stable_side])
@@ -187,6 +209,11 @@ def _judge(result: Branch, hopf: HopfPoint) -> None:
     folds = [b["parameter"] for b in result.bifurcations()
              if b["kind"] == "fold" and (b["parameter"] - hopf.value) * unstable_side < 0
              and any(result.stable[i] for i in (b["point"], b["point"] + 1) if i < n)]
+    if earlier is not None and np.isfinite(earlier["bistable"][0]):
+        # The earlier branch's range: its end away from the Hopf point, a bound if it was.
+        low, high = earlier["bistable"]
+        far = low if high == hopf.value else high
+        (grazing if earlier["bistable_open"] else folds).append(far)
     coexist = np.array(coexist + grazing + folds)
     open_end = False
     if hopf.on_boundary and coexist.size:
@@ -205,4 +232,8 @@ def _judge(result: Branch, hopf: HopfPoint) -> None:
                                  "hopf_l1_error": getattr(hopf, "l1_error", np.nan),
                                  "bistable_low": low, "bistable_high": high,
                                  "bistable_open": int(open_end),
-                                 "bistable_undetermined": int(undetermined)})
+                                 "bistable_undetermined": int(undetermined),
+                                 "hopf_on_boundary": int(hopf.on_boundary),
+                                 "hopf_mode": str(getattr(hopf, "mode", "")),
+                                 "hopf_unstable_modes": ", ".join(
+                                     getattr(hopf, "unstable_modes", ()))})

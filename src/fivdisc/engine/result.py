@@ -31,6 +31,9 @@ PHASE_NAMES = ("slip", "stick", "separation")
 # Run attributes that are arrays (one entry per slider or state component).
 _ARRAY_ATTRS = ("final_phase", "final_state")
 EVENT_KINDS = ("stick", "slip", "reversal", "separation", "recontact")
+# Every simulation result keeps some of these (a reproduced figure's runs only what the
+# figure draws, and the phases).
+_RESULT_VARIABLES = ("phase", "phi", "phi_dot", "q", "w", "normal_force", "friction_force")
 
 
 def _var(dims, data, units: str, long_name: str, **attrs) -> tuple:
@@ -593,8 +596,9 @@ def open_result(path: str | PathLike[str], run: str | None = None) -> Result:
             raise FivdiscError(f"run = {run!r} is invalid: {path} holds one run; leave run out")
         import xarray as xr
 
-        from fivdisc.files import CHECKSUM, check_netcdf
+        from fivdisc.files import CHECKSUM, check_netcdf, require_fivdisc_netcdf
 
+        require_fivdisc_netcdf(path, "open_result")
         check_netcdf(path)
         with xr.open_dataset(path, group=run) as stored:
             ds = stored.load()
@@ -604,9 +608,12 @@ def open_result(path: str | PathLike[str], run: str | None = None) -> Result:
     kind = ds.attrs.get("fivdisc_kind", "simulation")
     # One sample is a run: a run of less than one output interval, or one that failed at
     # its start.
-    if kind != "simulation" or "time" not in ds.coords or ds.sizes["time"] < 1:
+    if (kind != "simulation" or "time" not in ds.coords or ds.sizes["time"] < 1
+            or not any(name in ds for name in _RESULT_VARIABLES)):
         what = {"stability_map": "a stability map (fivdisc stability)",
                 "separation_map": "a separation map"}.get(kind, "not a simulation result")
+        if kind == "simulation" and "exponent" in ds:
+            what = "Lyapunov exponents (fivdisc lyapunov), not a simulation result"
         raise FivdiscError(f"{path}{f' (run {run})' if run else ''} is {what}: read it with "
                            "xarray.open_dataset, draw it with fivdisc plot")
     for name in _ARRAY_ATTRS:

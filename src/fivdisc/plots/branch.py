@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from fivdisc.analysis.cycle import MEASURES
+from fivdisc.case import describe_key
 from fivdisc.continuation.branch import Branch
 from fivdisc.errors import FivdiscError
 
@@ -17,7 +18,8 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["BRANCH_MEASURES", "NARROW", "draw_branch", "narrow_unstable", "plot_branch"]
+__all__ = ["BRANCH_MEASURES", "NARROW", "draw_branch", "draw_equilibrium", "equilibrium_curve",
+           "key_label", "narrow_unstable", "plot_branch"]
 
 #: What :func:`plot_branch` can draw: the period, or a measure per slider, as its
 #: largest (``_max``) or smallest (``_min``) value over a period, or both (no suffix).
@@ -27,7 +29,8 @@ BRANCH_MEASURES = ("period", *MEASURES, *(f"{m}_{e}" for m in MEASURES for e in 
 NARROW = 0.02
 # Short labels of the bifurcations on a figure.
 _MARKS = {"fold": ("LP", "s"), "period doubling": ("PD", "D"), "torus": ("NS", "o"),
-          "branch point": ("BP", "^"), "signature change": ("DIB", "v")}
+          "branch point": ("BP", "^"), "signature change": ("DIB", "v"),
+          "grazing": ("GR", "v")}
 
 
 def _columns(branch: Branch, measure: str, slider: int) -> list[tuple[str, np.ndarray, str]]:
@@ -93,8 +96,9 @@ def draw_branch(ax: Axes, branch: Branch, measure: str = "period", slider: int =
                 color: str = "C0", labels: bool = True) -> None:
     """Draw a measure of a branch on existing axes: stable stretches solid, unstable
     dashed, bifurcations marked (LP fold, PD period doubling, NS torus, BP branch point,
-    DIB a change of the event signature) and, with ``labels``, named. The points of an
-    unstable stretch too short to show dashed (:func:`narrow_unstable`) are marked."""
+    DIB a change of the event signature, GR a grazing) and, with ``labels``, named. The
+    points of an unstable stretch too short to show dashed (:func:`narrow_unstable`) are
+    marked."""
     x = branch.parameter
     stable = branch.stable
     curves = _columns(branch, measure, slider)
@@ -135,8 +139,88 @@ def draw_branch(ax: Axes, branch: Branch, measure: str = "period", slider: int =
                             xytext=(4, 4 + 9 * near), fontsize=8, color="C3")
 
 
+def key_label(key: str) -> str:
+    """Axis label of a case key: its words, symbol and unit (``disc speed $\\Omega_c$
+    [rad/s]``), as the stability figures label their axes."""
+    import types
+
+    from fivdisc.engine.conventions import axis_label, key_attrs
+
+    return axis_label(types.SimpleNamespace(attrs=key_attrs(key), name=key))
+
+
+# Points on which the sliding equilibrium's branch is drawn, and how far beyond the
+# branch's range (a fraction of it).
+_EQUILIBRIUM_POINTS = 201
+_EQUILIBRIUM_MARGIN = 0.05
+
+
+def equilibrium_curve(branch: Branch, measure: str, slider: int = 0):
+    """The sliding equilibrium along a branch's key, over the branch's range (and its
+    Hopf point's value): ``(values, measure's value, stable)``, from
+    :func:`~fivdisc.analysis.eigenbranches.eigen_branches` (NaN where there is no
+    equilibrium). At the equilibrium every measure's largest and smallest values are
+    its value; ``phi_dot`` is 0.
+
+    Raises
+    ------
+    FivdiscError
+        The measure is the period (an equilibrium has none), or there is no sliding
+        equilibrium at either end of the range.
+    """
+    from fivdisc.analysis.eigenbranches import eigen_branches
+    from fivdisc.errors import CaseError
+
+    if measure == "period":
+        raise FivdiscError("the sliding equilibrium has no period: draw its branch with a "
+                           "measure such as phi_dot or normal_force")
+    base = measure.removesuffix("_max").removesuffix("_min")
+    p = branch.parameter
+    hopf = branch.hopf()
+    ends = [float(p.min()), float(p.max())] + ([hopf["value"]] if hopf else [])
+    # A little beyond both ends, so that a Hopf point at one shows the equilibrium's
+    # change of stability.
+    margin = _EQUILIBRIUM_MARGIN * (max(ends) - min(ends)) or 1e-3 * abs(ends[0] or 1.0)
+    lo, hi = min(ends) - margin, max(ends) + margin
+    values = np.linspace(lo, hi, _EQUILIBRIUM_POINTS)
+    ds = None
+    for order in (values, values[::-1]):
+        try:
+            ds = eigen_branches(branch.case, branch.key, order)
+            break
+        except CaseError:
+            continue
+    if ds is None:
+        raise FivdiscError(f"no sliding equilibrium at {branch.key} = {lo:.6g} or {hi:.6g}: "
+                           "there is no equilibrium branch to draw")
+    ds = ds.sortby(branch.key)
+    x = ds[branch.key].values
+    if base == "phi_dot":
+        y = np.where(np.isfinite(ds["phi"].values[:, slider]), 0.0, np.nan)
+    else:
+        y = ds[base].values[:, slider]
+    return x, y, ds["max_growth_rate"].values < 0.0
+
+
+def draw_equilibrium(ax: Axes, branch: Branch, measure: str, slider: int = 0,
+                     color: str = "0.35") -> None:
+    """Draw the sliding equilibrium's branch (:func:`equilibrium_curve`) on existing
+    axes: stable solid, unstable dashed, its Hopf point (a branch from one) marked."""
+    x, y, stable = equilibrium_curve(branch, measure, slider)
+    cuts = np.flatnonzero(np.diff(stable.astype(int))) + 1
+    for a, b in itertools.pairwise(np.r_[0, cuts, x.size]):
+        piece = slice(a, min(b + 1, x.size))
+        ax.plot(x[piece], y[piece], color=color, lw=1.2, linestyle="-" if stable[a] else "--")
+    hopf = branch.hopf()
+    if hopf:
+        ax.plot([hopf["value"]], [np.interp(hopf["value"], x, y)], marker="o", color=color,
+                ms=6, linestyle="none")
+        ax.annotate("H", (hopf["value"], float(np.interp(hopf["value"], x, y))),
+                    textcoords="offset points", xytext=(4, -12), fontsize=8, color=color)
+
+
 def plot_branch(branch: Branch, measure: str = "period", slider: int = 0,
-                ax: Axes | None = None) -> Figure:
+                ax: Axes | None = None, equilibrium: bool = False) -> Figure:
     """A branch of periodic orbits against its key.
 
     Parameters
@@ -152,6 +236,10 @@ def plot_branch(branch: Branch, measure: str = "period", slider: int = 0,
         Which slider's measure.
     ax : matplotlib.axes.Axes, optional
         Axes to draw on (default: a new figure).
+    equilibrium : bool
+        Draw the sliding equilibrium's branch too (:func:`draw_equilibrium`: stable
+        solid, unstable dashed, in grey), where the orbits of a Hopf point leave it; not
+        with the period.
 
     Returns
     -------
@@ -168,12 +256,12 @@ def plot_branch(branch: Branch, measure: str = "period", slider: int = 0,
         ax = fig.add_subplot()
     else:
         fig = ax.figure
+    curves = _columns(branch, measure, slider)
+    if equilibrium:
+        draw_equilibrium(ax, branch, measure, slider)
     draw_branch(ax, branch, measure, slider)
     ds = branch.dataset
-    par = ds["parameter"]
-    unit = par.attrs.get("units", "")
-    ax.set_xlabel(f"{branch.key} [{unit}]" if unit else branch.key)
-    curves = _columns(branch, measure, slider)
+    ax.set_xlabel(key_label(branch.key))
     unit = curves[0][2]
     if measure == "period":
         what = "period"
@@ -182,9 +270,15 @@ def plot_branch(branch: Branch, measure: str = "period", slider: int = 0,
         what = MEASURES[base][0] + ("" if ds.sizes["slider"] == 1 else f", slider {slider}")
         what += {"_max": ", largest", "_min": ", smallest"}.get(measure[-4:], ", range")
     ax.set_ylabel(f"{what} [{unit}]" if unit and unit != "1" else what)
-    ax.set_title(f"periodic orbits continued in {branch.key}", fontsize=10)
-    handles = [Line2D([], [], color="C0", ls="-", label="stable"),
-               Line2D([], [], color="C0", ls="--", label="unstable")]
+    ax.set_title(f"periodic orbits continued in {describe_key(branch.key).long_name}"
+                 + (" with the sliding equilibrium" if equilibrium else ""), fontsize=10)
+    what = "periodic orbits, " if equilibrium else ""
+    handles = [Line2D([], [], color="C0", ls="-", label=f"{what}stable"),
+               Line2D([], [], color="C0", ls="--", label=f"{what}unstable")]
+    if equilibrium:
+        handles += [Line2D([], [], color="0.35", ls="-", label="sliding equilibrium, stable"),
+                    Line2D([], [], color="0.35", ls="--",
+                           label="sliding equilibrium, unstable")]
     narrow = narrow_unstable(branch, measure, slider)
     if narrow:
         spans = ", ".join(f"{min(lo, hi):.6g} to {max(lo, hi):.6g}" for lo, hi in narrow)
@@ -213,8 +307,6 @@ def overlay_branch(ax: Axes, branch: Branch, key: str, variable: str, slider: in
         raise FivdiscError(f"a branch keeps phi, phi_dot and normal_force per slider, not the "
                            f"section's variable {variable!r}")
     draw_branch(ax, branch, f"{variable}_max" if maxima else variable, slider, color="C1")
-    from matplotlib.lines import Line2D
-
-    ax.legend(handles=[Line2D([], [], color="C1", ls="-", label="periodic orbits, stable"),
-                       Line2D([], [], color="C1", ls="--", label="periodic orbits, unstable")],
-              loc="best", fontsize="small", frameon=False)
+    # Entries of the key the diagram draws.
+    ax.plot([], [], color="C1", ls="-", label="periodic orbits, stable")
+    ax.plot([], [], color="C1", ls="--", label="periodic orbits, unstable")

@@ -39,6 +39,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 from fivdisc.plots.text import (
     Window,
+    disc_speed_axis,
     drawing,
     engineering_scale,
     fit_text,
@@ -46,6 +47,7 @@ from fivdisc.plots.text import (
     lone_coords,
     new_axes,
     set_title,
+    set_two_line_title,
     where_text,
     window_bounds,
 )
@@ -71,6 +73,9 @@ _SEGMENTS_PER_RECORD = 100
 
 _BINS_PER_RANGE = 50
 
+
+# A spectrogram's figure [in]: wider than the default, for its colour bar beside it.
+_WIDE = (8.0, 4.8)
 
 # A time series drawn without a window shows its last this many oscillations.
 _READABLE_CYCLES = 30
@@ -189,6 +194,7 @@ def plot_timeseries(data: xr.Dataset | object, var: str, probe: int | None = Non
         ax.plot(da["time"].values, da.values * factor, lw=0.8, **lone_coords(da))
         ax.set_ylabel(label_of(da, var, prefix))
     ax.set_xlabel(label_of(da["time"], "time"))
+    disc_speed_axis(ax, ds)
     set_title(ax, ds, str(da.attrs.get("long_name", var)), where_text(da))
     return fig
 
@@ -238,7 +244,7 @@ def plot_spectrogram(data: xr.Dataset | object, var: str = "phi", probe: int | N
     if fmax is not None:
         mag = mag.sel(frequency=slice(None, fmax))
     top = float(mag.max())
-    fig, ax = new_axes(ax)
+    fig, ax = new_axes(ax, figsize=_WIDE)
     from matplotlib.colors import LogNorm
 
     if top > 0:
@@ -252,10 +258,19 @@ def plot_spectrogram(data: xr.Dataset | object, var: str = "phi", probe: int | N
                  else "magnitude")
     ax.set_xlabel(label_of(mag["time"], "time"))
     ax.set_ylabel(label_of(mag["frequency"], "frequency"))
+    ax.set_xlim(*_span(ds, t0, t1))
+    disc_speed_axis(ax, ds)
     long_name = ds[var].attrs.get("long_name", var)
-    set_title(ax, ds, f"spectrogram of {long_name}", where_text(mag),
-           f"0-{fmax:g} Hz, {segment:g} s segments ({1 / segment:.3g} Hz bins)")
+    set_two_line_title(ax, ds, f"spectrogram of {long_name}", where_text(mag),
+                       f"0-{fmax:g} Hz, {segment:g} s segments ({1 / segment:.3g} Hz bins)")
     return fig
+
+
+def _span(ds: xr.Dataset, t0: float | None, t1: float | None) -> tuple[float, float]:
+    """The time window's ends [s] within the record."""
+    time = ds["time"].values
+    return (float(time[0]) if t0 is None else max(float(t0), float(time[0])),
+            float(time[-1]) if t1 is None else min(float(t1), float(time[-1])))
 
 
 @drawing

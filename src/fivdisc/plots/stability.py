@@ -18,7 +18,8 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 from fivdisc.plots.text import drawing, new_axes, set_title
 
-__all__ = ["plot_eigen_branches", "plot_hopf_curves", "plot_stability_boundary",
+__all__ = ["GROWTH_SCALES", "growth_axis", "plot_eigen_branches", "plot_hopf_curves",
+           "plot_stability_boundary",
            "plot_stability_map"]
 
 
@@ -53,8 +54,10 @@ def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None,
     with several (a ``curve_key``), each value of the third key shades the region where
     it is stable, in its colour. The grid's boundary (where the growth rate changes
     sign, either way) is drawn as a contour; a value, or a map, without one says so in
-    the legend and on the axes. Axes are labelled with the keys' descriptions, symbols
-    and units.
+    the legend and on the axes. Where the exact boundary is given, it is drawn instead,
+    over the shading: the grid's contour, a few cells' linear interpolation of the
+    growth rate, would only show beside it where the two disagree. Axes are labelled
+    with the keys' descriptions, symbols and units.
 
     Parameters
     ----------
@@ -64,8 +67,8 @@ def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None,
         Where to draw.
     boundary : xarray.Dataset or sequence of them, optional
         Exact boundary curves of :func:`fivdisc.analysis.boundary.stability_boundary`
-        over the same keys (one per curve value, with `curve_key`), drawn on top
-        (black, dashed).
+        over the same keys (one per curve value, with `curve_key`), drawn on top (solid,
+        black or the value's colour) in place of the grid's contours.
     """
     xkey, ykey = ds.attrs["x_key"], ds.attrs["y_key"]
     ckey = ds.attrs.get("curve_key", "")
@@ -75,16 +78,24 @@ def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None,
     absent: list[str] = []
     x, y = ds[xkey].values, ds[ykey].values
     panels = [(None, ds)] if not ckey else [(v, ds.sel({ckey: v})) for v in ds[ckey].values]
+    exact = [boundary] if isinstance(boundary, xr.Dataset) else list(boundary or [])
+    # One exact boundary per panel replaces its grid contour; any other number is laid
+    # over every panel.
+    per_panel = len(exact) == len(panels)
     from matplotlib import rcParams
 
     cycle = rcParams["axes.prop_cycle"].by_key()["color"]
-    for value, one in panels:
+    for k, (value, one) in enumerate(panels):
         stable = one["stable"].transpose(ykey, xkey).values.astype(float)
         growth = one["max_growth_rate"].transpose(ykey, xkey).values
         stable[np.isnan(growth)] = np.nan
         if value is None:
             text, color = "", "k"
-            ax.contourf(x, y, stable, levels=[-0.5, 0.5, 1.5], colors=["#f4c7c3", "#c6e5c3"])
+            # The sign of the interpolated growth rate, so that the shading's edge is the
+            # grid's contour, not a staircase of its cells.
+            big = float(np.nanmax(np.abs(growth), initial=0.0)) or 1.0
+            ax.contourf(x, y, growth, levels=[-2 * big, 0.0, 2 * big],
+                        colors=["#c6e5c3", "#f4c7c3"])
             ax.plot([], [], color="#c6e5c3", lw=8, label="stable")
             ax.plot([], [], color="#f4c7c3", lw=8, label="unstable")
         else:
@@ -95,24 +106,25 @@ def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None,
             text = f"${symbol}$ = {value:g}{unit}" if symbol else f"{ckey} = {value:g}{unit}"
             color = cycle[list(ds[ckey].values).index(value) % len(cycle)]
             if np.nanmax(stable, initial=0.0) > 0.5:
-                ax.contourf(x, y, stable, levels=[0.5, 1.5], colors=[color], alpha=0.15)
-        if np.isfinite(one["boundary"].values).any():
+                big = float(np.nanmax(np.abs(growth), initial=0.0)) or 1.0
+                ax.contourf(x, y, growth, levels=[-2 * big, 0.0], colors=[color], alpha=0.15)
+        if per_panel:
+            _draw_exact(ax, exact[k], xkey, ykey, color, text)
+        elif np.isfinite(one["boundary"].values).any():
             ax.contour(x, y, growth, levels=[0.0], colors=[color], linewidths=1.5)
             ax.plot([], [], color=color, lw=1.5,
                     label=f"{text}: boundary, stable shaded" if text else "grid boundary")
-        else:
+        if not np.isfinite(one["boundary"].values).any() and not (
+                per_panel and exact[k].sizes.get("point", 0)):
             ok = stable[np.isfinite(stable)]
             state = ("stable throughout" if ok.size and ok.all() else "unstable throughout"
                      if not ok.any() else f"stable at {ok.mean():.0%}, no sign change")
             absent.append(f"{text} ({state})" if text else state)
             if text:
                 ax.plot([], [], color=color, lw=8, alpha=0.3, label=f"{text}: {state}")
-    exact = [boundary] if isinstance(boundary, xr.Dataset) else list(boundary or [])
-    for k, one in enumerate(exact):
-        for b in np.unique(one["branch"].values):
-            sel = one["branch"].values == b
-            ax.plot(one[xkey].values[sel], one[ykey].values[sel], color="k", lw=1.0,
-                    ls="--", label="exact boundary" if k == b == 0 else None)
+    if not per_panel:
+        for k, one in enumerate(exact):
+            _draw_exact(ax, one, xkey, ykey, "k", "", label=k == 0)
     ax.set_xlabel(axis_label(ds[xkey]))
     ax.set_ylabel(axis_label(ds[ykey]))
     ax.set_xlim(x[0], x[-1])
@@ -127,6 +139,20 @@ def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None,
     set_title(ax, ds, what, detail="no boundary in the grid: " + ", ".join(absent) if absent
            else "")
     return fig
+
+
+def _draw_exact(ax: Axes, one: xr.Dataset, xkey: str, ykey: str, color: str, text: str,
+                label: bool = True) -> None:
+    """The curves of an exact boundary, solid and over the map's shading and contours,
+    with a legend entry (``text``: the curve value's) when `label`."""
+    for b in np.unique(one["branch"].values):
+        sel = one["branch"].values == b
+        ax.plot(one[xkey].values[sel], one[ykey].values[sel], color=color, lw=1.5,
+                zorder=3)
+    if label and one.sizes.get("point", 0):
+        ax.plot([], [], color=color, lw=1.5,
+                label=f"{text}: exact boundary, stable shaded" if text
+                else "exact boundary")
 
 
 @drawing
@@ -161,15 +187,55 @@ def plot_stability_boundary(ds: xr.Dataset, ax: Axes | None = None) -> Figure:
     return fig
 
 
+#: Scales of the growth-rate axis of :func:`plot_eigen_branches`.
+GROWTH_SCALES = ("auto", "linear", "symlog")
+# "auto" takes a symmetric-log axis where the largest |growth rate| exceeds this many
+# times the typical branch's largest (the median over the branches).
+_SYMLOG_RATIO = 30.0
+
+
+def growth_axis(growth: np.ndarray, scale: str = "auto") -> tuple[str, float]:
+    """The growth-rate axis of an eigenvalue-branch figure: ``("linear", 0)`` or
+    ``("symlog", linthresh)``.
+
+    ``"auto"`` takes the symmetric-log axis where the largest |growth rate| is more than
+    30 times the median over the branches of each one's largest (a 4 1/s instability
+    beside 417 1/s is a flat line on a linear axis); its linear part reaches to the
+    power of ten below that median, where most branches lie.
+
+    Parameters
+    ----------
+    growth : ndarray
+        ``(values, branches)`` growth rates [1/s] (NaN: no equilibrium).
+    scale : str
+        One of :data:`GROWTH_SCALES`.
+    """
+    from fivdisc.analysis.spectra import AnalysisError
+
+    if scale not in GROWTH_SCALES:
+        raise AnalysisError(f"growth_scale = {scale!r} is invalid: must be one of "
+                            f"{', '.join(GROWTH_SCALES)}")
+    peaks = np.nanmax(np.abs(growth), axis=0, initial=0.0) if growth.size else np.zeros(1)
+    peaks = peaks[np.isfinite(peaks)]
+    typical = float(np.median(peaks)) if peaks.size else 0.0
+    top = float(peaks.max(initial=0.0))
+    if scale == "linear" or (scale == "auto" and not top > _SYMLOG_RATIO * typical):
+        return "linear", 0.0
+    floor = typical if typical > 0 else (top if top > 0 else 1.0)
+    return "symlog", float(10.0 ** np.floor(np.log10(floor)))
+
+
 @drawing
-def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None) -> Figure:
+def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None,
+                        growth_scale: str = "auto") -> Figure:
     """Frequency and growth rate of every eigenvalue branch against the key
     (:func:`fivdisc.analysis.eigenbranches.eigen_branches`).
 
-    One colour per branch (positive frequencies only: one of each complex pair); where a
-    branch is unstable it is drawn thick. Mode couplings are marked with a dotted line,
-    existence limits with a solid grey one, and Hopf points
-    (:func:`fivdisc.analysis.hopf.hopf_points`) with dots.
+    One colour per branch (positive frequencies only: one of each complex pair),
+    labelled with its mode in the key beside the axes; where a branch is unstable it is
+    drawn thick. Mode couplings are marked with a dotted line, existence limits with a
+    solid grey one, and Hopf points (:func:`fivdisc.analysis.hopf.hopf_points`) with
+    dots in the colour of the mode that crosses there.
 
     Parameters
     ----------
@@ -178,19 +244,26 @@ def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None) -> Figure:
     hopf : sequence of HopfPoint, optional
         Hopf points to mark; by default those stored in `ds` (``hopf``,
         ``hopf_frequency``: ``fivdisc stability --x`` writes them), if any.
+    growth_scale : str
+        The growth-rate axis: ``"linear"``, ``"symlog"`` (symmetric log, linear near
+        zero) or ``"auto"``, symlog where the rates span more than the linear axis
+        shows (:func:`growth_axis`).
     """
     import matplotlib.pyplot as plt
 
     new_axes(None)  # chooses a headless backend where needed
     fig, (top, bottom) = plt.subplots(2, 1, sharex=True, layout="constrained",
-                                      figsize=(7.0, 6.5))
+                                      figsize=(8.0, 6.5))
     key = ds.attrs["x_key"]
     x = ds[key].values
     freq, growth = ds["frequency"].values, ds["growth_rate"].values
+    scale, linthresh = growth_axis(growth, growth_scale)
+    colors: dict[str, str] = {}  # mode -> its branch's colour
     for b in range(freq.shape[1]):
         if not np.nanmax(freq[:, b], initial=-1.0) > 0.0:
             continue
         (line,) = top.plot(x, freq[:, b], lw=1.0, label=str(ds["mode"].values[b]))
+        colors[str(ds["mode"].values[b])] = line.get_color()
         bottom.plot(x, growth[:, b], lw=1.0, color=line.get_color())
         bad = np.where(growth[:, b] > 0.0, growth[:, b], np.nan)
         top.plot(x, np.where(growth[:, b] > 0.0, freq[:, b], np.nan), lw=3.5,
@@ -202,21 +275,34 @@ def plot_eigen_branches(ds: xr.Dataset, hopf: Sequence | None = None) -> Figure:
         for value in ds["existence_limit"].values:
             ax.axvline(value, color="0.5", lw=2.0)
     if hopf is not None:
-        marks = [(hp.value, hp.frequency) for hp in hopf]
+        marks = [(hp.value, hp.frequency, hp.mode) for hp in hopf]
+    elif "hopf" in ds:
+        modes = (ds["hopf_mode"].values if "hopf_mode" in ds
+                 else np.full(ds.sizes["hopf"], ""))
+        marks = list(zip(ds["hopf"].values, ds["hopf_frequency"].values, modes,
+                         strict=True))
     else:
-        marks = list(zip(ds["hopf"].values, ds["hopf_frequency"].values, strict=True)
-                     ) if "hopf" in ds else []
-    for value, frequency in marks:
-        top.plot(value, frequency, "ko", ms=5)
-        bottom.plot(value, 0.0, "ko", ms=5)
+        marks = []
+    for value, frequency, mode in marks:
+        # Filled with its branch's colour: the key names the mode that crosses there.
+        face = colors.get(str(mode), "k")
+        top.plot(value, frequency, "o", mfc=face, mec="k", ms=6)
+        bottom.plot(value, 0.0, "o", mfc=face, mec="k", ms=6)
     bottom.axhline(0.0, color="k", lw=0.5)
     top.set_ylabel("frequency [Hz]")
-    bottom.set_ylabel("growth rate [1/s]")
+    if scale == "symlog":
+        bottom.set_yscale("symlog", linthresh=linthresh)
+        bottom.axhspan(-linthresh, linthresh, color="0.92", zorder=0, lw=0)
+        bottom.set_ylabel(f"growth rate [1/s]\n(symmetric log, linear within ±{linthresh:g})")
+    else:
+        bottom.set_ylabel("growth rate [1/s]")
     bottom.set_xlabel(axis_label(ds[key]))
-    top.legend(loc="best", fontsize="small", ncols=2)
+    # Beside the axes, where it hides no branch.
+    fig.legend(*top.get_legend_handles_labels(), loc="outside right upper",
+               fontsize="small", title="mode", title_fontsize="small")
     set_title(top, ds, "eigenvalue branches (thick: unstable)",
-           detail="dotted: mode coupling; dots: Hopf points" if len(ds["coupling"]) or marks
-           else "")
+           detail="dotted: mode coupling; dots: Hopf points, in their mode's colour"
+           if len(ds["coupling"]) or marks else "")
     return fig
 
 

@@ -105,6 +105,9 @@ def plot_bifurcation(
     dot = _DOT if ys.size >= _FEW else _DOT + 3.0 * (1.0 - ys.size / _FEW)
     top.plot(xs, ys, linestyle="none", marker=".", ms=dot, mew=0.0, color="k",
              rasterized=ys.size > 20_000)
+    # The key's entry for the dots, with a marker large enough to see in it.
+    top.plot([], [], linestyle="none", marker=".", ms=8, color="k",
+             label=f"{chosen.variable}{chosen.selection} at the section, one dot per value")
     if branch is not None:
         from fivdisc.continuation.branch import Branch, open_branch
         from fivdisc.plots.branch import overlay_branch
@@ -118,7 +121,7 @@ def plot_bifurcation(
     if failed.any():
         top.plot(x[failed], np.zeros(failed.sum()), "x", color="tab:red", ms=5,
                  transform=top.get_xaxis_transform(), clip_on=False, label="run failed")
-        top.legend(loc="upper left", fontsize="small")
+    top.legend(loc="upper left", fontsize="small", framealpha=0.9)
     if lyapunov:
         exponent = np.ravel(data["largest_lyapunov"].values)
         bottom.axhline(0.0, color="0.5", lw=0.8, zorder=1)

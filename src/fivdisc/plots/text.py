@@ -47,7 +47,9 @@ def drawing(function: Callable[P, R]) -> Callable[P, R]:
     return checked
 
 
-def new_axes(ax: Axes | None) -> tuple[Figure, Axes]:
+def new_axes(ax: Axes | None, figsize: tuple[float, float] | None = None
+             ) -> tuple[Figure, Axes]:
+    """`ax` and its figure, or new ones (`figsize` [in], default matplotlib's)."""
     if ax is not None:
         return ax.figure, ax
     import matplotlib
@@ -61,7 +63,7 @@ def new_axes(ax: Axes | None) -> tuple[Figure, Axes]:
         matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, new_ax = plt.subplots(layout="constrained")
+    fig, new_ax = plt.subplots(layout="constrained", figsize=figsize)
     return fig, new_ax
 
 
@@ -133,6 +135,61 @@ def set_title(ax: Axes, ds: xr.Dataset, what: str, where: str = "", detail: str 
              detail]
     ax.set_title(fit_text(ax, "\n".join(line for line in lines if line), "medium"),
                  fontsize="medium")
+
+
+# Font sizes a two-line title may take, largest first [pt].
+_TITLE_SIZES = (10.0, 9.0, 8.0, 7.0)
+
+
+def set_two_line_title(ax: Axes, ds: xr.Dataset, what: str, where: str = "",
+                       detail: str = "") -> None:
+    """Title of at most two lines: the case's name, what is drawn and where; the run
+    and a detail. The font shrinks (down to 7 pt) until both lines fit the axes' width
+    as laid out; a line still too long loses its end to an ellipsis."""
+    name = str(ds.attrs.get("case_name", ""))
+    title = str(ds.attrs.get("title", ""))
+    run = title.split(": ", 1)[1] if ": " in title else ""
+    first = ", ".join(p for p in (f"{name}: {what}" if name else what, where) if p)
+    lines = [first, "; ".join(p for p in (run, detail) if p)]
+    lines = [line for line in lines if line]
+    fig = ax.figure
+    fig.draw_without_rendering()  # the layout (a colour bar takes its share) first
+    width = ax.get_position().width * fig.get_figwidth() * 72.0  # [pt]
+    for size in _TITLE_SIZES:
+        chars = int(width / (_CHAR_WIDTH * size))
+        if all(len(line) <= chars for line in lines):
+            break
+    lines = [line if len(line) <= chars else line[: max(chars - 1, 1)].rstrip() + "…"
+             for line in lines]
+    ax.set_title("\n".join(lines), fontsize=size)
+
+
+def disc_speed_axis(ax: Axes, ds: xr.Dataset) -> None:
+    """A second time axis on top, in disc speed, where the disc's speed changes
+    monotonically over the record (a braking or accelerating run): each time read
+    as the speed the disc had then."""
+    if "disc_speed" not in ds or "time" not in ds["disc_speed"].dims:
+        return
+    time = np.asarray(ds["time"].values, dtype=float)
+    speed = np.asarray(ds["disc_speed"].values, dtype=float)
+    if time.size < 2 or not np.all(np.isfinite(speed)):
+        return
+    step = np.diff(speed)
+    scale = float(np.max(np.abs(speed))) or 1.0
+    if not (np.all(step < 0) or np.all(step > 0)) or np.ptp(speed) < 1e-6 * scale:
+        return
+    # np.interp wants increasing abscissae: a braking run's speeds are reversed.
+    order = np.argsort(speed)
+
+    def to_speed(t):
+        return np.interp(t, time, speed)
+
+    def to_time(v):
+        return np.interp(v, speed[order], time[order])
+
+    top = ax.secondary_xaxis("top", functions=(to_speed, to_time))
+    units = ds["disc_speed"].attrs.get("units", "rad/s")
+    top.set_xlabel(f"disc speed [{units}]")
 
 
 def fit_text(ax: Axes, text: str, size: str) -> str:
