@@ -10,7 +10,7 @@ measured in the same run:
 3. the cost per step of 2 and 8 sliders against 1 slider (same disc, same span), in
    stick-slip and in steady sliding.
 
-Costs per step are the kernel's wall time (``wall_time``, which excludes compilation)
+Costs per step are the integration's wall time (``wall_time``)
 over its accepted steps, the median of three runs.
 """
 

@@ -1,17 +1,19 @@
-"""First use of each command from an empty numba cache, side by side with an earlier commit.
+"""First use of each command against later use, from a fresh install of the working tree,
+side by side with the last numba kernel's first use from an empty numba cache.
 
-Run ``python benchmarks/bench_first_use.py`` (``--baseline COMMIT``, default ``278cbee``,
-the commit before issue 29; ``--now COMMIT`` to time a commit's sources instead of the
-fivdisc on ``PYTHONPATH``; ``--rounds N``, default 1; ``--only NAME`` for some of the
-commands; ``--warmup`` also times ``fivdisc warmup`` from an empty cache and then each
-command on the cache it filled). Each command runs as a whole process, the way a new user
-starts it, with ``NUMBA_CACHE_DIR`` set to a new empty directory, so that every kernel it
-needs compiles; the earlier commit runs from its unpacked sources
-(``previous.source_tree``) on the same interpreter and libraries. The two alternate, so
-that a change in the machine's load falls on both. It prints each process's wall time
-[s], the ratio of the medians (now / before) and the target of issue 29, item 1, with the
-load average before and after, and each process's processor time (with its helpers'):
-on a machine shared with other work the absolute times say little, the ratios more.
+Run ``python benchmarks/bench_first_use.py`` (``--baseline COMMIT``, default
+``previous.LAST_NUMBA``; ``--rounds N``, default 1; ``--only NAME`` for some of the
+commands; ``--installed`` to time the fivdisc of this interpreter instead of a fresh
+install). The working tree is installed with ``pip install`` into a new virtual
+environment (about a minute: the compiled core is built then), and each command runs as
+a whole process the way a new user starts it: its first use in that installation, then
+its later use (the same command again, ``--rounds`` times). The earlier commit runs from
+its unpacked sources (``previous.source_tree``) on this interpreter and its libraries,
+with ``NUMBA_CACHE_DIR`` set to a new empty directory, so that every kernel it needs
+compiles. It prints each process's wall time [s], first use / later use (target of
+issue 37, item 5: within 10 %) and first use now / first use then, with the load average
+before and after and each process's processor time: on a machine shared with other work
+the absolute times say little, the ratios more.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from __future__ import annotations
 import argparse
 import os
 import resource
+import shutil
 import statistics
 import subprocess
 import sys
@@ -26,23 +29,42 @@ import tempfile
 import time
 from pathlib import Path
 
-from previous import source_tree
+from previous import LAST_NUMBA, source_tree
 
+REPO = Path(__file__).resolve().parents[1]
 # The console script `fivdisc` runs exactly this; through the interpreter being timed.
 _CLI = "from fivdisc.cli import main; main()"
 
-# name: (arguments, target [s] of issue 29, item 1); short runs, so that the time is the
-# compilation's and the command's start.
-COMMANDS: dict[str, tuple[tuple[str, ...], float]] = {
-    "simulate": (("simulate", "fig10", "-o", "fig10.nc", "--no-progress"), 15.0),
-    "orbit": (("orbit", "fig13", "--transient", "5", "--no-progress"), 25.0),
-    "lyapunov": (("lyapunov", "fig13", "--transient", "1", "--duration", "1",
-                  "--no-progress"), 25.0),
-    "continue": (("continue", "fig13", "--key", "speed.value", "--to", "6.35", "--points",
-                  "3", "--transient", "5", "--no-progress"), 25.0),
-    "stability": (("stability",), 5.0),
+# name: arguments; short runs, so that the time is mostly the command's start.
+COMMANDS: dict[str, tuple[str, ...]] = {
+    "simulate": ("simulate", "fig10", "-o", "fig10.nc", "--no-progress"),
+    "orbit": ("orbit", "fig13", "--transient", "5", "--no-progress"),
+    "lyapunov": ("lyapunov", "fig13", "--transient", "1", "--duration", "1", "--no-progress"),
+    "continue": ("continue", "fig13", "--key", "speed.value", "--to", "6.35", "--points",
+                 "3", "--transient", "5", "--no-progress"),
+    "stability": ("stability",),
+    "sweep": ("sweep", "small-sweep.toml", "-o", "sweep.zarr", "--no-progress", "--workers",
+              "2"),
 }
-WARMUP = ("warmup",)
+# A sweep of 2 x 2 short runs of a decelerating disc, written into each working directory;
+# its store is removed before each run, so that every run computes every point.
+_SWEEP = """\
+[base.speed]
+profile = "decelerating"
+initial = 6.0
+duration = 5.0
+
+[base.simulation]
+duration = 0.2
+output_rate = 100.0
+
+[axes]
+"speed.initial" = "2.0:6.0:2"
+"speed.duration" = "5.0:20.0:2"
+
+[reduce]
+keep = ["separated"]
+"""
 # Processor time of each process timed, in order [s].
 CPU: list[float] = []
 
@@ -52,14 +74,15 @@ def _cpu() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def _seconds(args: tuple[str, ...], pythonpath: str, cache: Path, workdir: Path) -> float:
+def _seconds(python: str, args: tuple[str, ...], env: dict[str, str], workdir: Path) -> float:
     """Wall time of one process running the command line with ``args`` [s]; its processor
-    time (with its helper processes') goes to ``CPU``."""
-    env = {**os.environ, "PYTHONPATH": pythonpath, "NUMBA_CACHE_DIR": str(cache),
-           "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+    time (with its workers') goes to ``CPU``."""
+    env = {**env, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+    (workdir / "small-sweep.toml").write_text(_SWEEP)
+    shutil.rmtree(workdir / "sweep.zarr", ignore_errors=True)
     cpu = _cpu()
     start = time.perf_counter()
-    out = subprocess.run([sys.executable, "-c", _CLI, *args], env=env, cwd=workdir,
+    out = subprocess.run([python, "-c", _CLI, *args], env=env, cwd=workdir,
                          stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     seconds = time.perf_counter() - start
     CPU.append(_cpu() - cpu)
@@ -71,66 +94,60 @@ def _seconds(args: tuple[str, ...], pythonpath: str, cache: Path, workdir: Path)
     return seconds
 
 
-def _first_use(args: tuple[str, ...], pythonpath: str) -> float:
-    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as work:
-        return _seconds(args, pythonpath, Path(cache), Path(work))
-
-
-def _after_warmup(names: list[str], pythonpath: str) -> tuple[float, dict[str, float]]:
-    """``fivdisc warmup`` on an empty cache, then each command on what it filled [s]."""
-    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as work:
-        warmup = _seconds(WARMUP, pythonpath, Path(cache), Path(work))
-        return warmup, {name: _seconds(COMMANDS[name][0], pythonpath, Path(cache), Path(work))
-                        for name in names}
+def _fresh_install(home: Path) -> str:
+    """Python of a new virtual environment with the working tree installed (with the
+    distributed extra, which `fivdisc sweep` needs)."""
+    subprocess.run([sys.executable, "-m", "venv", str(home)], check=True)
+    python = str(home / "bin" / "python")
+    start = time.perf_counter()
+    subprocess.run([python, "-m", "pip", "install", "-q", f"{REPO}[distributed]"], check=True)
+    print(f"pip install of the working tree: {time.perf_counter() - start:.0f} s", flush=True)
+    return python
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--baseline", default="278cbee", help="earlier commit")
-    parser.add_argument("--now", metavar="COMMIT",
-                        help="time this commit's sources instead of the fivdisc on "
-                             "PYTHONPATH (so that editing the tree meanwhile changes nothing)")
-    parser.add_argument("--rounds", type=int, default=1, help="processes per command")
+    parser.add_argument("--baseline", default=LAST_NUMBA, help="earlier (numba) commit")
+    parser.add_argument("--rounds", type=int, default=1, help="later uses per command")
     parser.add_argument("--only", action="append", choices=sorted(COMMANDS),
                         help="time this command (repeatable; default: all)")
-    parser.add_argument("--warmup", action="store_true",
-                        help="also time fivdisc warmup, then each command after it")
+    parser.add_argument("--installed", action="store_true",
+                        help="time the fivdisc of this interpreter, not a fresh install")
     args = parser.parse_args()
     names = args.only or list(COMMANDS)
-    now = str(source_tree(args.now)) if args.now else os.environ.get("PYTHONPATH", "")
     before = str(source_tree(args.baseline))
     load = os.getloadavg()[0]
-    times: dict[str, tuple[list[float], list[float]]] = {n: ([], []) for n in names}
-    warm: list[tuple[float, dict[str, float]]] = []
-    for round_ in range(args.rounds):
+    first: dict[str, float] = {}
+    later: dict[str, list[float]] = {n: [] for n in names}
+    then: dict[str, float] = {}
+    env_now = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    with tempfile.TemporaryDirectory() as tmp:
+        python = sys.executable if args.installed else _fresh_install(Path(tmp) / "venv")
+        if args.installed:
+            env_now = dict(os.environ)
         for name in names:
-            cmd = COMMANDS[name][0]
-            # The order alternates between rounds, so neither side always goes first.
-            pair = [(now, 0), (before, 1)][:: 1 if round_ % 2 == 0 else -1]
-            cpu = {}
-            for pythonpath, side in pair:
-                times[name][side].append(_first_use(cmd, pythonpath))
-                cpu[side] = CPU[-1]
-            print(f"{name:<10} now {times[name][0][-1]:7.1f} s (cpu {cpu[0]:.1f} s), at "
-                  f"{args.baseline} {times[name][1][-1]:7.1f} s (cpu {cpu[1]:.1f} s); load "
+            cmd = COMMANDS[name]
+            with tempfile.TemporaryDirectory() as work:
+                first[name] = _seconds(python, cmd, env_now, Path(work))
+                cpu = CPU[-1]
+                for _ in range(args.rounds):
+                    later[name].append(_seconds(python, cmd, env_now, Path(work)))
+            with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as work:
+                then[name] = _seconds(sys.executable, cmd,
+                                      {**os.environ, "PYTHONPATH": before,
+                                       "NUMBA_CACHE_DIR": cache}, Path(work))
+            print(f"{name:<10} first {first[name]:6.2f} s (cpu {cpu:.1f} s), later "
+                  f"{statistics.median(later[name]):6.2f} s; at {args.baseline} from an empty "
+                  f"numba cache {then[name]:6.1f} s (cpu {CPU[-1]:.1f} s); load "
                   f"{os.getloadavg()[0]:.1f}", flush=True)
-        if args.warmup:
-            warm.append(_after_warmup(names, now))
-            print(f"fivdisc warmup {warm[-1][0]:.1f} s, then "
-                  + ", ".join(f"{n} {s:.1f} s" for n, s in warm[-1][1].items()), flush=True)
-    print(f"\nfirst use from an empty numba cache, median of {args.rounds} process(es); "
-          f"load average {load:.2f} before, {os.getloadavg()[0]:.2f} after "
+    print(f"\nload average {load:.2f} before, {os.getloadavg()[0]:.2f} after "
           f"({os.cpu_count()} cores)")
-    print(f"{'command':<10} {'now [s]':>9} {args.baseline + ' [s]':>13} {'ratio':>7} "
-          f"{'target [s]':>11}")
+    print(f"{'command':<10} {'first [s]':>10} {'later [s]':>10} {'first/later':>12} "
+          f"{args.baseline + ' [s]':>13} {'now/then':>9}")
     for name in names:
-        mine, theirs = (statistics.median(t) for t in times[name])
-        print(f"{name:<10} {mine:>9.1f} {theirs:>13.1f} {mine / theirs:>7.2f} "
-              f"{COMMANDS[name][1]:>11.0f}")
-    if warm:
-        print(f"fivdisc warmup, empty cache: {statistics.median(w[0] for w in warm):.1f} s; "
-              "then each command: " + ", ".join(
-                  f"{n} {statistics.median(w[1][n] for w in warm):.1f} s" for n in names))
+        mine = statistics.median(later[name])
+        print(f"{name:<10} {first[name]:>10.2f} {mine:>10.2f} {first[name] / mine:>12.2f} "
+              f"{then[name]:>13.1f} {first[name] / then[name]:>9.2f}")
 
 
 if __name__ == "__main__":

@@ -6,9 +6,8 @@ It prints:
 1. the ratio of the scipy ``solve_ivp`` (RK45, numpy right-hand side, Python events)
    wall time to fivdisc's, same equations, same tolerances, same simulated span, one core;
 2. the wall time of the paper's Fig. 10 case (decelerating from 2 pi rad/s over
-   t_max = 35 s, 7 modal coordinates, output at 10 kHz) after compilation;
-3. the time a fresh process needs to import fivdisc, load the compiled kernel from the
-   cache and finish a first short simulation;
+   t_max = 35 s, 7 modal coordinates, output at 10 kHz) after a first run;
+3. the time a fresh process needs to import fivdisc and finish a first short simulation;
 4. the peak resident memory of a process running the Fig. 10 case.
 """
 
@@ -64,7 +63,7 @@ def against_baseline(span: float) -> None:
 
 
 def fig10() -> None:
-    simulate(FIG10.replace({"simulation.duration": 0.01}))  # compile / load the cache
+    simulate(FIG10.replace({"simulation.duration": 0.01}))  # imports
     wall = _median_time(lambda: simulate(FIG10), 3)
     res = simulate(FIG10)
     a = res.dataset.attrs
@@ -82,12 +81,12 @@ def cold_process() -> None:
         print(time.perf_counter() - t0)
         """
     )
-    subprocess.run([sys.executable, "-c", code], check=True, capture_output=True)  # fill cache
+    subprocess.run([sys.executable, "-c", code], check=True, capture_output=True)  # file cache
     start = time.perf_counter()
     out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
                          text=True)
     total = time.perf_counter() - start
-    print(f"fresh process, cached kernel: first simulation done {float(out.stdout):.2f} s "
+    print(f"fresh process: first simulation done {float(out.stdout):.2f} s "
           f"after start of import ({total:.2f} s including interpreter start-up)")
 
 

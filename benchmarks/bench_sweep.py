@@ -9,7 +9,7 @@ Run ``python benchmarks/bench_sweep.py`` (a 40 x 40 map, a few minutes on two co
    and the ratio of 2-worker to 1-worker wall time (0.5 is perfect scaling);
 3. the wall time of the ``--n`` x ``--n`` map on ``--workers`` workers.
 
-Pool wall times include starting the worker processes and warming their compiled code.
+Pool wall times include starting the worker processes.
 """
 
 from __future__ import annotations
@@ -28,7 +28,6 @@ from fivdisc.sweep import (
     separation_sweep,
 )
 from fivdisc.sweep.reductions import evaluate
-from fivdisc.sweep.run import warm_kernel
 from fivdisc.sweep.separation import DEFAULT_RANGES
 
 X_RANGE = (2.0, 20.0)  # Omega_0 [rad/s], as the default Fig. 27 map
@@ -71,7 +70,6 @@ def main() -> None:
     args = parser.parse_args()
     assert DEFAULT_RANGES["decelerating"] == (_axis(X_RANGE, 40), _axis(Y_RANGE, 40))
 
-    warm_kernel()
     speed = single_run_speed()
     print(f"single run: {speed:.1f} simulated s per wall s")
 

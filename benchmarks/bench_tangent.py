@@ -12,7 +12,7 @@ baseline measured in the same run:
 3. with ``--processes N``, the one-vector figure again in N fresh processes (it varies
    from process to process by more than between the rounds of one).
 
-The runs are interleaved after a warm-up that compiles (in each round the baseline, then
+The runs are interleaved after a warm-up (in each round the baseline, then
 the runs with tangents), and each figure is the ratio of the fastest run of each kind
 over the rounds: the work is deterministic, so the fastest run is the one least
 disturbed by the rest of the machine (the advice of :mod:`timeit`); the median of the
@@ -56,7 +56,7 @@ def _run(model, y0, span, vectors, max_step):
     clock = CLOCK["clock"]
     start = clock()
     run.run_to(span)
-    return clock() - start, int(run.ist[1])
+    return clock() - start, run.stats["steps"]
 
 
 def _median(values):
@@ -73,7 +73,7 @@ def per_step(case, repeat=7, counts=(1, 2, 4), span=SPAN) -> None:
     model = build_model(case)
     y0 = initial_state(model)
     cap = tangent_step(model)
-    for n in (0, *counts):  # warm-up: compile both specialisations
+    for n in (0, *counts):  # warm-up
         _run(model, y0, 0.01, n, cap)
     walls: dict[int, list[float]] = {n: [] for n in counts}
     bases = []

@@ -1,26 +1,29 @@
-"""The floor of the kernel's cost per step: a plain numba Dormand-Prince 5(4) loop with
-the same step-size control over a linear system of the same state size.
+"""The floor of the core's cost per step: a plain Dormand-Prince 5(4) loop with the same
+step-size control over a linear system of the same state size, in C++ in the same
+extension, built by the same compiler with the same flags
+(``fivdisc.core._core.floor_dopri_linear``, ``src/fivdisc/core/src/floor.hpp``).
 
 ``floor_cost(model, duration)`` integrates ``y' = J y`` with J the exact Jacobian of the
 model's slip equations at a generic state (so the step sizes resemble the real run's),
-no events, no contact solve, no output, and returns the median wall time per accepted
-step [s] and the steps taken. J is applied two ways: as a dense matrix (O(n^2) per
-product, which at many coordinates costs more than the kernel's O(n) right-hand side)
-and in the model's own structure, the sparse free disc and free sliders plus the
-contacts' low-rank rest (O(n)). Anything the real kernel spends beyond the floor is the
-price of its right-hand side, events and output.
+no events, no contact solve, no output, and returns the median time per accepted step
+[s] and the steps taken. J is applied two ways: as a dense matrix (O(n^2) per product,
+which at many coordinates costs more than the core's O(n) right-hand side) and in the
+model's own structure, the sparse free disc and free sliders plus the contacts' low-rank
+rest (O(n)). Anything the core spends beyond the floor is the price of its right-hand
+side, events and output.
 
 Run ``python benchmarks/floor.py``: it prints, for the paper's Fig. 10 case (one slider,
-7 modal coordinates), the kernel's cost per accepted step without output and with the
+7 modal coordinates), the core's cost per accepted step without output and with the
 10 kHz output, each as a ratio to both floors measured in the same run; then the cost per
 step at 7 to 23 modal coordinates against the floors, and at 1 to 8 sliders beside the
 floors of the same sliders (each as a ratio to one slider's), each with its
 least-squares slope and the largest deviation from that line. Each slider count's cost
 is also given as a ratio to its own structured floor, and that ratio relative to one
-slider's (the growth of the kernel over the growth of its floor). The sliders' runs are
+slider's (the growth of the core over the growth of its floor). The sliders' runs are
 timed in turns with their floors (runs without output), the fastest of ``--rounds``
 rounds, by the wall time or with ``--cpu-time`` by the CPU time; ``--only PART`` prints
-one part.
+one part. The flags measured are the build's: -O3, no -march=native, no FMA contraction
+(``CMakeLists.txt``).
 """
 
 from __future__ import annotations
@@ -28,86 +31,20 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from numba import njit
+from fivdisc.core._core import floor_dopri_linear
 
-from fivdisc.core.dopri5 import A, E
-from fivdisc.core.dynamics import complex_step_jacobian
-
-# The kernel's own step-control constants: the floor must take the steps the kernel would
-# (its PI controller below repeats the kernel's lines on purpose, without events).
-from fivdisc.core.integrate import _BETA, _EXPO1
+from fivdisc import core
 from fivdisc.model.layout import SEPARATION, SLIP
 
 
-@njit(cache=True)
-def _apply(op, y, out):
-    """``out = B y + U^T (V y)``: ``B`` in CSR form, ``U``, ``V`` of shape (rank, n)."""
-    indptr, indices, data, u, v = op
-    for i in range(y.shape[0]):
-        acc = 0.0
-        for p in range(indptr[i], indptr[i + 1]):
-            acc += data[p] * y[indices[p]]
-        out[i] = acc
-    for r in range(u.shape[0]):
-        s = 0.0
-        for i in range(y.shape[0]):
-            s += v[r, i] * y[i]
-        for i in range(y.shape[0]):
-            out[i] += u[r, i] * s
-
-
-@njit(cache=True)
 def _dopri_linear(op, y, t_final, rtol, atol):
-    """DOPRI5 with the kernel's PI control on y' = J y (J applied by ``_apply``);
-    returns accepted steps."""
-    ns = y.shape[0]
-    k = np.zeros((7, ns))
-    ytmp = np.empty(ns)
-    err_vec = np.empty(ns)
-    _apply(op, y, k[0])
-    t = 0.0
-    h = 1e-6
-    err_old = 1e-4
-    steps = 0
-    after_reject = False
-    while t < t_final:
-        hs = min(h, t_final - t)
-        for st in range(1, 7):
-            ytmp[:] = y
-            for j in range(st):
-                a = hs * A[st, j]
-                if a != 0.0:
-                    for i in range(ns):
-                        ytmp[i] += a * k[j, i]
-            _apply(op, ytmp, k[st])
-        err_vec[:] = 0.0
-        for st in range(7):
-            a = hs * E[st]
-            if a != 0.0:
-                for i in range(ns):
-                    err_vec[i] += a * k[st, i]
-        acc = 0.0
-        for i in range(ns):
-            sc = atol + rtol * max(abs(y[i]), abs(ytmp[i]))
-            acc += (err_vec[i] / sc) ** 2
-        err = np.sqrt(acc / ns)
-        if err > 1.0:
-            h = hs / min(5.0, err**_EXPO1 / 0.9)
-            after_reject = True
-            continue
-        steps += 1
-        pi = err**_EXPO1 / err_old**_BETA if err > 0.0 else 0.0
-        fac = min(5.0, max(0.1, 0.9 / pi)) if pi > 0.0 else 5.0
-        err_old = max(err, 1e-4)
-        if after_reject:
-            fac = min(fac, 1.0)
-        after_reject = False
-        y[:] = ytmp
-        for i in range(ns):
-            k[0, i] = k[6, i]
-        t += hs
-        h = hs * fac
-    return steps
+    """Accepted steps of DOPRI5 with the core's PI control on y' = J y (J as ``op``:
+    CSR arrays and the low-rank factors)."""
+    indptr, indices, data, u, v = op
+    return floor_dopri_linear(indptr.astype(np.int64), indices.astype(np.int64),
+                              np.ascontiguousarray(data, dtype=float),
+                              np.ascontiguousarray(u), np.ascontiguousarray(v),
+                              np.ascontiguousarray(y, dtype=float), t_final, rtol, atol)
 
 
 def _operators(model) -> dict[str, tuple]:
@@ -124,13 +61,13 @@ def _operators(model) -> dict[str, tuple]:
     y[: model.n] = 1e-6
     for j in range(n_s):
         y[model.index("phi_dot", j)] = 1.0
-    jac = complex_step_jacobian(0.0, y, ph, sg, model.kernel_args)
+    cm = core.core_model(model)
+    jac = core.jacobian(cm, 0.0, y, ph, sg)
     # The sliders' own z, zdot are held in contact; keep them so (zero rows).
     for j in range(n_s):
         jac[model.index("z", j)] = 0.0
         jac[model.index("z_dot", j)] = 0.0
-    free = complex_step_jacobian(0.0, y, np.full(n_s, SEPARATION, dtype=np.int64), sg,
-                                 model.kernel_args)
+    free = core.jacobian(cm, 0.0, y, np.full(n_s, SEPARATION, dtype=np.int64), sg)
     u, sv, vt = np.linalg.svd(jac - free)
     rank = int(np.sum(sv > 1e-12 * sv[0]))
     b = sp.csr_matrix(free)
@@ -242,13 +179,13 @@ def _floor_once(op, start, duration: float, clock) -> float:
 
 
 def _kernel_once(model, y0, duration: float, clock) -> float:
-    """Time per accepted step [s] of the kernel's run without output by ``clock``."""
+    """Time per accepted step [s] of the core's run without output by ``clock``."""
     from fivdisc.engine.integration import Integration
 
     run = Integration(model, y0, duration=duration)
     t0 = clock()
     run.run_to(duration)
-    return (clock() - t0) / int(run.ist[1])
+    return (clock() - t0) / run.stats["steps"]
 
 
 def sliders(rounds: int, clock) -> None:

@@ -4,7 +4,8 @@ side by side with the working tree in one benchmark run.
 ``run_previous(commit, code)`` builds (once, cached under ``~/.cache/fivdisc-bench``) a
 virtual environment with fivdisc installed from ``git archive COMMIT`` of this repository,
 then runs ``code`` with that environment's Python and returns its standard output. The
-first call takes a minute or two (install, then numba's compilation on first use).
+first call takes a minute or two (the install; for a commit whose kernel was numba, also
+numba's compilation on first use).
 
 ``source_tree(commit)`` only unpacks the commit's ``src`` (cached in the same place), for
 the benchmarks of whole processes (start-up, first use), which run it with the same
@@ -27,6 +28,9 @@ CACHE = Path(os.environ.get("FIVDISC_BENCH_CACHE", Path.home() / ".cache" / "fiv
 # main before the model family (several sliders, damping, friction laws) landed: the
 # kernel the single-slider figures are compared against.
 BEFORE_FAMILY = "ba8c35d"
+# The last kernel in numba (issue 37 ported it to the compiled C++ core): main before the
+# layer folders; the numba kernel was only moved after it.
+LAST_NUMBA = "a96e870"
 
 
 def _resolve(commit: str) -> str:

@@ -31,15 +31,15 @@ HERE = Path(__file__).resolve().parent
 RUNS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("floor.py", ()),
     ("floor.py", ("--only", "sliders", "--cpu-time")),
+    ("bench_core.py", ()),
     ("bench_family.py", ()),
     ("bench_tangent.py", ("--cpu-time", "--span", "2", "--rounds", "21")),
     ("bench_sweep.py", ()),
     ("bench_store.py", ()),
     ("bench_continuation.py", ("--rounds", "2")),
     ("bench_stability_boundary.py", ()),
-    ("bench_compile.py", ()),
-    ("bench_first_use.py", ("--baseline", "9d68a9a")),
-    ("bench_startup.py", ("--repeat", "7", "--baseline", "e16250d", "--reference")),
+    ("bench_first_use.py", ()),
+    ("bench_startup.py", ("--repeat", "7", "--baseline", "a96e870", "--reference")),
 )
 
 

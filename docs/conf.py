@@ -29,8 +29,7 @@ myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
 
 # Tutorials are executed on every build, in a temporary directory, so that they are
-# tested; a failing cell fails the build. The timeout covers the one-off compilation of
-# the kernel in a fresh installation.
+# tested; a failing cell fails the build.
 nb_execution_mode = "force"
 nb_kernel_rgx_aliases = {".*": "fivdisc-docs"}
 nb_execution_raise_on_error = True

@@ -23,8 +23,6 @@ line start without scipy, xarray or matplotlib. The API is listed once, in ``_AP
 each module with the names it gives ``fivdisc``.
 """
 
-from importlib.metadata import version
-
 from fivdisc._lazy import public
 
 _API = {
@@ -56,5 +54,11 @@ _API = {
     "fivdisc.continuation.branch": ("Branch", "open_branch"),
 }
 
-__all__, __getattr__, __dir__ = public(globals(), _API,
-                                       computed={"__version__": lambda: version("fivdisc")})
+
+def _version() -> str:
+    from importlib.metadata import version
+
+    return version("fivdisc")
+
+
+__all__, __getattr__, __dir__ = public(globals(), _API, computed={"__version__": _version})

@@ -245,15 +245,15 @@ def test_hopf_eigenvector_in_the_full_layout_on_a_flexible_disc():
     the eigenvector solves J v = lambda v on every free row of the full Jacobian, and its
     z rows are the change of the disc's w under the slider (from the plate's mode shapes,
     independent of the kernel)."""
+    from fivdisc import core
     from fivdisc.case import load_case
-    from fivdisc.core import dynamics as dyn
     from fivdisc.engine.equilibrium import slip_phases
 
     case = load_case(path("fig03a"))
     hp = hopf_points(case, "slider.rotational_damping", np.linspace(0.0, 3.0, 16))[0]
     model = build_model(hp.case)
     ph, sg = slip_phases(model)
-    jac = dyn.complex_step_jacobian(0.0, hp.state, ph, sg, model.kernel_args)
+    jac = core.jacobian(core.core_model(model), 0.0, hp.state, ph, sg)
     n, free = model.n, np.r_[0 : model.n + 1, model.n + 2 : 2 * model.n + 3]
     residual = jac[np.ix_(free, free)] @ hp.eigenvector[free] - hp.eigenvalue * hp.eigenvector[free]
     # Complex-step Jacobian exact to round-off: residual ~ eps |J| |v|.

@@ -14,7 +14,7 @@ from fivdisc.analysis.exponents import lyapunov
 from fivdisc.analysis.orbits import periodic_orbit
 from fivdisc.analysis.stability import linear_stability
 from fivdisc.case import Case
-from fivdisc.core import dynamics as dyn
+from fivdisc.core import core_model, jacobian
 from fivdisc.errors import FivdiscError
 from fivdisc.model.build import build_model
 
@@ -97,8 +97,8 @@ def test_sum_of_all_exponents_is_the_mean_divergence():
     trace = np.empty(nt)
     for i in range(nt):
         sign = 1 if 1.0 - states[i, model.index("phi_dot")] > 0 else -1
-        jac = dyn.complex_step_jacobian(float(ds.time[i]), states[i].copy(), np.array([0]),
-                                        np.array([sign]), model.kernel_args)
+        jac = jacobian(core_model(model), float(ds.time[i]), states[i].copy(),
+                       np.array([0]), np.array([sign]))
         trace[i] = np.trace(jac[np.ix_(free, free)])
     integral = simpson(trace, x=ds.time.values)
     assert ds.time.values[-1] == pytest.approx(duration, abs=1e-12)
@@ -160,9 +160,8 @@ def test_sum_of_all_exponents_adds_the_saltation_determinants():
         times = np.linspace(a, b, 601)
         trace = np.empty(times.size)
         for i, t in enumerate(times):
-            jac = dyn.complex_step_jacobian(float(t), kernel_state(seg.sol(t)), np.array([0]),
-                                            np.array([int(seg.signs[0])]),
-                                            model.kernel_args)
+            jac = jacobian(core_model(model), float(t), kernel_state(seg.sol(t)),
+                           np.array([0]), np.array([int(seg.signs[0])]))
             trace[i] = np.trace(jac[np.ix_(free, free)])
         integral += simpson(trace, x=times)
     jumps = 0.0

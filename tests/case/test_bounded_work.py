@@ -108,7 +108,7 @@ def test_runs_that_cannot_fit_in_memory_are_refused(tmp_path: Path, simulation: 
 
 def test_the_memory_estimate_bounds_a_run_and_is_not_far_above_it() -> None:
     case = Case(simulation={"duration": 2.0, "output_rate": 20000.0})
-    simulate(case.replace({"simulation.duration": 0.01}))  # compile outside the measurement
+    simulate(case.replace({"simulation.duration": 0.01}))  # imports outside the measurement
     tracemalloc.start()
     try:
         simulate(case)

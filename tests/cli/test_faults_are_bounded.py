@@ -193,7 +193,7 @@ def test_sigint_stops_a_run_within_a_second_and_keeps_it() -> None:
 def test_accumulating_switches_end_as_zeno_naming_the_sliders() -> None:
     """Switches whose spacings interleave tiny and longer ones escape the test of 1000 in
     a row under 1e-10 s; the rate test (10,000 within 1e-5 s) takes them."""
-    from fivdisc.core import slots
+    from fivdisc import core
     from fivdisc.engine.integration import ZENO_RATE_COUNT, ZENO_RATE_SPAN, Integration
     from fivdisc.engine.simulation import initial_state
     from fivdisc.model.build import build_model
@@ -204,8 +204,8 @@ def test_accumulating_switches_end_as_zeno_naming_the_sliders() -> None:
     # never two tiny ones in a row; sliders 0 and 2 take turns.
     gaps = np.where(np.arange(ZENO_RATE_COUNT) % 2, 1.5e-9, 1e-12)
     times = 0.3 + np.cumsum(gaps)
-    rows = np.zeros((times.size, slots.N_EVI), dtype=np.int64)
-    rows[:, slots.EVI_SLIDER] = np.where(np.arange(times.size) % 2, 0, 2)
+    rows = np.zeros((times.size, core.N_EVI), dtype=np.int64)
+    rows[:, core.EVI_SLIDER] = np.where(np.arange(times.size) % 2, 0, 2)
     assert times[-1] - times[0] < ZENO_RATE_SPAN
     run.ev_times.append(times)
     run.ev_rows.append(rows)
@@ -281,15 +281,9 @@ DIVERGING = [
 @pytest.mark.parametrize(("tables", "word"), DIVERGING, ids=["printed sign", "1e4 rad/s"])
 def test_lyapunov_of_a_diverging_run_is_refused(tables, word, tmp_path: Path) -> None:
     """simulate calls the run diverged; lyapunov must not print an exponent for it, and
-    says so as soon as the transient leaves the model's range. The tangent vectors are
-    carried from the start (they align over the transient), so a fresh installation
-    compiles the kernel with tangents first: loaded here, so that the bound is on the
-    refusal (`benchmarks/bench_first_use.py` times the compilation)."""
-    from fivdisc.analysis.exponents import warm_tangent_kernel
-
+    says so as soon as the transient leaves the model's range."""
     case = Case(**tables)
     assert simulate(case).status == "diverged"
-    warm_tangent_kernel()
     path = tmp_path / "c.toml"
     case.save(path)
     result, wall = cli_run(["lyapunov", str(path), "--no-progress"])

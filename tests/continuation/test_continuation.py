@@ -398,7 +398,7 @@ def _graze_run(phi0: float, max_step: float = 0.0):
                       phases=np.array([lay.STICK]))
     run.run_to(_GRAZE_SPAN)
     times, _ = run.events()
-    return times, run.out_y[1, : model.state_size], int(run.ist[1])
+    return times, run.out_y[1, : model.state_size], run.stats["steps"]
 
 
 def test_a_switch_inside_one_step_is_found():

@@ -205,33 +205,6 @@ def test_continue_from_hopf_on_the_command_line(tmp_path):
     assert "--from-hopf = '0.5:30' is invalid" in bad.output
 
 
-@pytest.mark.parametrize("start", ["hopf", "file"])
-def test_continue_announces_the_tangent_kernel_compiling(tmp_path, monkeypatch, start):
-    """Issue 27, item 3: a fresh installation's first `fivdisc continue --from-hopf` (or
-    `--from FILE`) compiles the kernel with tangent vectors, minutes on a loaded machine;
-    it ran 4 min 42 s without a word, since only `periodic_orbit`'s own search said
-    so. Both starts now say it once, as `fivdisc orbit` does."""
-
-    from fivdisc.engine import compilation
-
-    case = tmp_path / "rigid.toml"
-    case.write_text(CASE.to_toml())
-    args = ["--key", "speed.value", "--to", "30", "--points", "2"]
-    if start == "file":
-        first = run_cli(["continue", str(case), *args, "--from-hopf",
-                                         "0.5:30:25", "-o", str(tmp_path / "b.nc")])
-        assert first.exit_code == 0, first.output
-        args = ["--from", str(tmp_path / "b.nc"), *args]
-    else:
-        args = [str(case), *args, "--from-hopf", "0.5:30:25"]
-    monkeypatch.setattr(compilation, "_announced", set())
-    monkeypatch.setattr(compilation, "needs_compiling", lambda dispatcher: True)
-    monkeypatch.setattr("fivdisc.engine.split_compile._cores", lambda: 1)
-    run = run_cli(["continue", *args])
-    assert run.exit_code == 0, run.output
-    assert run.stderr.count("compiling the kernel with tangent vectors, once") == 1
-
-
 def test_the_bistable_range_ends_at_the_located_fold():
     """Subcritical orbits that turn stable at a fold of cycles: the range of stable
     sliding beside a stable vibration ends at the fold, located to 1e-6 relative, not at

@@ -188,14 +188,14 @@ def test_tangent_linear_rhs_equals_the_complex_step(friction):
     right-hand side; the complex step of the right-hand side itself is its independent
     reference (both exact to rounding). Random states and directions, every phase and
     slip sign, a damped disc with doublets, the bottom face, a decelerating disc."""
-    from fivdisc.core import dynamics as dyn
+    from fivdisc import core
 
     fr = {"law": "exponential"} | friction
     case = Case(disc={"modes": [[0, 0], [0, 2], [1, 1]], "damping_ratio": 0.01},
                 slider={"face": "bottom", "angle": 0.4}, friction=fr,
                 speed={"profile": "decelerating", "initial": 6.0, "duration": 10.0})
     model = build_model(case)
-    mdl = model.kernel_args
+    cm = core.core_model(model)
     rng = np.random.default_rng(3)
     nd = model.state_size
     for phase, sign in ((lay.SLIP, 1), (lay.SLIP, -1), (lay.STICK, 1), (lay.SEPARATION, 1)):
@@ -205,9 +205,6 @@ def test_tangent_linear_rhs_equals_the_complex_step(friction):
             v = rng.standard_normal(nd)
             ph, sg = np.array([phase]), np.array([sign])
             t = float(rng.uniform(0.0, 5.0))
-            wk = dyn.new_work(mdl, y)
-            dyn.evaluate(t, y, ph, sg, True, mdl, wk, np.empty(nd))
-            fast = np.empty(nd)
-            dyn.linearised_one(y, v, ph, sg, mdl, wk, fast)
-            ref = dyn.complex_step_jacobian(t, y, ph, sg, mdl) @ v
+            fast = core.jvp(cm, t, y, v, ph, sg, True, "linear")
+            ref = core.jacobian(cm, t, y, ph, sg) @ v
             assert np.max(np.abs(fast - ref)) <= 1e-12 * np.max(np.abs(ref)), (phase, sign)

@@ -30,7 +30,7 @@ def test_a_bar_only_on_a_terminal(monkeypatch, stream, show, shown):
 
 
 def test_simulate_shows_simulated_time_on_a_terminal(monkeypatch):
-    simulate(Case(simulation={"duration": 0.01}))  # compiled or loaded before, quietly
+    simulate(Case(simulation={"duration": 0.01}))  # imports done before, quietly
     err = _Terminal()
     monkeypatch.setattr(sys, "stderr", err)
     simulate(Case(simulation={"duration": 0.02}), progress=True)

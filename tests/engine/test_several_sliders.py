@@ -12,8 +12,7 @@ from scipy.interpolate import PchipInterpolator
 
 import fivdisc
 from fivdisc.case import Case, load_case
-from fivdisc.core import dynamics as dyn
-from fivdisc.core.impact import solve_lcp
+from fivdisc.core import core_model, jacobian, kinetic_friction, solve_lcp
 from fivdisc.engine.simulation import simulate
 from fivdisc.examples import DIRECTORY as EXAMPLES
 from fivdisc.model import layout as lay
@@ -79,9 +78,8 @@ def _free_disc_eigenvalues(case: Case, speed: float) -> tuple[np.ndarray, object
     """Eigenvalues of the disc's own equations: the slider flies (phase separation), so
     the disc block of the Jacobian is decoupled from it."""
     model = build_model(case.replace({"speed.value": speed}))
-    mdl = model.kernel_args
     y = np.zeros(model.state_size)
-    jac = dyn.complex_step_jacobian(0.0, y, np.array([lay.SEPARATION]), np.array([1]), mdl)
+    jac = jacobian(core_model(model), 0.0, y, np.array([lay.SEPARATION]), np.array([1]))
     n = model.n
     idx = np.r_[0:n, n + 2 : 2 * n + 2]
     return np.linalg.eigvals(jac[np.ix_(idx, idx)]), model
@@ -224,10 +222,10 @@ def test_table_law_reproduces_the_law_it_samples():
 def test_kernel_friction_law_matches_its_formula(law):
     """The compiled law against a direct evaluation (scipy PCHIP for the table)."""
     case = Case(friction={"static": 0.8, **law})
-    mdl = build_model(case).kernel_args
+    cm = core_model(build_model(case))
     u = np.linspace(0.0, 1.5, 301)
     r = 0.1
-    got = np.array([dyn.kinetic_friction(mdl.opts, mdl.table, r, 1, ui / r) for ui in u])
+    got = np.array([kinetic_friction(cm, r, 1, ui / r) for ui in u])
     if law["law"] == "stribeck":
         want = 0.35 + 0.25 * np.exp(-(u / 0.3) ** 2.0) + 0.1 * u
     else:
@@ -281,8 +279,7 @@ def test_impact_lcp_is_solved_exactly():
         dmat = a @ a.T + 0.1 * np.eye(m)
         gam = np.zeros(m)
         gam[0] = -abs(rng.normal()) - 0.1
-        lam = np.empty(m)
-        w = solve_lcp(dmat, gam, np.zeros(m, np.bool_), lam, m)
+        w, lam = solve_lcp(dmat, gam, np.zeros(m, np.bool_))
         lam_ref, w_ref = _lcp_by_enumeration(dmat, gam)
         np.testing.assert_allclose(lam, lam_ref, atol=1e-12)
         np.testing.assert_allclose(w, w_ref, atol=1e-12)
@@ -295,10 +292,9 @@ def test_forced_contacts_stay_closed():
     """A bilateral (forced) contact keeps zero gap velocity even when it needs a pull."""
     dmat = np.array([[2.0, 1.5], [1.5, 2.0]])
     gam = np.array([-1.0, 0.0])
-    lam = np.empty(2)
-    w = solve_lcp(dmat, gam, np.array([False, False]), lam, 2)
+    w, lam = solve_lcp(dmat, gam, np.array([False, False]))
     assert lam[1] == 0.0 and w[1] > 0.0
-    w = solve_lcp(dmat, gam, np.array([False, True]), lam, 2)
+    w, lam = solve_lcp(dmat, gam, np.array([False, True]))
     assert w[1] == 0.0 and lam[1] < 0.0
 
 

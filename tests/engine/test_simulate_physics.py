@@ -6,9 +6,7 @@ import numpy as np
 import pytest
 
 from fivdisc.case import Case
-from fivdisc.core import dynamics as dyn
-from fivdisc.core.impact import single_impact
-from fivdisc.core.sizes import work_rows
+from fivdisc.core import core_model, evaluate, single_impact
 from fivdisc.engine.equilibrium import sliding_equilibrium
 from fivdisc.engine.result import select_slider
 from fivdisc.engine.simulation import simulate
@@ -97,9 +95,8 @@ def test_impact_map_equal_velocities_and_energy_loss():
     model = build_model(Case())
     n, omega = model.n, 2 * np.pi
     rng = np.random.default_rng(7)
-    mdl = model.kernel_args
-    dy = np.empty(model.state_size)
-    flying = np.array([dyn.SEPARATION])
+    cm = core_model(model)
+    flying = np.array([lay.SEPARATION])
     sign = np.array([1])
     for trial in range(50):
         y = np.zeros(model.state_size)
@@ -108,21 +105,19 @@ def test_impact_map_equal_velocities_and_energy_loss():
         y[n] = rng.uniform(-0.5, 0.5)
         # Half the trials with the slider moving with the disc (v = 0).
         y[2 * n + 2] = omega if trial % 2 else rng.uniform(0, 2 * omega)
-        work = dyn.new_work(mdl, y)
-        aux = work_rows(1)[3]
-        dyn.evaluate(0.0, y, flying, sign, True, mdl, work, dy)
-        y[n + 1] = work[aux + lay.A_WC, 0]
+        _, aux = evaluate(cm, 0.0, y, flying, sign)
+        y[n + 1] = aux["w"][0]
         # Slider approaching the disc surface.
-        y[-1] = work[aux + lay.A_WCD, 0] - abs(rng.normal(0, 0.5))
+        y[-1] = aux["w_rate"][0] - abs(rng.normal(0, 0.5))
         before = y.copy()
-        single_impact(0, y, mdl, work)
-        dyn.evaluate(0.0, y, flying, sign, True, mdl, work, dy)
-        assert y[-1] == pytest.approx(work[aux + lay.A_WCD, 0], abs=1e-12 * abs(before[-1]))
+        y = single_impact(cm, y, 0)
+        _, aux = evaluate(cm, 0.0, y, flying, sign)
+        assert y[-1] == pytest.approx(aux["w_rate"][0], abs=1e-12 * abs(before[-1]))
         # Classical plastic-impact loss: u^2 / (2 K), K = 1/m + sum g^2/M, with u the
         # approach velocity; the normal impulse p on a surface sloped by g'.q that slides
         # at v = Omega - phidot under the slider also does work -p v (g'.q).
-        g, gp = work[0, :n], work[1, :n]
-        m = mdl.slider[lay.S_MASS, 0]
+        g, gp = aux["g"][0], aux["g_prime"][0]
+        m = model.kernel.slider[lay.S_MASS, 0]
         kk = 1 / m + np.sum(g**2 / model.modal_mass)
         u = before[-1] - (g @ before[n + 2 : 2 * n + 2] + before[2 * n + 2] * (gp @ before[:n]))
         p = -u / kk

@@ -511,6 +511,13 @@ def test_stored_modes_are_the_solved_ones_to_the_last_bit(monkeypatch, tmp_path)
     stored = tmp_path / "fivdisc-plate-modes.json"
     assert len(json.loads(stored.read_text())["modes"]) == 12
     assert modes() == solved  # read back: the same numbers
+    # Their values at a model's radii (sliders, probes) too, stored by the first call.
+    plate = AnnularPlate(A, B, 0.002, 7800.0, 200e9, NU)
+    radii = np.array([A, 0.1, B])
+    computed = [plate.mode(k, 2).shape(radii, d) for k in range(3) for d in (0, 1)]
+    monkeypatch.setattr(plate_cache, "_modes", None)
+    assert [plate.mode(k, 2).shape(radii, d) for k in range(3) for d in (0, 1)] == [
+        pytest.approx(c, rel=0, abs=0) for c in computed]
     text = json.loads(stored.read_text())
     key = next(iter(text["modes"]))
     text["modes"][key][0] *= 1.5

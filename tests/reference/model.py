@@ -3,7 +3,7 @@
 This module is an *independent* implementation of the model stated in
 ``docs/model.md`` (the printed paper has errors; that page wins): S sliders on
 either face, disc damping and several friction laws.  It exists to check the package's fast
-(numba) simulator and to serve as the speed baseline of the benchmarks.  It
+(compiled) simulator and to serve as the speed baseline of the benchmarks.  It
 deliberately shares no code with ``fivdisc.core`` or ``fivdisc.simulate``:
 it only takes modal data from ``fivdisc.model.plate`` and parameters from a case
 object (``fivdisc.case.Case`` or any object with the same attributes, e.g. a

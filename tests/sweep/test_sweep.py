@@ -525,7 +525,7 @@ def _start(sweep_file: Path, store: Path) -> subprocess.Popen:
 
 
 def _wait_for_points(process: subprocess.Popen, store: Path, count: int) -> None:
-    deadline = time.monotonic() + 180.0  # a cold numba cache takes ~30 s per worker
+    deadline = time.monotonic() + 180.0  # generous on a loaded machine
     while not (store.exists() and read_mask(store).sum() >= count):
         assert process.poll() is None, process.communicate()
         assert time.monotonic() < deadline, "the sweep made no progress"

@@ -70,7 +70,6 @@ def test_cluster_results_equal_the_local_pool(cluster, tmp_path) -> None:
     )
     assert result.exit_code == 0, result.output
     assert "6 points: 0 already stored, 6 computed" in result.output
-    assert "fivdisc-warm-kernel" in cluster.scheduler.worker_plugins
     data = open_sweep(store)
     # equal but for the history attribute: when each store was made
     xr.testing.assert_identical(data.assign_attrs(history=""),
@@ -174,7 +173,7 @@ def test_a_dying_cluster_ends_the_sweep_in_one_line_and_keeps_finished_points(
                          cwd=tmp_path)
         coordinator = _python("-m", "fivdisc", "sweep", "sweep.toml", "-o", str(store),
                               "--scheduler", address, "--no-progress", cwd=tmp_path)
-        deadline = time.monotonic() + 180.0  # a cold numba cache takes ~30 s per worker
+        deadline = time.monotonic() + 180.0  # generous on a loaded machine
         while not (store.exists() and read_mask(store).sum() >= 2):
             assert coordinator.poll() is None, coordinator.communicate()
             assert time.monotonic() < deadline, "the sweep made no progress"

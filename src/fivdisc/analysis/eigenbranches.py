@@ -27,7 +27,6 @@ from fivdisc.analysis.stability import mode_labels
 from fivdisc.case import Case
 from fivdisc.engine.equilibrium import Equilibrium, _evaluate
 from fivdisc.limits import check_memory
-from fivdisc.model import layout as lay
 from fivdisc.model.build import Model
 
 # Two branches' frequencies count as merged (a coupling) within this fraction of the
@@ -215,7 +214,7 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
         if labelled is None or abs(value - own) < abs(values[labelled[0]] - own):
             labelled = (i, model, jac)
         force[i], angle[i] = eq.normal_force, eq.phi
-        under[i] = _evaluate(model, eq.state)[1][lay.A_WC]
+        under[i] = _evaluate(model, eq.state)[1]["w"]
     if bar is not None:
         bar.close()
     lam = follow(lam)

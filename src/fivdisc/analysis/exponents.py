@@ -1,6 +1,6 @@
 """Lyapunov exponents of the non-smooth flow by the QR (Benettin) method.
 
-``n`` tangent vectors are carried with the state (:mod:`fivdisc.core.tangent`: the
+``n`` tangent vectors are carried with the state (:mod:`fivdisc.core`, ``tangent.hpp``: the
 variational equations inside each phase, saltation matrices at every switch) and
 re-orthonormalised every ``interval`` seconds: ``V = Q R``; the logarithms of ``|R_ii|``
 summed over the measurement and divided by its length are the exponents, largest first.
@@ -331,8 +331,7 @@ def lyapunov(
         Seed of the random tangent vectors at the start of the transient.
     progress : bool
         Show a progress bar in simulated time over the transient and the measurement (on
-        a terminal), and a notice when the kernel with tangent vectors compiles (first
-        use).
+        a terminal).
 
     Returns
     -------
@@ -457,7 +456,6 @@ def lyapunov(
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise FivdiscError(f"n = {n!r} is invalid: must be an integer >= 1")
     from fivdisc.engine.simulation import Deflection, initial_state
-    from fivdisc.engine.split_compile import compile_split
 
     model = build_model(case)
     check_steps(model, transient + duration, "transient + duration")
@@ -472,9 +470,6 @@ def lyapunov(
         cap = min(cap, sim.max_step)
     run = Integration(model, initial_state(model, initial), duration=transient + duration,
                       rtol=rtol, atol=atol, max_step=cap)
-    # The kernel's first compilation, if it is one, on two cores; the one with tangents,
-    # needed next, begins meanwhile.
-    compile_split(run, tangents=True)
     run.advance(0.0)
     # The phases at the start are chosen by the first advance.
     free = run.free()
@@ -501,8 +496,6 @@ def _measure(run: Integration, model: Model, limit: Any, free: np.ndarray, n: in
     """Align random tangent vectors over the transient, then measure the exponents over
     `duration`, with `bar` counting both."""
     from fivdisc.analysis.orbits import energy_scales
-    from fivdisc.engine.compilation import tangent_notice
-    from fivdisc.engine.split_compile import compile_split_tangents
 
     sc = energy_scales(model)
     rng = np.random.default_rng(seed)
@@ -511,13 +504,9 @@ def _measure(run: Integration, model: Model, limit: Any, free: np.ndarray, n: in
                    for _ in range(starts)])
     aligning = transient > 0
     t0 = run.t
-    # The first interval compiles the kernel with tangents in a fresh installation; it
-    # is the transient's first, or without a transient the measurement's.
-    with tangent_notice(show=progress or None):
-        compile_split_tangents()
-        run.set_tangents((q * sc[:, None]).T)
-        first = _interval(run, limit, min(interval, transient if aligning else duration), sc,
-                          starts, "the transient" if aligning else "the measurement")
+    run.set_tangents((q * sc[:, None]).T)
+    first = _interval(run, limit, min(interval, transient if aligning else duration), sc,
+                      starts, "the transient" if aligning else "the measurement")
     bar.update(run.t - bar.n)
     # Alignment: the vectors are carried through the transient and re-orthonormalised as
     # in the measurement, their stretching discarded, so that the measurement starts from
@@ -600,19 +589,3 @@ def _check(run: Integration, limit, what: str) -> None:
         raise FivdiscError(f"lyapunov: the run ended with {run.status_name} at "
                            f"t = {run.t:.9g} s during {what}")
 
-
-def warm_tangent_kernel(show: bool = False) -> None:
-    """Compile or load the kernel with tangent vectors now, with an exponent over 1 ms
-    of simulated time (a sweep computing exponents does it before its workers start,
-    ``fivdisc warmup`` with every kernel).
-
-    Parameters
-    ----------
-    show
-        Print the notice of :func:`fivdisc.engine.compilation.tangent_notice` if it compiles.
-    """
-    from fivdisc.engine.compilation import tangent_notice
-
-    with tangent_notice(show=show):
-        lyapunov(Case(simulation={"duration": 1e-3}), transient=0.0, duration=1e-3,
-                 interval=1e-3)

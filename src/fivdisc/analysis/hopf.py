@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
+from fivdisc import core
 from fivdisc.analysis.normalform import first_lyapunov
 from fivdisc.analysis.points import (
     ParameterPoints,
@@ -29,10 +30,8 @@ from fivdisc.analysis.points import (
     slip_jacobian,
 )
 from fivdisc.case import Case
-from fivdisc.core import tangent as tan
 from fivdisc.engine.equilibrium import Equilibrium, _evaluate, sliding_equilibrium, slip_phases
 from fivdisc.errors import AnalysisError, SimulationError
-from fivdisc.model import layout as lay
 from fivdisc.model.build import Model
 
 # Relative tolerance of the located value of the key (Brent's method; the growth rate is
@@ -177,15 +176,14 @@ def _full_layout(model: Model, eq: Equilibrium, vector: np.ndarray
     """Equilibrium and eigenvector (reduced variables) in the kernel's full layout, the
     sliders' z, zdot filled in from the disc under them."""
     ph, sg = slip_phases(model)
-    kern = model.kernel_args
     idx = reduced_indices(model)
     full = np.zeros((2, model.state_size))
     full[0, idx], full[1, idx] = vector.real, vector.imag
-    full = tan.unslaved(0.0, eq.state, ph, sg, kern, full)
+    full = core.unslaved(core.core_model(model), 0.0, eq.state, ph, sg, full)
     state = eq.state.copy()
     # The slaved rows of the equilibrium itself: z = w under the slider (zdot = 0).
     _, aux = _evaluate(model, state)
-    state[model.n + model.n_sliders + np.arange(model.n_sliders)] = aux[lay.A_WC]
+    state[model.n + model.n_sliders + np.arange(model.n_sliders)] = aux["w"]
     vec = full[0] + 1j * full[1]
     vec /= np.linalg.norm(vec)
     big = np.argmax(np.abs(vec))

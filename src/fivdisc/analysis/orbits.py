@@ -5,7 +5,7 @@ coordinates of a point x0 on it and T; the equations are ``phi_T(x0) - x0 = 0`` 
 phase condition ``f(x0_ref) . (x0 - x0_ref) = 0`` (the correction is orthogonal to the
 flow, which removes the freedom to slide x0 along the orbit). Newton's method uses the
 monodromy matrix ``M = d phi_T / d x0``, carried exactly across every switch by the
-saltation matrices (:mod:`fivdisc.core.tangent`), and ``d phi_T / dT = f(phi_T(x0))``.
+saltation matrices (:mod:`fivdisc.core`, ``tangent.hpp``), and ``d phi_T / dT = f(phi_T(x0))``.
 
 A converged orbit is reduced to its minimal period: an orbit of period T is also a fixed
 point of the flow over 2T, 3T, ..., so a first guess near a multiple of the period
@@ -589,8 +589,7 @@ def periodic_orbit(
         Where `guess` comes from, kept in the orbit's ``start`` (default: "from the
         given state", or the transient run's description).
     progress : bool
-        Show the Newton iterations and their residual on a terminal (stderr), and say
-        so when the kernel with tangent vectors compiles (first use).
+        Show the Newton iterations and their residual on a terminal (stderr).
 
     Returns
     -------
@@ -666,7 +665,6 @@ def periodic_orbit(
     if model.n_sliders == 0 or model.state_size == 0:
         raise FivdiscError("periodic_orbit needs a case with a slider")
     from fivdisc.engine.simulation import initial_state
-    from fivdisc.engine.split_compile import compile_split
 
     atol_run = atol if atol is not None else rtol * 1e-7
     if guess is None:
@@ -674,9 +672,6 @@ def periodic_orbit(
         duration = case.simulation.duration if transient is None else transient
         _positive("transient", duration, "s")
         run = Integration(model, y0, duration=duration, rtol=rtol, atol=atol_run)
-        # The kernel's first compilation, if it is one, on two cores; the one with
-        # tangents, needed next, begins meanwhile.
-        compile_split(run, tangents=True)
         run.run_to(duration, notice=LongRunNotice(model, duration, "the transient run",
                                                   "a shorter transient takes less"))
         if run.status_name != "success":
@@ -712,13 +707,9 @@ def periodic_orbit(
     shooting = Shooting(model, phases, rtol, atol_run)
     deadline = time.monotonic() + time_budget
 
-    from fivdisc.engine.compilation import tangent_notice
     from fivdisc.engine.progress import progress_bar
-    from fivdisc.engine.split_compile import compile_split_tangents
 
-    with tangent_notice(show=progress or None):
-        compile_split_tangents()
-        shooting.shoot(x0, min(period, 1e-6), tangents=True)
+    shooting.shoot(x0, min(period, 1e-6), tangents=True)  # the tangents' set-up
     _announce_shots(shooting, x0, period, time_budget)
     # A shot stops at the budget (with many sliders one takes minutes), with some room
     # left for the minimal period's and the multipliers' work after the iteration.

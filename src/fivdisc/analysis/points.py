@@ -15,8 +15,8 @@ from functools import cache
 
 import numpy as np
 
+from fivdisc import core
 from fivdisc.case import Case
-from fivdisc.core import dynamics as dyn
 from fivdisc.engine.equilibrium import Equilibrium, sliding_equilibrium, slip_phases
 from fivdisc.errors import AnalysisError, CaseError, SimulationError
 from fivdisc.limits import duration_words
@@ -136,7 +136,7 @@ def slip_jacobian(model: Model, state: np.ndarray) -> np.ndarray:
     """Exact (complex-step) Jacobian of the slip equations (s = +1 for every slider) at
     ``state``, in the variables ``(q, phi, qdot, phidot)``."""
     ph, sg = slip_phases(model)
-    jac = dyn.complex_step_jacobian(0.0, state, ph, sg, model.kernel_args)
+    jac = core.jacobian(core.core_model(model), 0.0, state, ph, sg)
     idx = reduced_indices(model)
     return jac[idx][:, idx]
 

@@ -84,9 +84,6 @@ class _Group(click.Group):
 @click.version_option(package_name="fivdisc")
 def cli() -> None:
     """fivdisc: friction-induced vibration of a slider on a spinning elastic disc."""
-    from fivdisc.engine.compilation import announce_by_default
-
-    announce_by_default()  # every command says when it compiles a kernel
 
 
 def _register() -> None:
@@ -123,7 +120,7 @@ _register()
 
 def main() -> None:
     """Console-script entry point."""
-    # A command imports numba, xarray and the netCDF engine as it goes: with the default
+    # A command imports scipy, xarray and the netCDF engine as it goes: with the default
     # thresholds the collector runs hundreds of times over their objects meanwhile, a
     # noticeable part of a short command (``benchmarks/bench_startup.py`` times both).
     # Rarer collections still bound what cycles a long sweep leaves behind.

@@ -62,8 +62,7 @@ _SEARCH_OPTIONS = ("--period", "--transient", "the search window", "--rtol")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               help="Write the branch to a netCDF file (.nc), for fivdisc plot.")
 @click.option("--progress/--no-progress", default=True, show_default=True,
-              help="Show the Newton iterations and the points on a terminal. A kernel's "
-              "first compilation is announced either way.")
+              help="Show the Newton iterations and the points on a terminal.")
 def continuation(case_file: Path | None, key: str, target: float, back_to: float | None,
                  from_file: Path | None, which: int | None, hopf_spec: str | None,
                  points: int, step: float, max_step: float,

@@ -45,8 +45,7 @@ def _report(res, case, as_json: bool, out: Path | None) -> None:
               help="Print period, multipliers, verdict and residual as JSON.")
 @click.option("-o", "--output", type=_NC, help="Write the orbit to a netCDF file (.nc).")
 @click.option("--progress/--no-progress", default=True, show_default=True,
-              help="Show the Newton iterations on a terminal. A kernel's first compilation "
-              "is announced either way.")
+              help="Show the Newton iterations on a terminal.")
 def orbit(case_file: Path | None, period: float | None, transient: float | None,
           from_file: Path | None, window: float, rtol: float, as_json: bool,
           output: Path | None, progress: bool) -> None:

@@ -211,15 +211,8 @@ def run_walk(problem: OrbitProblem, first: Callable[[float], Point], to: float,
              back_to: float | None = None) -> Branch:
     """The first point (``first(deadline)``), then the walk to ``to`` (and, after a fold,
     back to ``back_to``, default the first point's value): the branch."""
-    from fivdisc.analysis.exponents import warm_tangent_kernel
     from fivdisc.engine.progress import progress_bar
-    from fivdisc.engine.split_compile import compile_split_tangents
 
-    # A start from a Hopf point or a saved orbit is the first use of the kernel with
-    # tangent vectors, minutes of compiling in a fresh installation: say so (as
-    # periodic_orbit does) before the first point, whose time it is not.
-    compile_split_tangents()
-    warm_tangent_kernel(show=progress or None)
     deadline = time.monotonic() + settings.time_budget
     walk = Walk()
     with progress_bar(settings.max_points, f"continuing in {problem.key}", "point",

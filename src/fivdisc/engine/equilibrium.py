@@ -1,8 +1,7 @@
 """Where a run starts: the sliding equilibrium at constant disc speed (paper section 3.1),
 for any number of sliders, and the initial state of a simulation.
 
-Both sit below the simulation driver, so that what compiles and starts runs
-(:mod:`fivdisc.engine.split_compile`, the driver, the analyses) can share them.
+Both sit below the simulation driver, so that the driver and the analyses can share them.
 """
 
 from __future__ import annotations
@@ -12,10 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fivdisc import core
 from fivdisc.case import Case
-from fivdisc.core import dynamics as dyn
-from fivdisc.core.sizes import work_rows
-from fivdisc.engine.compilation import compile_notice
 from fivdisc.errors import SimulationError
 from fivdisc.model import layout as lay
 from fivdisc.model.build import Model, build_model
@@ -72,14 +69,11 @@ def slip_phases(model: Model) -> tuple[np.ndarray, np.ndarray]:
     return np.full(ns, lay.SLIP, dtype=np.int64), np.ones(ns, dtype=np.int64)
 
 
-def _evaluate(model: Model, y: np.ndarray) -> tuple[np.ndarray, tuple]:
+def _evaluate(model: Model, y: np.ndarray) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The slip equations' right-hand side at ``y`` and the per-slider quantities of
+    :func:`fivdisc.core.evaluate` (``normal_force``, ``friction_force``, ``w``, ...)."""
     ph, sg = slip_phases(model)
-    mdl = model.kernel_args
-    wk = dyn.new_work(mdl, y)
-    dy = np.empty(model.state_size)
-    dyn.evaluate(0.0, y, ph, sg, True, mdl, wk, dy)
-    aux = work_rows(model.n_sliders)[3]
-    return dy, wk[aux : aux + lay.N_AUX, : model.n_sliders]
+    return core.evaluate(core.core_model(model), 0.0, y, ph, sg)
 
 
 def _unknowns(model: Model) -> np.ndarray:
@@ -162,59 +156,52 @@ def sliding_equilibrium(
         raise SimulationError(
             f"speed.value = {omega_c} has no sliding equilibrium: the disc must spin (> 0 rad/s)"
         )
-    # The first equilibrium of a fresh installation compiles the right-hand side (with
-    # the friction law and its complex-step Jacobian) that everything here calls.
-    with compile_notice((dyn.evaluate, dyn.complex_step_jacobian), show=None,
-                        what="right-hand side and its Jacobian"):
-        from fivdisc.engine.split_compile import compile_split_rhs
+    n, ns = model.n, model.n_sliders
+    kern = model.kernel_args
+    unknowns = _unknowns(model)
+    acc_index = unknowns + n + 2 * ns
+    radius, n0 = kern.row("radius"), kern.row("n0")
+    inertias = np.append(model.modal_mass, kern.row("inertia"))
+    # Rigid-disc guess: N = N0, friction balanced by the in-plane spring; the disc
+    # deflected statically by the preloads.
+    cm = core.core_model(model)
+    mu = np.array([core.kinetic_friction(cm, radius[j], 1, omega_c) for j in range(ns)])
+    with np.errstate(all="ignore"):
+        phi0 = radius * mu * n0 / kern.row("kphi")
+        stiff = model.modal_mass * (model.omega**2 - model.l**2 * omega_c**2)
+        q0 = np.zeros(n)
+        for j in range(ns):
+            psi = kern.row("theta")[j] + phi0[j]
+            g = (np.where(model.sgn > 0, np.cos(model.l * psi), np.sin(model.l * psi))
+                 * model.shape[j])
+            q0 -= kern.slider[lay.S_SN0, j] * g / stiff
+    x0 = np.append(q0, phi0)
+    if not np.all(np.isfinite(x0)):
+        # Parameters out of range (a preload or friction torque against a vanishing
+        # spring): the static deflection is not representable.
+        raise SimulationError(
+            f"no sliding equilibrium at Omega = {omega_c} rad/s: the static deflection "
+            "by the preloads is out of floating-point range (check slider.preload, "
+            "slider.rotational_stiffness, the friction coefficients)"
+        )
+    if guess is not None and guess.q.size == n and np.size(guess.phi) == ns:
+        x0 = np.append(guess.q, guess.phi)
 
-        compile_split_rhs()  # on two cores, if they compile
-        n, ns = model.n, model.n_sliders
-        kern = model.kernel_args
-        unknowns = _unknowns(model)
-        acc_index = unknowns + n + 2 * ns
-        radius, n0 = kern.row("radius"), kern.row("n0")
-        inertias = np.append(model.modal_mass, kern.row("inertia"))
-        # Rigid-disc guess: N = N0, friction balanced by the in-plane spring; the disc
-        # deflected statically by the preloads.
-        mu = np.array([dyn.kinetic_friction(kern.opts, kern.table, radius[j], 1, omega_c)
-                       for j in range(ns)])
-        with np.errstate(all="ignore"):
-            phi0 = radius * mu * n0 / kern.row("kphi")
-            stiff = model.modal_mass * (model.omega**2 - model.l**2 * omega_c**2)
-            q0 = np.zeros(n)
-            for j in range(ns):
-                psi = kern.row("theta")[j] + phi0[j]
-                g = (np.where(model.sgn > 0, np.cos(model.l * psi), np.sin(model.l * psi))
-                     * model.shape[j])
-                q0 -= kern.slider[lay.S_SN0, j] * g / stiff
-        x0 = np.append(q0, phi0)
-        if not np.all(np.isfinite(x0)):
-            # Parameters out of range (a preload or friction torque against a vanishing
-            # spring): the static deflection is not representable.
-            raise SimulationError(
-                f"no sliding equilibrium at Omega = {omega_c} rad/s: the static deflection "
-                "by the preloads is out of floating-point range (check slider.preload, "
-                "slider.rotational_stiffness, the friction coefficients)"
-            )
-        if guess is not None and guess.q.size == n and np.size(guess.phi) == ns:
-            x0 = np.append(guess.q, guess.phi)
+    def state(x: np.ndarray) -> np.ndarray:
+        y = np.zeros(model.state_size)
+        y[unknowns] = x
+        return y
 
-        def state(x: np.ndarray) -> np.ndarray:
-            y = np.zeros(model.state_size)
-            y[unknowns] = x
-            return y
+    ph, sg = slip_phases(model)
 
-        def residual(x: np.ndarray) -> np.ndarray:
-            dy, _ = _evaluate(model, state(x))
-            return dy[acc_index] * inertias
+    def residual(x: np.ndarray) -> np.ndarray:
+        return core.rhs(cm, 0.0, state(x), ph, sg)[acc_index] * inertias
 
-        def jacobian(x: np.ndarray) -> np.ndarray:
-            ph, sg = slip_phases(model)
-            jac = dyn.complex_step_jacobian(0.0, state(x), ph, sg, kern)
-            return jac[np.ix_(acc_index, unknowns)] * inertias[:, None]
+    def jacobian(x: np.ndarray) -> np.ndarray:
+        jac = core.jacobian(cm, 0.0, state(x), ph, sg)
+        return jac[np.ix_(acc_index, unknowns)] * inertias[:, None]
 
-        sol = root(residual, x0, jac=jacobian, method="hybr", options={"xtol": xtol})
+    sol = root(residual, x0, jac=jacobian, method="hybr", options={"xtol": xtol})
     # hybr may report "no progress" once it sits at round-off: judge by the residual, in
     # generalised forces [N], against the preload.
     scale = float(np.max(n0)) + 1.0
@@ -224,7 +211,7 @@ def sliding_equilibrium(
         )
     y = state(sol.x)
     _, aux = _evaluate(model, y)
-    nf = aux[lay.A_N].copy()
+    nf = aux["normal_force"]
     if contact and np.any(nf <= 0.0):
         j = int(np.argmin(nf))
         raise SimulationError(
@@ -235,7 +222,7 @@ def sliding_equilibrium(
         q=sol.x[:n].copy(),
         phi=sol.x[n:].copy(),
         normal_force=nf,
-        friction_force=aux[lay.A_F].copy(),
+        friction_force=aux["friction_force"],
         speed=omega_c,
         state=y,
     )

@@ -1,4 +1,5 @@
-"""One integration of a model, advanced call by call: the kernel's whole state between calls.
+"""One integration of a model, advanced call by call on the compiled core, which keeps its
+whole state between calls.
 
 :func:`fivdisc.simulate` drives one to write a :class:`~fivdisc.engine.result.Result`; the
 nonlinear-dynamics analyses (:mod:`fivdisc.analysis.orbits`,
@@ -11,15 +12,12 @@ import math
 
 import numpy as np
 
-from fivdisc.core import integrate as kern
-from fivdisc.core import slots
-from fivdisc.core import tangent as tan
+from fivdisc import core
 from fivdisc.engine.result import EVENT_KINDS
 from fivdisc.errors import FivdiscError
 from fivdisc.model import layout as lay
 from fivdisc.model.build import Model
 
-_EVENT_BUFFER = 1 << 15
 # Switches closer than this, this many times in a row, are taken as Zeno/chattering.
 ZENO_DT = 1e-10
 ZENO_COUNT = 1000
@@ -37,14 +35,14 @@ _STALLED = 1e-14
 _CALL_WORK = 500_000
 
 STATUS = {
-    slots.ST_RUNNING: "running",
-    slots.ST_DONE: "success",
-    slots.ST_STOPPED: "stopped",
-    slots.ST_NONFINITE: "nonfinite",
-    slots.ST_UNDERFLOW: "step_size_underflow",
-    slots.ST_ZENO: "endless_switching",
-    slots.ST_MAX_SWITCHES: "max_switches",
-    slots.ST_TOO_MANY_STEPS: "too_many_steps",
+    core.ST_RUNNING: "running",
+    core.ST_DONE: "success",
+    core.ST_STOPPED: "stopped",
+    core.ST_NONFINITE: "nonfinite",
+    core.ST_UNDERFLOW: "step_size_underflow",
+    core.ST_ZENO: "endless_switching",
+    core.ST_MAX_SWITCHES: "max_switches",
+    core.ST_TOO_MANY_STEPS: "too_many_steps",
 }
 
 
@@ -219,7 +217,10 @@ class LongRunNotice:
 
 
 class Integration:
-    """The integrator of ``model`` from state ``y0`` at t = 0 to ``duration``.
+    """The integrator of ``model`` from state ``y0`` at t = 0 to ``duration``: a thin
+    wrapper of the compiled core's :class:`fivdisc.core.Integrator`, which keeps the whole
+    state between calls; this class adds the step budget, the accumulation test of
+    switches and the event table.
 
     Parameters
     ----------
@@ -254,58 +255,76 @@ class Integration:
         self.model = model
         self.duration = duration
         n_acc = lay.N_ENERGY if energy else 0
-        self.y = np.concatenate([np.asarray(y0, dtype=float), np.zeros(n_acc)])
-        size = self.y.size
+        y = np.concatenate([np.asarray(y0, dtype=float), np.zeros(n_acc)])
         n_sl = model.n_sliders
         n_out = int(np.floor(duration * output_rate + 1e-9)) + 1 if output_rate > 0 else 0
-        # Rows past the last written sample are cut off, so they need no fill.
-        self.out_y = np.empty((n_out, size))
-        self.out_aux = np.empty((n_out, 4 * n_sl + 1))
-        ctl = np.zeros(slots.N_CONTROL)
-        ctl[slots.C_RTOL] = sim.rtol if rtol is None else rtol
-        ctl[slots.C_ATOL] = sim.atol if atol is None else atol
-        ctl[slots.C_MAX_STEP] = sim.max_step if max_step is None else max_step
-        ctl[slots.C_T_FINAL] = duration
-        ctl[slots.C_OUT_DT] = 1.0 / output_rate if output_rate > 0 else np.inf
-        ctl[slots.C_MAX_SWITCHES] = sim.max_switches
-        ctl[slots.C_ZENO_DT] = ZENO_DT
-        ctl[slots.C_ZENO_COUNT] = ZENO_COUNT
-        ctl[slots.C_STOP_MASK] = sum(1 << EVENT_KINDS.index(k) for k in set(stop_on))
-        self.ctl = ctl
+        ph = np.full(n_sl, lay.SLIP, dtype=np.int64)
+        if phases is not None:
+            ph[:] = phases
+        bp = model.speed.breakpoints
+        self.breaks = np.unique(bp[bp < duration])
+        self.core = core.Integrator(
+            core.core_model(model), y, ph, t_final=float(duration),
+            rtol=float(sim.rtol if rtol is None else rtol),
+            atol=float(sim.atol if atol is None else atol),
+            max_step=float(sim.max_step if max_step is None else max_step),
+            out_dt=1.0 / output_rate if output_rate > 0 else np.inf, n_out=n_out,
+            max_switches=float(sim.max_switches), zeno_dt=ZENO_DT,
+            zeno_count=float(ZENO_COUNT),
+            stop_mask=sum(1 << EVENT_KINDS.index(k) for k in set(stop_on)),
+            breaks=self.breaks)
         self.max_steps = sim.max_steps
-        self.call_steps = max(20, _CALL_WORK // (size * (n_sl + 1)))
+        self.call_steps = max(20, _CALL_WORK // (y.size * (n_sl + 1)))
         self.zeno_sliders: tuple[int, ...] = ()
         self.zeno_span = 0.0
         self.zeno_count = 0
-        self.fst = np.zeros(slots.N_FSTATE)
-        self.fst[slots.F_LAST_SWITCH] = -np.inf
-        self.ist = np.zeros(slots.N_ISTATE, dtype=np.int64)
-        self.ph = np.full(n_sl, lay.SLIP, dtype=np.int64)
-        if phases is not None:
-            self.ph[:] = phases
-        self.sg = np.ones(n_sl, dtype=np.int64)
-        self.k = np.zeros((7, size))
-        self.ev_prev = np.zeros(3 * n_sl)
-        self.ev_t = np.empty(_EVENT_BUFFER)
-        self.ev_i = np.empty((_EVENT_BUFFER, slots.N_EVI), dtype=np.int64)
-        bp = model.speed.breakpoints
-        self.breaks = np.unique(bp[bp < duration])
-        self.mdl = model.kernel_args
         self.ev_times: list[np.ndarray] = []
         self.ev_rows: list[np.ndarray] = []
-        self.tan: tuple[np.ndarray, np.ndarray] | None = None
-        self.status = slots.ST_RUNNING
+        self.status = core.ST_RUNNING
 
     @property
     def t(self) -> float:
         """Time reached [s]."""
-        return float(self.fst[slots.F_T])
+        return float(self.core.t)
+
+    @property
+    def y(self) -> np.ndarray:
+        """A copy of the state reached, with the energy accumulators if any (slaved
+        coordinates as the core holds them)."""
+        return self.core.y
 
     @property
     def state(self) -> np.ndarray:
         """The dynamic state reached (without energy accumulators), slaved coordinates as
-        the kernel holds them."""
-        return self.y[: self.model.state_size].copy()
+        the core holds them."""
+        return self.core.y[: self.model.state_size]
+
+    @property
+    def ph(self) -> np.ndarray:
+        """Every slider's phase (a copy)."""
+        return self.core.ph
+
+    @property
+    def sg(self) -> np.ndarray:
+        """Every slider's slip sign (a copy)."""
+        return self.core.sg
+
+    @property
+    def out_y(self) -> np.ndarray:
+        """The state samples (rows; those past :attr:`n_samples` are not written)."""
+        return self.core.out_y
+
+    @property
+    def out_aux(self) -> np.ndarray:
+        """Per sample, each slider's normal force, friction force, phase and w under it,
+        then Omega (rows as :attr:`out_y`)."""
+        return self.core.out_aux
+
+    @property
+    def stats(self) -> dict[str, int]:
+        """Accepted (``steps``) and rejected steps, right-hand sides (``rhs``; those to
+        locate events ``rhs_events``), ``switches`` and ``samples``."""
+        return dict(self.core.stats)
 
     @property
     def status_name(self) -> str:
@@ -313,22 +332,20 @@ class Integration:
 
     @property
     def n_samples(self) -> int:
-        return int(self.ist[slots.I_OUT_NEXT])
+        return int(self.core.n_samples)
 
     def take_peak(self) -> float:
         """The largest |w| [m] under the sliders at the samples written since the last
         call (nan if any was not finite), and start again."""
-        peak = float(self.fst[slots.F_W_PEAK])
-        self.fst[slots.F_W_PEAK] = 0.0
-        return peak
+        return float(self.core.take_peak())
 
     @property
     def steps_tried(self) -> int:
         """Steps tried so far, accepted and rejected."""
-        return int(self.ist[slots.I_STEPS] + self.ist[slots.I_REJECTED])
+        return int(self.core.steps_tried)
 
     def advance(self, target: float) -> int:
-        """Integrate until ``t >= target`` (or the end, a failure, a full event buffer, the
+        """Integrate until ``t >= target`` (or the end, a failure, a full event log, the
         call's step budget); returns the status. The first call (any target) also chooses
         the phases at the start.
 
@@ -338,33 +355,31 @@ class Integration:
         changes none of its steps. The run ends as ``too_many_steps`` once
         ``simulation.max_steps`` steps were tried, and as ``endless_switching`` when its
         switches accumulate (:data:`ZENO_RATE_COUNT` within :data:`ZENO_RATE_SPAN`).
+        The core releases the GIL while it integrates.
         """
         left = self.max_steps - self.steps_tried
-        if left <= 0 and self.ist[slots.I_STARTED]:
-            self.status = slots.ST_TOO_MANY_STEPS
+        if left <= 0 and self.core.started:
+            self.status = core.ST_TOO_MANY_STEPS
             return self.status
-        self.ctl[slots.C_CALL_STEPS] = max(1, min(self.call_steps, left))
         tried, t0 = self.steps_tried, self.t
-        status = kern.run(target, self.mdl, self.ctl, self.fst, self.ist, self.y, self.ph,
-                          self.sg, self.k, self.ev_prev, self.breaks, self.out_y, self.out_aux,
-                          self.ev_t, self.ev_i, self.tan)
-        n_ev = self.ist[slots.I_EVENTS]
+        status = self.core.advance(target, max(1, min(self.call_steps, left)))
+        times, rows = self.core.take_events()
+        n_ev = times.size
         if n_ev:
-            self.ev_times.append(self.ev_t[:n_ev].copy())
-            self.ev_rows.append(self.ev_i[:n_ev].copy())
-            self.ist[slots.I_EVENTS] = 0
-        if status == slots.ST_ZENO:
+            self.ev_times.append(times)
+            self.ev_rows.append(rows)
+        if status == core.ST_ZENO:
             self._name_zeno(ZENO_COUNT)
-        elif status == slots.ST_RUNNING and n_ev and self._accumulating():
-            status = slots.ST_ZENO
-        elif (status == slots.ST_RUNNING and self.t < self.duration
+        elif status == core.ST_RUNNING and n_ev and self._accumulating():
+            status = core.ST_ZENO
+        elif (status == core.ST_RUNNING and self.t < self.duration
               and self.steps_tried >= self.max_steps):
-            status = slots.ST_TOO_MANY_STEPS
-        elif (status == slots.ST_RUNNING and self.steps_tried - tried >= self.call_steps
+            status = core.ST_TOO_MANY_STEPS
+        elif (status == core.ST_RUNNING and self.steps_tried - tried >= self.call_steps
               and self.t - t0 < (self.steps_tried - tried) * _STALLED * max(1.0, self.t)):
             # A whole call's steps that do not add up to the round-off of t: the
             # step size has underflowed although each step is accepted.
-            status = slots.ST_UNDERFLOW
+            status = core.ST_UNDERFLOW
         self.status = status
         return status
 
@@ -378,7 +393,7 @@ class Integration:
             if have >= count:
                 break
         if not times:
-            return np.empty(0), np.empty((0, slots.N_EVI), dtype=np.int64)
+            return np.empty(0), np.empty((0, core.N_EVI), dtype=np.int64)
         return np.concatenate(times[::-1]), np.concatenate(rows[::-1])
 
     def _name_zeno(self, count: int) -> None:
@@ -386,7 +401,7 @@ class Integration:
         span."""
         times, rows = self._recent(count)
         if times.size:
-            self.zeno_sliders = tuple(int(j) for j in np.unique(rows[:, slots.EVI_SLIDER]))
+            self.zeno_sliders = tuple(int(j) for j in np.unique(rows[:, core.EVI_SLIDER]))
             self.zeno_span = float(times[-1] - times[0])
             self.zeno_count = int(times.size)
 
@@ -394,6 +409,17 @@ class Integration:
         """Whether :data:`ZENO_RATE_COUNT` consecutive events among the latest fall within
         :data:`ZENO_RATE_SPAN` of simulated time."""
         new = self.ev_times[-1].size
+        # A window that holds a new event lies after the first new event's time less the
+        # span: count the events there first (most calls stop here, having looked at the
+        # last few chunks only).
+        cutoff = self.ev_times[-1][0] - ZENO_RATE_SPAN
+        near = 0
+        for chunk in reversed(self.ev_times):
+            near += chunk.size - int(np.searchsorted(chunk, cutoff))
+            if chunk[0] < cutoff or near >= ZENO_RATE_COUNT:
+                break
+        if near < ZENO_RATE_COUNT:
+            return False
         times, rows = self._recent(new + ZENO_RATE_COUNT - 1)
         if times.size < ZENO_RATE_COUNT:
             return False
@@ -403,7 +429,7 @@ class Integration:
             return False
         first = int(dense[0])
         window = rows[first:first + ZENO_RATE_COUNT]
-        self.zeno_sliders = tuple(int(j) for j in np.unique(window[:, slots.EVI_SLIDER]))
+        self.zeno_sliders = tuple(int(j) for j in np.unique(window[:, core.EVI_SLIDER]))
         self.zeno_span = float(spans[first])
         self.zeno_count = ZENO_RATE_COUNT
         return True
@@ -419,7 +445,7 @@ class Integration:
             status = self.advance(target)
             if notice is not None:
                 notice.update(self)
-            if status != slots.ST_RUNNING or self.t >= target:
+            if status != core.ST_RUNNING or self.t >= target:
                 return status
             if deadline is not None and time.monotonic() > deadline:
                 return status
@@ -427,7 +453,7 @@ class Integration:
     def events(self) -> tuple[np.ndarray, np.ndarray]:
         """Times and integer rows (kind, from, to, slider) of the switches so far."""
         if not self.ev_times:
-            return np.empty(0), np.empty((0, slots.N_EVI), dtype=np.int64)
+            return np.empty(0), np.empty((0, core.N_EVI), dtype=np.int64)
         return np.concatenate(self.ev_times), np.concatenate(self.ev_rows)
 
     def set_tangents(self, vectors: np.ndarray) -> None:
@@ -444,29 +470,20 @@ class Integration:
                 f"tangent vectors have shape {vectors.shape}: must be (k, {nd}), rows over "
                 "the dynamic state"
             )
-        if self.tan is None or self.tan[0].shape != vectors.shape:
-            self.tan = (np.zeros(vectors.shape), np.zeros((vectors.shape[0], 7, nd)))
-        v, kv = self.tan
-        v[:] = vectors
-        if self.ist[slots.I_STARTED]:
-            tan.prepare(self.t, self.y, self.ph, self.sg, self.mdl, v, kv)
+        self.core.set_tangents(vectors)
 
     def tangents(self, slaved: bool = True) -> np.ndarray:
         """Current tangent vectors (rows); with ``slaved``, the rows of coordinates that
         follow the contact (``z``, ``zdot`` in contact) are filled in as the output
         carries them, else they are zero as integrated."""
-        if self.tan is None:
+        if not self.core.has_tangents:
             raise RuntimeError("no tangent vectors are carried: call set_tangents first")
-        if not slaved:
-            return self.tan[0].copy()
-        return tan.unslaved(self.t, self.y, self.ph, self.sg, self.mdl, self.tan[0])
+        return self.core.tangents(slaved)
 
     def free(self) -> np.ndarray:
         """Mask of the coordinates that are free in the current phases."""
-        mask = np.ones(self.model.state_size)
-        tan.slave(self.ph, self.mdl, mask)
-        return mask.astype(bool)
+        return core.free_mask(core.core_model(self.model), self.core.ph)
 
     def rhs(self) -> np.ndarray:
         """The current phases' right-hand side at the current state (dynamic part)."""
-        return self.k[0, : self.model.state_size].copy()
+        return self.core.rhs()

@@ -244,7 +244,7 @@ class Summary:
     max_abs_w : float
         Largest |w| at the probes [m].
     wall_time : float
-        Time the integration took [s], without compiling or loading the kernel.
+        Time the integration took [s] (without building the model and the start).
     disc_thickness : float
         The disc's thickness h [m] (nan if the file does not say). Linear plate theory
         assumes |w| small against h: the printed summary notes when ``max_abs_w``
@@ -327,8 +327,7 @@ class Summary:
                        "|w| small against h. The paper's parameters do this too (Table 1's "
                        "500 N preload on a 2 mm disc): see 'Range of validity' in the "
                        "model docs")
-        out.append(f"wall time: {self.wall_time:.3g} s (integration only, without compiling "
-                   "the kernel)")
+        out.append(f"wall time: {self.wall_time:.3g} s (integration only)")
         return out
 
     def __str__(self) -> str:

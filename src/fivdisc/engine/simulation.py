@@ -8,16 +8,13 @@ from collections.abc import Callable
 
 import numpy as np
 
+from fivdisc import core
 from fivdisc.case import Case
-from fivdisc.core import integrate as kern
-from fivdisc.core import slots
-from fivdisc.engine.compilation import compile_notice
 from fivdisc.engine.conventions import fivdisc_version
 from fivdisc.engine.equilibrium import initial_state
 from fivdisc.engine.integration import STATUS, Integration, LongRunNotice, check_steps
 from fivdisc.engine.progress import SIMULATED_TIME, progress_bar
 from fivdisc.engine.result import EVENT_KINDS, PHASE_NAMES, Result, build_dataset
-from fivdisc.engine.split_compile import compile_split
 from fivdisc.errors import SimulationError
 from fivdisc.limits import check_simulation
 from fivdisc.model.build import Model, build_model
@@ -52,8 +49,7 @@ def simulate(
         Event kinds (``"separation"``, ``"stick"``, ...) that end the run early;
         the status is then ``"stopped"``.
     progress : bool
-        Show a progress bar in simulated time, and a notice while the kernel compiles
-        (the first run of a fresh installation).
+        Show a progress bar in simulated time.
 
     Returns
     -------
@@ -89,7 +85,7 @@ def simulate(
     switches: 18, separations: 0, impacts: 0
     peak normal force: 668.6... N, largest |w| at probes: 0.00434... m
     note: the disc deflected by up to 4.34 mm, 2.17 times its thickness h = 2 mm; ...
-    wall time: ... s (integration only, without compiling the kernel)
+    wall time: ... s (integration only)
 
     A kick of the first disc mode's velocity makes the slider leave the disc; stop the
     run there:
@@ -131,17 +127,13 @@ def simulate(
     run = Integration(model, y0, duration=sim.duration, output_rate=sim.output_rate,
                       stop_on=stop_on, energy=sim.energy_balance)
 
-    # A first call with target 0 only sets up the start: it compiles or loads the kernel
-    # before the progress bar starts, so the bar's rate and estimate are the integrator's
-    # (and the wall time excludes the compilation, announced with the bar).
-    # Without a bar the notice is still the command line's (a library call says nothing).
-    with compile_notice(kern.run, show=progress or None):
-        compile_split(run)
-        run.advance(0.0)
+    # A first call with target 0 only sets up the start (the phases the initial state
+    # allows), before the progress bar and the wall time start.
+    run.advance(0.0)
     bar = progress_bar(sim.duration, "simulating", "s", show=progress,
                        bar_format=SIMULATED_TIME)
     start = _time.perf_counter()
-    status = slots.ST_RUNNING
+    status = core.ST_RUNNING
     notice = LongRunNotice(model, sim.duration)
     with Interrupt() as interrupt:
         try:
@@ -156,9 +148,9 @@ def simulate(
                     notice.update(run)
                     if bar is not None:
                         bar.update(run.t - bar.n)
-                    if status != slots.ST_RUNNING or run.t >= target:
+                    if status != core.ST_RUNNING or run.t >= target:
                         break
-                if interrupt.requested or limit.exceeded(run) or status != slots.ST_RUNNING:
+                if interrupt.requested or limit.exceeded(run) or status != core.ST_RUNNING:
                     break
         except KeyboardInterrupt:
             interrupt.requested = True
@@ -181,7 +173,7 @@ def simulate(
         message = _message(name, t_end, phases, case, run)
     n_done = run.n_samples
     times = np.minimum(np.arange(n_done) / sim.output_rate, sim.duration)
-    ist = run.ist
+    stats = run.stats
     attrs = {
         "status": name,
         "message": message,
@@ -192,11 +184,11 @@ def simulate(
         f"{speed.source} given to simulate (the case's [speed] table is not used)",
         "fivdisc_version": fivdisc_version(),
         "wall_time": wall,
-        "n_steps": int(ist[slots.I_STEPS]),
-        "n_rejected": int(ist[slots.I_REJECTED]),
-        "n_rhs": int(ist[slots.I_RHS]),
-        "n_rhs_events": int(ist[slots.I_EVAL_EVENTS]),
-        "n_switches": int(ist[slots.I_SWITCHES]),
+        "n_steps": stats["steps"],
+        "n_rejected": stats["rejected"],
+        "n_rhs": stats["rhs"],
+        "n_rhs_events": stats["rhs_events"],
+        "n_switches": stats["switches"],
         "final_phase": ph.copy(),
         "final_state": y.copy(),
     }
@@ -385,20 +377,9 @@ def _message(name: str, t: float, phase: str, case: Case, run: Integration) -> s
         "or check the parameters",
         "step_size_underflow": f"step size underflow {where}; try looser simulation.rtol/atol",
         "max_switches": f"simulation.max_switches = {sim.max_switches} reached {where} "
-        f"after {run.ist[slots.I_SWITCHES]} switches",
+        f"after {run.stats['switches']} switches",
         "too_many_steps": f"simulation.max_steps = {sim.max_steps} steps tried {where} "
         f"(mean step {t / max(run.steps_tried, 1):.3g} s); raise simulation.max_steps, "
         "loosen simulation.rtol/atol or check the parameters (a stiff spring or damper)",
     }.get(name, f"ended {where}")
 
-
-def warm_kernel(show: bool = False) -> None:
-    """Compile or load the simulation kernel now, with a run of 1 ms of simulated time.
-
-    Parameters
-    ----------
-    show
-        Print the notice of :func:`compile_notice` if the kernel compiles.
-    """
-    with compile_notice(kern.run, show=show):
-        simulate(Case(simulation={"duration": 1e-3, "output_rate": 1000.0}))

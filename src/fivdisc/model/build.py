@@ -43,7 +43,7 @@ class Model:
     damping : ndarray
         Modal damping ratio per coordinate [-].
     kernel : KernelModel
-        The tuple of arrays the compiled kernels read (:mod:`fivdisc.model.layout`).
+        The tuple of arrays the compiled core reads (:mod:`fivdisc.model.layout`).
     speed : SpeedProfile
         Disc speed.
     probe_shapes : ndarray
@@ -97,7 +97,8 @@ class Model:
 
     @cached_property
     def kernel_args(self) -> lay.KernelModel:
-        """The model tuple the numba kernels take, with the speed profile of this model."""
+        """The model tuple the compiled core takes (:func:`fivdisc.core.core_model`), with
+        the speed profile of this model."""
         return self.kernel._replace(speed=self.speed.pieces())
 
     def with_speed(self, speed: SpeedProfile) -> Model:

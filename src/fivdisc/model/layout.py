@@ -14,10 +14,9 @@ the power of each kind of force, carried along but kept out of the error norm an
 events, so they never change the step sequence. For one slider the layout is the
 paper's ``[q, phi, z, qdot, phidot, zdot]``.
 
-The model is a tuple of a few two-dimensional arrays whose rows are named below, rather
-than one array per quantity: numba passes every array of a tuple argument as a separate
-structure on each call, and with one array per quantity the calls of the right-hand side
-cost more than its arithmetic.
+The model is a tuple of a few two-dimensional arrays whose rows are named below; the
+compiled core (:func:`fivdisc.core.core_model`) checks them once and holds them as named
+fields (``src/fivdisc/core/src/model.hpp``).
 """
 
 from __future__ import annotations

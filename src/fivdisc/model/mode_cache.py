@@ -1,9 +1,11 @@
 """The disc's radial modes, kept on disk from one process to the next.
 
 Finding a mode's frequency parameter and the peak of its shape takes root searches
-(:func:`scipy.optimize.brentq`), and importing :mod:`scipy.optimize` alone is a third of a
-second of every short command. The modes of a geometry are therefore stored once, in
-``fivdisc-plate-modes.json`` in ``$FIVDISC_CACHE_DIR`` (else ``$NUMBA_CACHE_DIR``, else
+(:func:`scipy.optimize.brentq`), and its values take Bessel functions
+(:mod:`scipy.special`): importing either is a quarter to a third of a second of every
+short command. The modes of a geometry, and their values at the radii a model asks for
+(its sliders' tracks and probes), are therefore stored once, in
+``fivdisc-plate-modes.json`` in ``$FIVDISC_CACHE_DIR`` (else
 ``~/.cache/fivdisc``), and read back exactly (JSON keeps every bit of a float). The file
 is stamped with a hash of :mod:`fivdisc.model.plate`'s source and the numpy and scipy
 versions: when one changes, the stored modes are ignored and found again. A file that
@@ -19,14 +21,14 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-__all__ = ["lookup", "remember"]
+__all__ = ["lookup", "lookup_values", "remember", "remember_values"]
 
 _FILE = "fivdisc-plate-modes.json"
 _modes: dict[str, Any] | None = None
 
 
 def _path() -> Path:
-    directory = os.environ.get("FIVDISC_CACHE_DIR") or os.environ.get("NUMBA_CACHE_DIR")
+    directory = os.environ.get("FIVDISC_CACHE_DIR")
     if directory:
         return Path(directory) / _FILE
     home = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
@@ -62,6 +64,25 @@ def lookup(key: str) -> Any:
     if _modes is None:
         _modes = _read()
     return _modes.get(key)
+
+
+def lookup_values(key: str, radii: list[float]) -> list[float] | None:
+    """A radial function's values at ``radii`` [m] stored under ``key`` (the mode and the
+    derivative), or None if any of them is not stored."""
+    stored = lookup(f"values {key}")
+    if not isinstance(stored, dict):
+        return None
+    found = [stored.get(repr(r)) for r in radii]
+    return None if any(v is None for v in found) else found
+
+
+def remember_values(key: str, radii: list[float], values: list[float]) -> None:
+    """Store a radial function's ``values`` at ``radii`` [m] under ``key``, beside those
+    stored at other radii."""
+    stored = lookup(f"values {key}")
+    merged = dict(stored) if isinstance(stored, dict) else {}
+    merged.update({repr(r): v for r, v in zip(radii, values, strict=True)})
+    remember(f"values {key}", merged)
 
 
 def remember(key: str, value: Any) -> None:

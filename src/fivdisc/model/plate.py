@@ -51,7 +51,6 @@ from functools import lru_cache
 from typing import Any
 
 import numpy as np
-from scipy import special
 
 from fivdisc.errors import ModeError
 from fivdisc.model import mode_cache
@@ -70,6 +69,9 @@ _SCAN_CHUNK = 64
 # computed to an absolute error of order 1e-15; below this its sign means nothing. That happens
 # as beta -> 0, where J_l and I_l (and Y_l and K_l) become parallel, and where Y_l overflows.
 _DETERMINANT_NOISE = 1e-12
+# PlateMode.shape keeps its values at up to this many radii in the mode cache (a model's
+# sliders and probes); longer arrays (figures, root searches) are computed.
+_STORED_RADII = 64
 # Slack on the radial range accepted by PlateMode.shape, to let r = a or b computed with
 # round-off through.
 _RADIUS_SLACK = 1e-12
@@ -115,6 +117,10 @@ def _scaled_basis(
     x = np.asarray(x, dtype=float)
     orders = np.array([order, order + 1], dtype=float).reshape((2,) + (1,) * x.ndim)
     pair = np.empty((2, *x.shape, 4))  # (order l or l + 1, *x.shape, column)
+    # Imported here: a model whose radial values are in the mode cache needs no scipy.special
+    # (a quarter of a second of every short command).
+    from scipy import special
+
     pair[..., 0] = special.jv(orders, x)
     pair[..., 1] = special.yv(orders, x)
     pair[..., 2] = special.ive(orders, x) * np.exp(x - x_b)
@@ -598,7 +604,25 @@ class PlateMode:
         if radii.size and not (np.all(radii >= a - slack) and np.all(radii <= b + slack)):
             bad = radii[(radii < a - slack) | (radii > b + slack) | np.isnan(radii)].flat[0]
             raise ModeError(f"r = {float(bad)!r} is out of range; allowed: {a} <= r <= {b} [m]")
-        values = _radial_values(
-            self.l, self.beta, a, b, np.asarray(self.coefficients), radii, int(derivative)
-        )
+        if radii.size <= _STORED_RADII:
+            values = self._stored_values(radii, int(derivative))
+        else:
+            values = _radial_values(
+                self.l, self.beta, a, b, np.asarray(self.coefficients), radii, int(derivative)
+            )
         return float(values) if radii.ndim == 0 else values
+
+    def _stored_values(self, radii: np.ndarray, derivative: int) -> np.ndarray:
+        """:meth:`shape` at a few radii (sliders' tracks, probes), kept in the mode cache
+        from one process to the next: the values computed once, read back exactly."""
+        plate = self.plate
+        key = repr((plate.inner_radius, plate.outer_radius, plate.poisson_ratio, self.k,
+                    self.l, derivative))
+        stored = mode_cache.lookup_values(key, radii.ravel().tolist())
+        if stored is None:
+            values = _radial_values(self.l, self.beta, plate.inner_radius, plate.outer_radius,
+                                    np.asarray(self.coefficients), radii, derivative)
+            mode_cache.remember_values(key, radii.ravel().tolist(),
+                                       np.ravel(values).tolist())
+            return values
+        return np.reshape(np.array(stored, dtype=float), radii.shape)

@@ -1,4 +1,4 @@
-"""Disc speed profiles Omega(t) as piecewise cubics that the compiled kernel evaluates.
+"""Disc speed profiles Omega(t) as piecewise cubics that the compiled core evaluates.
 
 The paper's three situations (constant, Eq. 3; decelerating, Eq. 1; accelerating,
 Eq. 2) and piecewise-linear tables are represented exactly. A pair of Python
@@ -337,7 +337,7 @@ class SpeedProfile:
 
     def pieces(self) -> np.ndarray:
         """``(len(knots), 5)``: each piece's start [s] and its four coefficients, the form
-        the compiled kernels read."""
+        the compiled core reads."""
         return np.column_stack([self.knots, self.coefficients])
 
     def is_constant(self) -> bool:

@@ -29,7 +29,6 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from fivdisc.engine.simulation import warm_kernel
 from fivdisc.errors import FivdiscError
 from fivdisc.files import check_netcdf, write_atomic, write_netcdf
 from fivdisc.paper.cases import CITATION, FIGURES
@@ -147,9 +146,6 @@ def reproduce(figures: Iterable[int] | None = None,
 
     from tqdm import tqdm
 
-    if todo:
-        # Compiled here once (with a notice), the worker processes load it from the cache.
-        warm_kernel(show=progress)
     with tqdm(total=len(numbers), initial=len(reused), unit="fig", desc="figures",
               disable=not progress, dynamic_ncols=True) as bar:
         for number in (n for n in todo if n in SWEEP_FIGURES):

@@ -454,7 +454,7 @@ def evaluate(
         The run did not end as requested (its status and message are given), or a
         user reduction returned something other than a real number.
     """
-    # Imported here: the simulator loads numba, which validating a sweep does not need.
+    # Imported here: the simulator loads xarray, which validating a sweep does not need.
     from fivdisc.engine.simulation import simulate
 
     reductions = resolve(keep, lyapunov)

@@ -26,9 +26,7 @@ from os import PathLike
 from pathlib import Path
 from typing import Any
 
-from fivdisc.analysis.exponents import warm_tangent_kernel
 from fivdisc.case import Case
-from fivdisc.engine.simulation import warm_kernel
 from fivdisc.errors import FivdiscError
 from fivdisc.sweep.reductions import LyapunovSettings, SweepError, evaluate
 from fivdisc.sweep.sections import Section
@@ -36,7 +34,7 @@ from fivdisc.sweep.spec import Sweep
 from fivdisc.sweep.store.lock import store_lock
 from fivdisc.sweep.store.sweep_store import PointOutcome, SweepStore
 
-__all__ = ["SweepReport", "run_sweep", "warm_kernel"]
+__all__ = ["SweepReport", "run_sweep"]
 
 # Points submitted ahead per worker: enough to keep workers busy while the
 # coordinator writes, few enough that an interruption discards little work.
@@ -108,7 +106,6 @@ def _init_local_worker(parent: int) -> None:
     # Ctrl-C reaches the whole process group; only the coordinator should act on it.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     threading.Thread(target=_exit_with_parent, args=(parent,), daemon=True).start()
-    warm_kernel()
 
 
 class _WorkerDied(Exception):
@@ -188,20 +185,6 @@ class _LocalPool:
             process.terminate()
 
 
-def _warm_plugin() -> Any:
-    from distributed.diagnostics.plugin import WorkerPlugin
-
-    class WarmKernel(WorkerPlugin):
-        """Loads the simulator's compiled code once on every worker, present and future."""
-
-        name = "fivdisc-warm-kernel"
-
-        def setup(self, worker: Any) -> None:
-            warm_kernel()
-
-    return WarmKernel()
-
-
 class ClusterLost(SweepError):
     """The Dask cluster went away while the sweep was running on it."""
 
@@ -232,7 +215,6 @@ class _DaskPool:
             ) from None
         except (OSError, TimeoutError) as exc:
             raise SweepError(f"scheduler = {address!r}: cannot connect ({exc})") from None
-        self._client.register_plugin(_warm_plugin())
         self.workers = max(1, sum(self._client.nthreads().values()))
 
     def _lost(self, exc: BaseException) -> ClusterLost:
@@ -355,10 +337,6 @@ def run_sweep(
                 raise SweepError(target.refusal)
             if todo:
                 if pool is None:
-                    # Compiled here once (with a notice), the workers load it from the cache.
-                    warm_kernel(show=progress)
-                    if spec.lyapunov is not None:
-                        warm_tangent_kernel(show=progress)
                     pool = _LocalPool(workers or os.cpu_count() or 1)
                 try:
                     _drive(pool, spec, target, todo, already, failed, progress)

@@ -324,7 +324,7 @@ def _size(case: Case, dim: str) -> int:
         return len(case.simulation.probes)
     if dim == "coordinate":
         return sum(2 if int(l) > 0 else 1 for _, l in case.disc.modes)
-    from fivdisc.model.layout import ENERGY_NAMES  # numba: only for this variable
+    from fivdisc.model.layout import ENERGY_NAMES
 
     return len(ENERGY_NAMES)
 
