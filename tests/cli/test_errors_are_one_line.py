@@ -543,3 +543,19 @@ def test_numerical_warnings_are_dropped_when_a_command_fails(monkeypatch) -> Non
         warnings.simplefilter("always")
         result = run_cli(["stability"])
     assert result.exit_code == 2 and messages(result.stderr) == ["error: refused"]
+
+
+def test_an_error_of_a_fresh_process_is_one_line_to_its_exit(tmp_path: Path) -> None:
+    """After the compiled core: an error whose traceback held the core's model in a
+    reference cycle ended with nanobind's report of it as leaked at the exit (some twenty
+    lines after the one-line error; the command line freezes the collector at exit)."""
+    import subprocess
+    import sys
+
+    path = tmp_path / "c.toml"
+    Case(slider={"preload": 1e12}).save(path)  # no sliding equilibrium is found
+    done = subprocess.run([sys.executable, "-m", "fivdisc", "stability", str(path), "--json"],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2
+    lines = messages(done.stderr)
+    assert len(lines) == 1 and lines[0].startswith("error: no sliding equilibrium"), done.stderr

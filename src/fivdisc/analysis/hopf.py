@@ -218,7 +218,7 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, row_lo: np.
                 failure = err
                 continue
             jac = slip_jacobian(model, eq.state)
-            check_jacobian(model, jac, f"at {key} = {value:g}: ")
+            check_jacobian(model, eq.state, jac, f"at {key} = {value:g}: ")
             return model, eq, jac
         raise AnalysisError(
             f"{option} {key}: a complex pair crosses the imaginary axis between {lo:g} and "

@@ -18,7 +18,7 @@ import numpy as np
 from fivdisc import core
 from fivdisc.case import Case
 from fivdisc.engine.equilibrium import Equilibrium, sliding_equilibrium, slip_phases
-from fivdisc.errors import AnalysisError, CaseError, SimulationError
+from fivdisc.errors import AnalysisError, CaseError, FivdiscError, SimulationError
 from fivdisc.limits import duration_words
 from fivdisc.model import layout as lay
 from fivdisc.model.build import Model, build_model, model_at
@@ -94,10 +94,11 @@ def check_rates(model: Model, where: str = "") -> None:
             )
 
 
-def check_jacobian(model: Model, jac: np.ndarray, where: str = "") -> None:
-    """Refuse a slip Jacobian that is not finite, naming its first such entry and the
-    friction law's settings when it lies in a slider's velocity column (the law's
-    slope)."""
+def check_jacobian(model: Model, state: np.ndarray, jac: np.ndarray, where: str = "") -> None:
+    """Refuse a slip Jacobian (`jac`, at `state`) that is not finite, naming its first
+    such entry, and the friction law's settings when the law is the cause (the Jacobian
+    of the same model with constant friction is finite: the law's slope is out of
+    range)."""
     bad = np.argwhere(~np.isfinite(jac))
     if bad.size == 0:
         return
@@ -106,9 +107,8 @@ def check_jacobian(model: Model, jac: np.ndarray, where: str = "") -> None:
               else [f"phi{k}" for k in range(model.n_sliders)])
     names = [*model.labels, *angles, *(f"{v}_dot" for v in (*model.labels, *angles))]
     entry = f"d({names[i]})'/d({names[j]}) = {jac[i, j]}"
-    size = model.n + model.n_sliders
-    if j >= size + model.n:
-        law = model.case.friction
+    law = model.case.friction
+    if _finite_without_the_law(model, state):
         shown = ", ".join(f"friction.{k} = {v!r}" for k, v in law.model_dump().items()
                           if k not in ("law", "static") and isinstance(v, float | int))
         cause = (f"the slope of the friction law ({law.law}) at the sliding speed is out of "
@@ -116,8 +116,23 @@ def check_jacobian(model: Model, jac: np.ndarray, where: str = "") -> None:
     else:
         cause = ("a parameter of the case is out of the range doubles resolve; change the "
                  "extreme one")
-    raise AnalysisError(f"{where}the linearised slip equations are not finite at the sliding "
-                        f"equilibrium ({entry}): {cause}")
+    raise AnalysisError(f"{where}the linearised slip equations are not finite ({entry}): "
+                        f"{cause}")
+
+
+def _finite_without_the_law(model: Model, state: np.ndarray) -> bool:
+    """Whether the slip Jacobian at `state` is finite with the friction law replaced by
+    constant kinetic friction (the static coefficient's)."""
+    law = model.case.friction
+    if law.law == "exponential" and law.decay == 0.0:
+        return False  # constant already
+    plain = {"law": "exponential", "static": law.static, "kinetic_max": law.static,
+             "kinetic_min": law.static, "decay": 0.0}
+    try:
+        other = build_model(model.case.replace({"friction": plain}))
+    except FivdiscError:
+        return False
+    return bool(np.isfinite(slip_jacobian(other, state)).all())
 
 
 def reduced_indices(model: Model) -> np.ndarray:
@@ -321,7 +336,7 @@ class ParameterPoints:
             return None
         jac = slip_jacobian(model, eq.state)
         where = ", ".join(f"{k} = {v:g}" for k, v in zip(self.keys, values, strict=True))
-        check_jacobian(model, jac, f"at {where}: ")
+        check_jacobian(model, eq.state, jac, f"at {where}: ")
         return model, eq, jac
 
     def eigenvalues(self, values: Sequence[float], guess: Equilibrium | None = None

@@ -23,7 +23,7 @@ from fivdisc.analysis.points import (
 )
 from fivdisc.case import Case, is_case_key, keys_like, unit_of
 from fivdisc.engine.equilibrium import Equilibrium, sliding_equilibrium
-from fivdisc.errors import CaseError, nearest
+from fivdisc.errors import CaseError, SimulationError, nearest
 from fivdisc.limits import check_memory
 from fivdisc.model.build import Model, build_model
 
@@ -231,9 +231,16 @@ def linear_stability(case: Case | Model) -> LinearStability:
     """
     model = case if isinstance(case, Model) else build_model(case)
     check_rates(model)
-    eq = sliding_equilibrium(model)
+    try:
+        eq = sliding_equilibrium(model)
+    except SimulationError:
+        # A linearisation that is not finite (the friction law's slope out of range) also
+        # stops the root finder, which uses it: that is the cause to name.
+        rest = np.zeros(model.state_size)
+        check_jacobian(model, rest, slip_jacobian(model, rest))
+        raise
     jac = slip_jacobian(model, eq.state)
-    check_jacobian(model, jac)
+    check_jacobian(model, eq.state, jac)
     lam, vec = np.linalg.eig(jac)
     order = np.lexsort((-lam.imag, -lam.real))
     lam = lam[order]
