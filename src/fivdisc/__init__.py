@@ -27,7 +27,8 @@ from fivdisc._lazy import public
 
 _API = {
     "fivdisc.errors": ("AnalysisError", "CaseError", "ConvergenceError", "FivdiscError",
-                       "MissingExtraError", "ModeError", "SimulationError", "SweepError"),
+                       "FivdiscWarning", "MissingExtraError", "ModeError", "SimulationError",
+                       "SweepError"),
     "fivdisc.case": ("Case", "load_case"),
     "fivdisc.model.plate": ("AnnularPlate", "PlateMode"),
     "fivdisc.model.speed": ("SpeedProfile",),

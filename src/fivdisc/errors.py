@@ -117,6 +117,25 @@ class MissingExtraError(FivdiscError, ImportError):
     """
 
 
+class FivdiscWarning(UserWarning):
+    """Something the user should know before or after a long computation (its estimated
+    time, for one); the command line prints it as one line, ``warning: ...``.
+
+    Examples
+    --------
+    A script that would rather stop than start a run of minutes turns the warning into
+    an error (a short run warns of nothing):
+
+    >>> import warnings
+    >>> import fivdisc
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("error", fivdisc.FivdiscWarning)
+    ...     result = fivdisc.simulate(fivdisc.Case(simulation={"duration": 0.01}))
+    >>> result.ok
+    True
+    """
+
+
 def nearest(name: str, names: Iterable[str]) -> str:
     """The valid name closest to `name`, as the end of a message: ``"; did you mean
     'slider.mass'?"`` ("" if there are no names).

@@ -56,19 +56,41 @@ def figure_suffixes() -> tuple[str, ...]:
     return tuple(f".{name}" for name in sorted(FigureCanvasBase.get_supported_filetypes()))
 
 
+#: Largest input text file (a case or sweep file) [bytes]: the largest packaged example
+#: is a few kilobytes, a sweep listing a million values some megabytes.
+MAX_TEXT_BYTES = 16 * 2**20
+
+
 def read_text(path: str | PathLike[str]) -> str:
-    """The UTF-8 text of an input file.
+    """The UTF-8 text of an input file, of at most :data:`MAX_TEXT_BYTES`.
 
     Raises
     ------
     FileNotFoundError
         The file does not exist (the command line reports it on one line).
     FivdiscError
-        The path is a directory, cannot be read, or is not UTF-8 text (e.g. a binary file).
+        The path is a directory or a device, is larger than :data:`MAX_TEXT_BYTES`,
+        cannot be read, or is not UTF-8 text (e.g. a binary file). A device (``/dev/zero``)
+        or a file too large is refused before it is read; a pipe is read up to the limit.
     """
+    import stat
+
     path = Path(path)
+    limit = f"{MAX_TEXT_BYTES // 2**20} MiB"
     try:
-        return path.read_text(encoding="utf-8")
+        status = path.stat()
+        if stat.S_ISCHR(status.st_mode) or stat.S_ISBLK(status.st_mode):
+            raise FivdiscError(f"{path} is a device, not a file: give a TOML file")
+        if stat.S_ISREG(status.st_mode) and status.st_size > MAX_TEXT_BYTES:
+            raise FivdiscError(f"{path} is {status.st_size / 2**20:.3g} MiB: an input text "
+                               f"file must be at most {limit}; give a TOML file")
+        with path.open("rb") as f:  # a pipe: read up to the limit
+            data = f.read(MAX_TEXT_BYTES + 1)
+        if len(data) > MAX_TEXT_BYTES:
+            raise FivdiscError(f"{path} holds more than {limit}: an input text file must be "
+                               f"at most {limit}; give a TOML file")
+        # Newlines as a text file reads them (universal newlines).
+        return data.decode("utf-8").replace("\r\n", "\n").replace("\r", "\n")
     except UnicodeDecodeError as exc:
         raise FivdiscError(
             f"{path} is not a text file: byte {exc.object[exc.start]:#04x} at offset "
@@ -156,7 +178,8 @@ def write_atomic(path: str | PathLike[str], write: Callable[[Path], Any]) -> Non
 
     The temporary file lies in the same directory and keeps the suffix (matplotlib picks
     the format from it); it is removed if `write` fails or is interrupted, so `path` is
-    either the complete new file or what it was before.
+    either the complete new file or what it was before. One that a killed process left
+    (SIGKILL, a power cut) is removed by the next write of `path`.
 
     Parameters
     ----------
@@ -166,12 +189,35 @@ def write_atomic(path: str | PathLike[str], write: Callable[[Path], Any]) -> Non
         Writes the content to the path it is given, e.g. ``dataset.to_netcdf``.
     """
     path = Path(path)
+    _remove_stale(path)
     tmp = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
     try:
         write(tmp)
         tmp.replace(path)
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def _remove_stale(path: Path) -> None:
+    """Remove the temporary files of :func:`write_atomic` for `path` that a killed
+    process left (``.STEM.PID.tmpSUFFIX`` of a process that no longer runs)."""
+    prefix, suffix = f".{path.stem}.", f".tmp{path.suffix}"
+    try:
+        names = os.listdir(path.parent)
+    except OSError:
+        return
+    for name in names:
+        pid = name[len(prefix):len(name) - len(suffix)]
+        if not (name.startswith(prefix) and name.endswith(suffix) and pid.isdigit()):
+            continue
+        try:
+            os.kill(int(pid), 0)
+            continue  # still running: its write may be under way
+        except ProcessLookupError:
+            pass
+        except (PermissionError, OverflowError, ValueError):
+            continue  # another user's process, or not a process id
+        (path.parent / name).unlink(missing_ok=True)
 
 
 def _groups(group: Any) -> Iterator[Any]:
@@ -256,9 +302,12 @@ def check_netcdf(path: str | PathLike[str]) -> bool:
         if stored is None:
             return False
         actual = netcdf_checksum(path)
-    except (OSError, RuntimeError, ValueError) as exc:
-        raise FivdiscError(f"{path} is damaged: it cannot be read ({' '.join(str(exc).split())})"
-                           "; write it again") from None
+    except Exception as exc:
+        # A damaged file makes the netCDF library fail in many ways: OSError, RuntimeError,
+        # ValueError, and AttributeError for a damaged attribute ("Can't open HDF5
+        # attribute"), among others.
+        raise FivdiscError(f"{path} is damaged: it cannot be read ({_brief(exc)}); write it "
+                           "again") from None
     if actual != stored:
         raise FivdiscError(f"{path} is damaged: its data do not match the checksum stored in "
                            f"it ({CHECKSUM}); write it again")
@@ -371,10 +420,16 @@ def read_dataset(path: str | PathLike[str], option: str):
     if not (magic[:3] == b"CDF" or magic == b"\x89HDF"):
         raise FivdiscError(f"{option} {path}: is not a netCDF file: give one that fivdisc "
                            "wrote with -o (a case file goes where a command takes CASE_FILE)")
+    check_netcdf(path)
     try:
-        check_netcdf(path)
         with xr.open_dataset(path) as ds:
             return ds.load()
-    except (OSError, ValueError) as exc:
+    except Exception as exc:  # as in check_netcdf: the types vary
         raise FivdiscError(f"{option} {path}: cannot be read as a netCDF file "
-                           f"({' '.join(str(exc).split())[:120]})") from None
+                           f"({_brief(exc)})") from None
+
+
+def _brief(exc: BaseException) -> str:
+    """An exception of a reader as one short line (its type if it says nothing)."""
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text[:120]

@@ -29,13 +29,18 @@ __all__ = [
     "MAX_NODAL_CIRCLES",
     "MAX_NODAL_DIAMETERS",
     "MAX_RASTER_SIDE",
+    "MAX_SHOOTING_RTOL",
+    "MAX_SHOOTING_TOL",
     "MAX_SLIDERS",
     "MIN_RADIUS_RATIO",
+    "MIN_SHOOTING_RTOL",
+    "MIN_SHOOTING_TOL",
     "available_memory",
     "check_memory",
     "check_raster",
     "check_simulation",
     "disc_problem",
+    "duration_words",
     "simulation_bytes",
 ]
 
@@ -47,6 +52,16 @@ MIN_RADIUS_RATIO = 1e-3
 #: their number, and a switch re-checks every slider (measured: 1.8 s to choose the
 #: phases at the start of 100 sliders, 0.2 s per 20 steps; 1000 never got past the start).
 MAX_SLIDERS = 100
+#: Integration tolerances a periodic orbit's shooting runs accept: below the lower, the
+#: error control asks for less than double precision's round-off (unbounded work); above
+#: the upper, as for ``simulation.rtol``, the integrator no longer resolves the dynamics.
+MIN_SHOOTING_RTOL = 1e-14
+MAX_SHOOTING_RTOL = 0.1
+#: Shooting residuals (relative to the orbit's size) an orbit may be converged to: above
+#: the upper, the first return of a transient already meets it (0.5 % on Table 1) and
+#: the "orbit" is a trajectory that does not close; below the lower, round-off.
+MIN_SHOOTING_TOL = 1e-14
+MAX_SHOOTING_TOL = 1e-4
 #: Largest raster side matplotlib's Agg renderer draws [pixels].
 MAX_RASTER_SIDE = 2**16 - 1
 # Share of the available memory one request may plan to use.
@@ -68,6 +83,14 @@ def available_memory() -> int:
 
 def _size(nbytes: float) -> str:
     return f"{nbytes / _GiB:.3g} GiB"
+
+
+def duration_words(seconds: float) -> str:
+    """A duration in the unit a person reads it in: "40 s", "12 min", "3.2 h", "4.1 days"."""
+    for unit, size in (("days", 86400.0), ("h", 3600.0), ("min", 60.0)):
+        if seconds >= 2 * size:
+            return f"{seconds / size:.2g} {unit}"
+    return f"{seconds:.2g} s"
 
 
 def check_memory(nbytes: float, what: str, change: str) -> None:

@@ -139,8 +139,10 @@ def test_huge_stability_grid_is_refused_at_once() -> None:
     _one_line_error(["stability", "--x", "normal_damping=0:12:100000",
                      "--y", "rotational_damping=0:2:100000"],
                     "a stability map of 100000 x 100000 points", "use fewer points per axis")
+    # The map's size is checked before any axis' values are made (issue 40, item 5).
     _one_line_error(["stability", "--x", "normal_damping=0:12:1000000000000",
-                     "--y", "rotational_damping=0:2:10"], "--x with N = 1000000000000 values")
+                     "--y", "rotational_damping=0:2:10"],
+                    "a stability map of 1000000000000 x 10 points")
 
 
 def test_huge_sweeps_are_refused_at_once() -> None:

@@ -128,10 +128,13 @@ def test_numpy_values_are_accepted() -> None:
 
 @pytest.mark.parametrize("profile", list(SPEEDS))
 def test_round_trip(profile: str, tmp_path: Path) -> None:
+    # A perturbation of the equilibrium (a nested table) where there is one to perturb.
+    start = ({"initial_state": "equilibrium", "perturbation": {"phi_dot": -0.25}}
+             if profile == "constant" else {})
     case = Case(
         speed=SPEEDS[profile],
         slider={"normal_damping": 2.0},
-        simulation={"probes": [[0.05, 0.5]], "perturbation": {"phi_dot": -0.25}},
+        simulation={"probes": [[0.05, 0.5]], **start},
     )
     path = tmp_path / "case.toml"
     case.save(path)
@@ -476,8 +479,10 @@ def test_replace_dotted_keys() -> None:
 def test_replace_whole_table() -> None:
     new = Case().replace({"speed": {"profile": "decelerating", "initial": 10.0, "duration": 20.0}})
     assert new.speed == DeceleratingSpeed(initial=10.0, duration=20.0)
-    new = Case().replace({"simulation": {"duration": 3.0}, "simulation.perturbation.phi": 0.5})
-    assert new.simulation == Simulation(duration=3.0, perturbation={"phi": 0.5})
+    new = Case().replace({"simulation": {"duration": 3.0, "initial_state": "equilibrium"},
+                          "simulation.perturbation.phi": 0.5})
+    assert new.simulation == Simulation(duration=3.0, initial_state="equilibrium",
+                                        perturbation={"phi": 0.5})
 
 
 def test_replace_profile_starts_speed_afresh() -> None:

@@ -502,3 +502,60 @@ test_extreme_option_values = _profile(30, True)(
     given(args=EXTREME_COMMANDS)(_extreme_option_property))
 test_extreme_case_values_long = pytest.mark.slow(
     _profile(500, False)(given(extreme_cases())(_extreme_case_property)))
+
+
+# --- issue 40, item 7: no numpy warning before a one-line error ------------------------------
+
+
+@pytest.mark.parametrize("command", [["simulate"], ["stability", "--json"]])
+def test_no_numpy_warning_before_a_one_line_error(tmp_path: Path, command: list[str]) -> None:
+    """disc.damping_ratio = 1e300 overflowed in the model's arrays: numpy's "overflow
+    encountered in multiply" (with its file and line) came before the one-line refusal of
+    the infinite rate."""
+    import warnings
+
+    path = tmp_path / "c.toml"
+    Case(disc={"damping_ratio": 1e300}).save(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")  # not once per place: every warning shows
+        result = run([command[0], str(path), *command[1:]])
+    assert result.exit_code == 2
+    lines = messages(result.stderr)
+    assert len(lines) == 1 and "disc.damping_ratio" in lines[0], result.stderr
+
+
+def test_numerical_warnings_are_dropped_when_a_command_fails(monkeypatch) -> None:
+    """Whatever numpy warns on the way to a refusal is not shown before the refusal's one
+    line (the command line holds numerical warnings until it knows how it ends)."""
+    import warnings
+
+    import numpy as np
+
+    from fivdisc.analysis import stability
+    from fivdisc.errors import AnalysisError
+
+    def overflowing(case):
+        np.float64(1e308) * 10.0
+        raise AnalysisError("refused")
+
+    monkeypatch.setattr(stability, "linear_stability", overflowing)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        result = run_cli(["stability"])
+    assert result.exit_code == 2 and messages(result.stderr) == ["error: refused"]
+
+
+def test_an_error_of_a_fresh_process_is_one_line_to_its_exit(tmp_path: Path) -> None:
+    """After the compiled core: an error whose traceback held the core's model in a
+    reference cycle ended with nanobind's report of it as leaked at the exit (some twenty
+    lines after the one-line error; the command line freezes the collector at exit)."""
+    import subprocess
+    import sys
+
+    path = tmp_path / "c.toml"
+    Case(slider={"preload": 1e12}).save(path)  # no sliding equilibrium is found
+    done = subprocess.run([sys.executable, "-m", "fivdisc", "stability", str(path), "--json"],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2
+    lines = messages(done.stderr)
+    assert len(lines) == 1 and lines[0].startswith("error: no sliding equilibrium"), done.stderr

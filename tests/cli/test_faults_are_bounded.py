@@ -417,8 +417,8 @@ API_MISUSE = [
      "initial phi = 1e+300 rad is invalid"),
     ("sliders at pi and -pi", lambda: Case(sliders=[{"angle": math.pi}, {"angle": -math.pi}]),
      "puts sliders.1 where sliders.0 is"),
-    ("sliders at 0 and 2 pi 1e6", lambda: Case(sliders=[{"angle": 0.0},
-                                                        {"angle": 2 * math.pi * 1e6}]),
+    ("sliders at 0 and 2 pi 1e5", lambda: Case(sliders=[{"angle": 0.0},
+                                                        {"angle": 2 * math.pi * 1e5}]),
      "puts sliders.1 where sliders.0 is"),
     ("thickness 1e308", lambda: Case(disc={"thickness": 1e308}),
      "disc.thickness = 1e+308 is invalid: must be < disc.outer_radius"),
@@ -443,9 +443,9 @@ def test_wrong_input_gets_the_librarys_one_line_error(name, call, words) -> None
 
 
 def test_sliders_apart_are_accepted() -> None:
-    """The same-place test leaves sliders a hair apart (1e-6 rad) alone, also at large
-    angles."""
-    Case(sliders=[{"angle": 2 * math.pi * 1e6}, {"angle": 2 * math.pi * 1e6 + 1e-6}])
+    """The same-place test leaves sliders a hair apart (1e-4 rad, 10 micrometres on the
+    track; issue 40 set the least distance at one) alone, also at large angles."""
+    Case(sliders=[{"angle": 2 * math.pi * 1e5}, {"angle": 2 * math.pi * 1e5 + 1e-4}])
 
 
 def test_a_callable_speed_is_recorded_as_such() -> None:

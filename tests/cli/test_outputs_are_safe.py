@@ -236,3 +236,40 @@ def test_reproduce_outdir_checked(tmp_path: Path) -> None:
     result = run_cli(["reproduce", "--figures", "3", "-o", str(tmp_path / "file")])
     assert result.exit_code == 2 and "is a file" in result.stderr  # click's usage error
     assert (tmp_path / "file").read_text() == "x"
+
+
+# --- issue 40, item 5: a killed write ----------------------------------------------------------
+
+KILLED_WRITER = """
+import os, signal, sys
+from pathlib import Path
+from fivdisc.files import write_atomic
+
+def write(tmp: Path) -> None:
+    tmp.write_bytes(b"half a file")
+    os.kill(os.getpid(), signal.SIGKILL)  # killed while writing
+
+write_atomic(Path(sys.argv[1]), write)
+"""
+
+
+def test_a_temporary_file_of_a_killed_write_is_removed_by_the_next(case_file: Path,
+                                                                     tmp_path: Path) -> None:
+    """A SIGKILL during -o left .r.PID.tmp.nc behind for good; the next write of the same
+    output removes the leftovers of processes that no longer run (and of no other)."""
+    import subprocess
+    import sys
+
+    out = tmp_path / "r.nc"
+    killed = subprocess.run([sys.executable, "-c", KILLED_WRITER, str(out)], timeout=120)
+    assert killed.returncode == -9
+    left = list(tmp_path.glob(".r.*.tmp.nc"))
+    assert len(left) == 1 and not out.exists()
+    alive = tmp_path / f".r.{os.getppid()}.tmp.nc"  # a write under way in a live process
+    alive.write_bytes(b"")
+    mine = tmp_path / ".r.backup.tmp.nc"  # not a process id: a user's file
+    mine.write_bytes(b"")
+    result = run_cli(["simulate", case_file, "-o", out, "--no-progress"])
+    assert result.exit_code == 0, result.output
+    assert out.is_file()
+    assert sorted(tmp_path.glob(".r.*.tmp.nc")) == sorted([alive, mine])

@@ -356,3 +356,95 @@ def test_checksums_a_column_at_a_time_are_the_point_by_point_definition() -> Non
     indices = list(range(7, 7 + n))
     expected = [_checksum_of("d1g", i, [c[k] for c in columns]) for k, i in enumerate(indices)]
     assert checksums("d1g", indices, columns).tolist() == expected
+
+
+# --- issue 40, item 6: stores repaired, not recomputed ---------------------------------------
+
+
+def _raw_done(store: Path) -> np.ndarray:
+    """The done flags as stored (not as open_sweep derives them)."""
+    import zarr
+
+    return zarr.open_array(store / "done", mode="r")[...].ravel()
+
+
+def _repaired_without_recomputing(store: Path, reference) -> None:
+    report = _timed_rerun(store)
+    assert (report.already_done, report.computed) == (N, 0)
+    status, out, _ = _verify(store)
+    assert status == 0, out
+    assert _raw_done(store).all()
+    repaired = open_sweep(store)
+    assert repaired.identical(reference.assign_attrs(history=repaired.attrs["history"]))
+
+
+def test_a_deleted_group_metadata_file_is_rebuilt_from_the_sweep(store: Path) -> None:
+    """A deleted top-level zarr.json (chunks intact) was "not a Zarr store" and the rerun
+    refused it; a garbage one was rebuilt. Both are now."""
+    reference = open_sweep(store)
+    (store / "zarr.json").unlink()
+    status, _, err = _verify(store)
+    assert status == 2 and err.count("\n") == 1
+    assert "zarr.json is missing); rerun the sweep that wrote it to rebuild it" in err
+    _repaired_without_recomputing(store, reference)
+
+
+def test_a_changed_codec_is_restored_and_the_points_kept(store: Path) -> None:
+    """A codec changed in a variable's metadata made every chunk undecodable: all points
+    recomputed. The rerun restores the sweep's codecs (those under which more points
+    verify) and keeps every point."""
+    reference = open_sweep(store)
+    _set_meta("max_abs_w", "codecs", [{"name": "bytes", "configuration": {"endian": "little"}},
+                                      {"name": "gzip", "configuration": {"level": 5}}])(store)
+    status, out, _ = _verify(store)
+    assert status == 1 and f"{N} damaged" in out
+    _repaired_without_recomputing(store, reference)
+
+
+def test_codecs_of_the_chunks_are_kept_where_the_sweeps_would_lose_points(store: Path) -> None:
+    """Chunks written with other codecs (as another version of Zarr may) verify with the
+    codecs their metadata names: the rerun leaves those, and recomputes nothing."""
+    import zarr
+
+    reference = open_sweep(store)
+    path = store / "max_abs_w"
+    values = zarr.open_array(path, mode="r")[...]
+    meta = json.loads((path / "zarr.json").read_text())
+    for chunk in (path / "c").rglob("*"):
+        if chunk.is_file():
+            chunk.unlink()
+    array = zarr.create_array(path, shape=values.shape, chunks=tuple(
+        meta["chunk_grid"]["configuration"]["chunk_shape"]), dtype="float64",
+        fill_value=np.nan, compressors=[zarr.codecs.GzipCodec(level=5)], overwrite=True,
+        dimension_names=meta["dimension_names"], attributes=meta["attributes"])
+    array[...] = values
+    assert verify_store(store).complete.all()
+    _repaired_without_recomputing(store, reference)
+    assert "gzip" in (path / "zarr.json").read_text()
+
+
+@pytest.mark.parametrize("lost", ["done", "done/c"])
+def test_lost_done_flags_keep_the_points_whose_checksums_hold(store: Path, lost: str) -> None:
+    """A deleted done/ (or its chunks) lost every point: they were recomputed. The
+    checksums cover the points' values, so the points verify without their flags, and the
+    rerun rebuilds the metadata and writes the flags again."""
+    import shutil
+
+    reference = open_sweep(store)
+    shutil.rmtree(store / lost)
+    assert verify_store(store).complete.all()
+    _repaired_without_recomputing(store, reference)
+
+
+def test_verify_does_not_call_intact_points_not_computed(store: Path) -> None:
+    """With done/c deleted, --verify said "6 not computed" and exit status 0: the points'
+    values were intact. It says they verify, that their flags are lost, and that the store
+    needs the rerun that writes them (status 1)."""
+    import shutil
+
+    shutil.rmtree(store / "done" / "c")
+    status, out, err = _verify(store)
+    assert f"{N} complete and verified (1 of them failed runs), 0 not computed, 0 damaged" in out
+    assert f"{N} complete points lost their done flags (their values verify by their " \
+           "checksums; a rerun writes the flags again)" in out
+    assert status == 1 and err.startswith("error: ") and err.count("\n") == 1

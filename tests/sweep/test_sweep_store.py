@@ -257,8 +257,10 @@ def test_a_store_of_one_point_per_chunk_is_read_and_verified_not_resumed(
     # complete: a rerun (as `fivdisc bifurcation` does before drawing) computes nothing
     report = run_sweep(SPEC, path, workers=1, progress=False)
     assert (report.already_done, report.computed) == (N, 0)
-    # a point missing: refused before any work, the store left as it was
+    # a point missing: refused before any work, the store left as it was (its flag and
+    # checksum unset: a lost flag alone is no missing point, the checksum verifies it)
     _tamper(path, "done", 5, False)
+    _tamper(path, "checksum", 5, 0)
     files = sorted((f, f.read_bytes()) for f in path.rglob("*") if f.is_file())
     with pytest.raises(SweepError, match=r"old.zarr holds one point per chunk \(store format "
                                          r"4\); this version reads it but resumes only stores "

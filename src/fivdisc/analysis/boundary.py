@@ -42,6 +42,8 @@ class _Growth:
         self.points, self.lo, self.span = points, lo, span
         self.calls = 0
         self.guess = None
+        # The growth rates on the seed grid (rows along y), once computed.
+        self.seed_values = np.empty((0, 0))
 
     def values(self, u: np.ndarray) -> tuple[float, float]:
         return tuple(self.lo + self.span * np.asarray(u))
@@ -79,6 +81,8 @@ def _seeds(g: _Growth, m: int) -> dict[tuple, np.ndarray]:
     """Boundary points on the edges of an m x m grid over the unit box, by edge."""
     grid = np.linspace(0.0, 1.0, m)
     values = np.array([[g(np.array([x, y])) for x in grid] for y in grid])
+    if isinstance(g, _Growth):
+        g.seed_values = values
     seeds = {}
     for iy in range(m):
         for ix in range(m):
@@ -197,7 +201,9 @@ def stability_boundary(
         real eigenvalue crosses), ``growth_rate`` [1/s] (the largest real part there,
         zero to the root finder's tolerance); ``closed`` (per branch); attributes
         ``x_key``, ``y_key``, ``x_range``, ``y_range``, ``evaluations`` (eigen-solves
-        made) and the case.
+        made), ``seeds`` (seed lines a side) with ``seeds_stable``, ``seeds_unstable``
+        and ``seeds_without_equilibrium`` (how the seed grid's points came out: without
+        a curve, a boundary can still enclose a region between them) and the case.
 
     Raises
     ------
@@ -241,7 +247,7 @@ def stability_boundary(
         raise CaseError(f"seeds = {seeds}, step = {step} are invalid: need seeds >= 2 and "
                         "step > 0")
     check_keys(case, [xkey, ykey], ["x", "y"])
-    check_box(case, [(xkey, xr_), (ykey, yr_)])
+    check_box(case, [(xkey, xr_), (ykey, yr_)], ["x", "y"])
     points = ParameterPoints(case, [xkey, ykey])
     points.require_equilibrium((xr_[0], yr_[0]), "--boundary")
     lo = np.array([xr_[0], yr_[0]])
@@ -302,6 +308,7 @@ def _dataset(case: Case, g: _Growth, branches, x, y) -> xr.Dataset:
             lam, mode = g.critical(u)
             rows.append((*g.values(u), b, lam.real, abs(lam.imag) / (2 * np.pi), mode))
     evaluations = g.calls
+    seeds = g.seed_values
     cols = list(zip(*rows, strict=True)) if rows else [[]] * 6
     return xr.Dataset(
         {
@@ -323,5 +330,9 @@ def _dataset(case: Case, g: _Growth, branches, x, y) -> xr.Dataset:
                               "fivdisc.stability_boundary"),
                "fivdisc_kind": "stability_boundary", "x_key": xkey, "y_key": ykey,
                "x_range": np.asarray(xr_, dtype=float), "y_range": np.asarray(yr_, dtype=float),
-               "evaluations": evaluations, "case": case.to_toml()},
+               "evaluations": evaluations, "seeds": seeds.shape[0],
+               "seeds_stable": int(np.sum(seeds < 0.0)),
+               "seeds_unstable": int(np.sum(seeds >= 0.0)),
+               "seeds_without_equilibrium": int(np.sum(np.isnan(seeds))),
+               "case": case.to_toml()},
     )

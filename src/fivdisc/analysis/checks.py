@@ -12,15 +12,36 @@ import math
 
 from fivdisc.case import Case
 from fivdisc.errors import FivdiscError
+from fivdisc.limits import (
+    MAX_SHOOTING_RTOL,
+    MAX_SHOOTING_TOL,
+    MIN_SHOOTING_RTOL,
+    MIN_SHOOTING_TOL,
+)
 
-__all__ = ["MAX_RTOL", "MIN_RTOL", "check_orbit_request", "check_period", "check_time",
-           "shortest_period"]
+__all__ = ["MAX_RTOL", "MAX_TOL", "MIN_RTOL", "MIN_TOL", "check_orbit_request",
+           "check_period", "check_time", "check_tol", "shortest_period"]
 
-#: Tolerances the shooting runs accept: below MIN_RTOL the error control asks for less
-#: than double precision's round-off (unbounded work); above MAX_RTOL, as for
-#: ``simulation.rtol``, the integrator no longer resolves the dynamics.
-MIN_RTOL = 1e-14
-MAX_RTOL = 0.1
+# Below this preload [N] a normal force has no physical meaning (a millionth of a gram's
+# weight; fivdisc.engine.simulation._NO_FORCE, which calls such a run degenerate).
+_NO_FORCE = 1e-9
+#: Tolerances the shooting runs accept (:data:`fivdisc.limits.MIN_SHOOTING_RTOL`).
+MIN_RTOL = MIN_SHOOTING_RTOL
+MAX_RTOL = MAX_SHOOTING_RTOL
+#: Shooting residuals an orbit may be converged to (:data:`fivdisc.limits.MAX_SHOOTING_TOL`).
+MIN_TOL = MIN_SHOOTING_TOL
+MAX_TOL = MAX_SHOOTING_TOL
+
+
+def check_tol(name: str, value: float) -> None:
+    """Refuse a tolerance of the shooting residual outside [:data:`MIN_TOL`,
+    :data:`MAX_TOL`]: above it a trajectory that does not close passes for an orbit."""
+    if isinstance(value, bool) or not (isinstance(value, int | float)
+                                       and MIN_TOL <= value <= MAX_TOL):
+        raise FivdiscError(f"{name} = {value!r} is invalid: must lie in [{MIN_TOL:g}, "
+                           f"{MAX_TOL:g}] (the shooting residual relative to the orbit's "
+                           "size: above it a trajectory that does not close passes for an "
+                           "orbit)")
 
 
 def check_time(name: str, value: float | None, *, zero: bool = False) -> None:
@@ -92,9 +113,16 @@ def check_orbit_request(case: Case, *, period: float | None = None,
     if not case.disc.modes:
         raise FivdiscError("disc.modes = [] is invalid for a periodic orbit: a rigid disc "
                            "has no disc coordinates to shoot on; give at least one mode")
-    if not any(s.preload for s in case.sliders):
-        raise FivdiscError("slider.preload = 0 is invalid for a periodic orbit: without a "
-                           "normal force nothing drives the disc, which stays at rest")
+    # As a run's degeneracy test (fivdisc.engine.simulation.degenerate) counts it: below
+    # a nanonewton a normal force has no physical meaning (2.2e-308 N drove the shooting
+    # to subnormal states, a ZeroDivisionError in the kernel).
+    strongest = max(range(len(case.sliders)), key=lambda j: case.sliders[j].preload)
+    preload = case.sliders[strongest].preload
+    if not preload > _NO_FORCE:
+        raise FivdiscError(f"{case.slider_key(strongest)}.preload = {preload:g} is invalid "
+                           f"for a periodic orbit: must be > {_NO_FORCE:g} N for some slider "
+                           "(without a normal force nothing drives the disc, which stays at "
+                           "rest)")
     if period is not None:
         check_period(case, period, p_name)
     else:

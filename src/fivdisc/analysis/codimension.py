@@ -672,7 +672,7 @@ def hopf_curves(
         raise CaseError(f"seeds = {seeds}, step = {step} are invalid: need seeds >= 2 and "
                         "step > 0")
     check_keys(case, [xkey, ykey], ["x", "y"])
-    check_box(case, [(xkey, xr_), (ykey, yr_)])
+    check_box(case, [(xkey, xr_), (ykey, yr_)], ["x", "y"])
     points = ParameterPoints(case, [xkey, ykey])
     points.require_equilibrium((xr_[0], yr_[0]), "--hopf-curves")
     lo = np.array([xr_[0], yr_[0]])

@@ -16,10 +16,17 @@ from collections.abc import Sequence
 import numpy as np
 import xarray as xr
 
-from fivdisc.analysis.points import ParameterPoints, check_box, check_keys, check_values
+from fivdisc.analysis.points import (
+    ParameterPoints,
+    check_box,
+    check_keys,
+    check_values,
+    warn_if_long,
+)
 from fivdisc.analysis.stability import mode_labels
 from fivdisc.case import Case
 from fivdisc.engine.equilibrium import Equilibrium, _evaluate
+from fivdisc.limits import check_memory
 from fivdisc.model.build import Model
 
 # Two branches' frequencies count as merged (a coupling) within this fraction of the
@@ -167,10 +174,14 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
     [219.4 223.5 224.9 225.1 224.7 224.2 223.7]
     """
     values = check_values(option, key, values)
+    check_memory(branch_bytes(case) * values.size, f"{option} with {values.size} values",
+                 "use fewer values")
     check_keys(case, [key], [option])
-    check_box(case, [(key, values)])
+    check_box(case, [(key, values)], [option])
     points = ParameterPoints(case, [key])
     points.require_equilibrium((values[0],), option)
+    warn_if_long(points, (values[0],), values.size, f"eigenvalue branches along {key}",
+                 f"fewer values of {option}")
     size, ns = points.size, points.base.n_sliders
     lam = np.full((values.size, size), np.nan + 1j * np.nan)
     force = np.full((values.size, ns), np.nan)
@@ -228,6 +239,15 @@ def _branch_labels(model: Model, jac: np.ndarray, row: np.ndarray) -> tuple[str,
     # round-off; the assignment keeps a double eigenvalue's two apart.
     _, order = linear_sum_assignment(np.abs(row[:, None] - lam[None, :]))
     return tuple(labels[j] for j in order)
+
+
+def branch_bytes(case: Case) -> float:
+    """Memory of :func:`eigen_branches` per value of the key [bytes]: the eigenvalues
+    (complex), their copy followed into branches, the dataset's growth rates and
+    frequencies, the equilibrium's forces, angles and deflections, and the netCDF
+    writer's copies."""
+    size = 2 * (sum(1 if l == 0 else 2 for _, l in case.disc.modes) + len(case.sliders))
+    return 2.0 * (16 * 2 * size + 16 * size + 24 * len(case.sliders) + 8)
 
 
 def _last_valid(lam: np.ndarray, i: int) -> int:

@@ -23,14 +23,24 @@ import xarray as xr
 
 from fivdisc import core
 from fivdisc.analysis.normalform import first_lyapunov
-from fivdisc.analysis.points import ParameterPoints, reduced_indices
+from fivdisc.analysis.points import (
+    ParameterPoints,
+    check_jacobian,
+    reduced_indices,
+    slip_jacobian,
+)
 from fivdisc.case import Case
-from fivdisc.engine.equilibrium import Equilibrium, _evaluate, slip_phases
+from fivdisc.engine.equilibrium import Equilibrium, _evaluate, sliding_equilibrium, slip_phases
+from fivdisc.errors import AnalysisError, SimulationError
 from fivdisc.model.build import Model
 
 # Relative tolerance of the located value of the key (Brent's method; the growth rate is
 # smooth in the key, so the root is found to about this, far inside the 1e-8 promised).
 KEY_TOLERANCE = 1e-12
+# Growth rates within this fraction of the largest eigenvalue's modulus are round-off: no
+# sign, no crossing (the eigenvalues are computed to about 2.2e-16 times it; an undamped
+# mode's growth rate of exactly 0 comes out as +-5e-13 beside a 3600 1/s slider rate).
+ROUND_OFF = 1e-12
 
 
 @dataclass(frozen=True)
@@ -182,19 +192,45 @@ def _full_layout(model: Model, eq: Equilibrium, vector: np.ndarray
 
 
 def _locate(points: ParameterPoints, key: str, lo: float, hi: float, row_lo: np.ndarray,
-            row_hi: np.ndarray, b: int, labels: Sequence[str], guess: Equilibrium
-            ) -> HopfPoint:
+            row_hi: np.ndarray, b: int, labels: Sequence[str],
+            guesses: Sequence[Equilibrium], option: str) -> HopfPoint | None:
     """The Hopf point of branch `b` between `lo` and `hi` (its followed rows of
-    eigenvalues there `row_lo`, `row_hi`), its other modes named by `labels`."""
+    eigenvalues there `row_lo`, `row_hi`), its other modes named by `labels`; None if
+    the growth rates recomputed at the ends do not change sign (a crossing at round-off
+    level). `guesses` are the equilibria at the ends (those found)."""
     from scipy.optimize import brentq, linear_sum_assignment
 
     lam_lo, lam_hi = row_lo[b], row_hi[b]
+
+    def linearise(value: float) -> tuple:
+        near = list(guesses if abs(value - lo) <= abs(value - hi) else guesses[::-1])
+        point = points.linearise((value,), near[0] if near else None)
+        if point is not None:
+            return point
+        # From the other end's equilibrium, or the rigid-disc guess: in a bracket spanning
+        # decades of the key the nearest end's may not converge.
+        model = points.model((value,))
+        failure: Exception | None = None
+        for guess in [*near[1:], None]:
+            try:
+                eq = sliding_equilibrium(model, guess=guess)
+            except SimulationError as err:
+                failure = err
+                continue
+            jac = slip_jacobian(model, eq.state)
+            check_jacobian(model, eq.state, jac, f"at {key} = {value:g}: ")
+            return model, eq, jac
+        raise AnalysisError(
+            f"{option} {key}: a complex pair crosses the imaginary axis between {lo:g} and "
+            f"{hi:g}, but the sliding equilibrium is not found at {value:g} in between "
+            f"({failure}); give values closer together there"
+        )
 
     def eig_near(value: float) -> tuple:
         """The eigen-solution at `value` and which eigenvalue continues branch `b`: all
         of them matched to the branches interpolated there (so that near-equal
         eigenvalues, as identical pads have, each keep their own branch)."""
-        model, eq, jac = points.linearise((value,), guess)
+        model, eq, jac = linearise(value)
         lam, vec = np.linalg.eig(jac)
         t = (value - lo) / (hi - lo)
         _, column = linear_sum_assignment(
@@ -205,11 +241,16 @@ def _locate(points: ParameterPoints, key: str, lo: float, hi: float, row_lo: np.
         _, _, _, lam, _, i = eig_near(value)
         return float(lam[i].real)
 
+    if (growth(lo) < 0.0) == (growth(hi) < 0.0):
+        return None
     scale = max(abs(lo), abs(hi), abs(hi - lo))
     root = float(brentq(growth, lo, hi, xtol=KEY_TOLERANCE * scale, rtol=1e-15))
     model, eq, jac, lam, vec, i = eig_near(root)
+    # The slope by a central difference, kept inside the bracket (a root at its end, such
+    # as a key's lowest allowed value, has no values beyond it).
     step = 1e-6 * abs(hi - lo)
-    rate = (growth(root + step) - growth(root - step)) / (2.0 * step)
+    a, c = max(min(lo, hi), root - step), min(max(lo, hi), root + step)
+    rate = (growth(c) - growth(a)) / (c - a)
     pick = i if lam[i].imag > 0 else int(np.argmin(np.abs(lam - np.conj(lam[i]))))
     pair = [i, int(np.argmin(np.abs(lam - np.conj(lam[i]))))]
     others = np.delete(lam.real, pair)
@@ -312,15 +353,18 @@ def hopf_points(case: Case, key: str, values: Sequence[float], option: str = "ke
     for i in range(values.size - 1):
         if not _crossed(lam[i], lam[i + 1]):
             continue
-        guess = points.equilibrium(points.model((values[i],)))
+        ends = [points.equilibrium(points.model((v,))) for v in values[i : i + 2]]
+        guess = ends[0]
         # Between the two values the branches are followed again in steps short enough
         # to keep near-equal eigenvalues apart (identical pads), from the first value's
         # order, and each crossing is located on its own sub-step.
         sub, rows = _refine(points, values[i], values[i + 1], lam[i], lam[i + 1], guess)
         for k in range(sub.size - 1):
             for b in _crossed(rows[k], rows[k + 1]):
-                found.append(_locate(points, key, sub[k], sub[k + 1], rows[k], rows[k + 1],
-                                     b, labels, guess))
+                hopf = _locate(points, key, sub[k], sub[k + 1], rows[k], rows[k + 1], b,
+                               labels, [e for e in ends if e is not None], option)
+                if hopf is not None:
+                    found.append(hopf)
     ascending = values[-1] > values[0]
     return sorted(found, key=lambda h: h.value, reverse=not ascending)
 
@@ -334,12 +378,16 @@ _STEP_SHARE = 0.25
 
 def _crossed(row: np.ndarray, after: np.ndarray) -> list[int]:
     """The branches whose complex eigenvalue (positive imaginary part) crosses the
-    imaginary axis from `row` to `after`."""
+    imaginary axis from `row` to `after`. Growth rates within round-off of zero
+    (:data:`ROUND_OFF` of the largest eigenvalue's modulus) have no sign: an undamped
+    mode's come out as +-5e-13 at random, and are no crossing."""
     if not (np.isfinite(row).all() and np.isfinite(after).all()):
         return []
+    noise = ROUND_OFF * max(float(np.max(np.abs(row))), float(np.max(np.abs(after))))
     return [b for b in range(row.size)
             if (row[b].real < 0.0) != (after[b].real < 0.0)
-            and min(row[b].imag, after[b].imag) > 0]
+            and min(row[b].imag, after[b].imag) > 0
+            and min(abs(row[b].real), abs(after[b].real)) > noise]
 
 
 def _refine(points: ParameterPoints, lo: float, hi: float, row_lo: np.ndarray,

@@ -29,6 +29,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from fivdisc.analysis.checks import check_tol
 from fivdisc.analysis.symmetry import (
     ORBIT_SYMMETRY,
     CaseSymmetry,
@@ -37,7 +38,7 @@ from fivdisc.analysis.symmetry import (
     case_symmetry,
 )
 from fivdisc.case import Case
-from fivdisc.engine.integration import Integration, tangent_step
+from fivdisc.engine.integration import Integration, LongRunNotice, tangent_step
 from fivdisc.errors import ConvergenceError, FivdiscError
 from fivdisc.model import layout as lay
 from fivdisc.model.build import Model, build_model
@@ -322,6 +323,8 @@ class Shooting:
         if model.case.simulation.max_step > 0:
             cap = min(cap, model.case.simulation.max_step)
         self.cap = cap
+        # A time.monotonic() past which a shot stops (OutOfTime); None: no limit.
+        self.deadline: float | None = None
 
     def at(self, model: Model) -> Shooting:
         """The same shooting (phases, tolerances, scales) on another model."""
@@ -366,7 +369,10 @@ class Shooting:
         run.advance(0.0)
         rate_start = run.rhs()
         free = run.free()
-        run.run_to(period)
+        run.run_to(period, self.deadline)
+        if run.status_name == "running":
+            raise OutOfTime(f"the time budget ran out during a run over the period "
+                            f"({period:.6g} s) at t = {run.t:.9g} s")
         if run.status_name != "success":
             raise FivdiscError(f"the run over one period ({period:.6g} s) ended with "
                                f"{run.status_name} at t = {run.t:.9g} s")
@@ -595,6 +601,11 @@ def _stall(shooting: Shooting, sol: _Newton) -> Stall:
                  "motion there may not be periodic (check with a forward run)", eps)
 
 
+class OutOfTime(Exception):
+    """A shot stopped at its :attr:`Shooting.deadline` (not a FivdiscError: a Newton
+    step does not try a smaller step after it)."""
+
+
 def _newton(shooting: Shooting, x0: np.ndarray, period: float, tol: float,
             max_iterations: int, deadline: float, bar=None) -> _Newton:
     """Newton shooting on (x0, T) from a guess, each step halved until it reduces the
@@ -634,6 +645,9 @@ def _newton(shooting: Shooting, x0: np.ndarray, period: float, tol: float,
             trial_x[free] += frac * step[:m] * sc[free]
             try:
                 trial = shooting.shoot(trial_x, trial_t)
+            except OutOfTime:
+                return _Newton(x0, period, shot, residual, iterations,
+                               "the time budget ran out")
             except FivdiscError:
                 continue
             trial_res = shooting.residual(trial, trial_x, trial_t)
@@ -648,6 +662,39 @@ def _newton(shooting: Shooting, x0: np.ndarray, period: float, tol: float,
             bar.update()
             bar.set_postfix_str(f"residual {residual:.2e}")
     return _Newton(x0, period, shot, residual, iterations, reason)
+
+
+# A search whose Newton iterations are estimated to take longer than this in all [s]
+# says so before the first (a FivdiscWarning): with many sliders one takes minutes.
+_LONG_SEARCH = 60.0
+# Iterations a search usually takes, for that estimate.
+_TYPICAL_ITERATIONS = 5
+# Fraction of the period a shot is timed over, for that estimate.
+_TIMED_SHOT = 0.05
+
+
+def _announce_shots(shooting: Shooting, x0: np.ndarray, period: float,
+                    time_budget: float) -> None:
+    """Warn when a Newton iteration (a run over the period carrying a tangent vector per
+    coordinate) is long, with its time measured on a part of the period."""
+    import warnings
+
+    from fivdisc.errors import FivdiscWarning
+    from fivdisc.limits import duration_words
+
+    start = time.perf_counter()
+    try:
+        shooting.shoot(x0, _TIMED_SHOT * period)
+    except FivdiscError:
+        return
+    shot = (time.perf_counter() - start) / _TIMED_SHOT
+    if shot * _TYPICAL_ITERATIONS > _LONG_SEARCH:
+        warnings.warn(
+            f"each Newton iteration takes about {duration_words(shot)} (a run over the "
+            f"period, {period:.3g} s, carrying {shooting.model.state_size} tangent vectors: "
+            f"one per coordinate of {shooting.model.n_sliders} sliders and the disc), "
+            f"measured; the search stops at its time budget, {duration_words(time_budget)}",
+            FivdiscWarning, stacklevel=3)
 
 
 def _returns_at(shooting: Shooting, x0: np.ndarray, period: float) -> int:
@@ -839,7 +886,8 @@ def periodic_orbit(
         raise FivdiscError(f"periodic_orbit needs a constant disc speed (speed.profile = "
                            f"'constant'), not {case.speed.profile!r}: with a varying speed "
                            "the system is not autonomous and has no free period")
-    for name, value in (("tol", tol), ("window", window), ("time_budget", time_budget)):
+    check_tol("tol", tol)
+    for name, value in (("window", window), ("time_budget", time_budget)):
         _positive(name, value)
     if not (np.isfinite(rtol) and 0 < rtol < 1e-2):
         raise FivdiscError(f"rtol = {rtol!r} is invalid: must be in (0, 1e-2)")
@@ -859,7 +907,8 @@ def periodic_orbit(
         duration = case.simulation.duration if transient is None else transient
         _positive("transient", duration, "s")
         run = Integration(model, y0, duration=duration, rtol=rtol, atol=atol_run)
-        run.run_to(duration)
+        run.run_to(duration, notice=LongRunNotice(model, duration, "the transient run",
+                                                  "a shorter transient takes less"))
         if run.status_name != "success":
             raise FivdiscError(f"periodic_orbit: the transient run ended with "
                                f"{run.status_name} at t = {run.t:.9g} s")
@@ -901,51 +950,72 @@ def periodic_orbit(
 
     from fivdisc.engine.progress import progress_bar
 
-    with progress_bar(max_iterations, "Newton shooting", "iteration", show=progress) as bar:
-        sol = _newton(shooting, x0, period, tol, max_iterations, deadline, bar)
+    shooting.shoot(x0, min(period, 1e-6), tangents=True)  # the tangents' set-up
+    _announce_shots(shooting, x0, period, time_budget)
+    # A shot stops at the budget (with many sliders one takes minutes), with some room
+    # left for the minimal period's and the multipliers' work after the iteration.
+    shooting.deadline = deadline
+    try:
+        with progress_bar(max_iterations, "Newton shooting", "iteration",
+                          show=progress) as bar:
+            sol = _newton(shooting, x0, period, tol, max_iterations, deadline, bar)
+    except OutOfTime as exc:  # in the first shot: no iterate to report
+        raise ConvergenceError(f"periodic_orbit: not converged: time_budget = "
+                               f"{time_budget:g} s ran out ({exc})", result=None,
+                               reason="the time budget ran out") from None
     accuracy = float("nan")
-    if sol.reason == STALL:
-        stall = _stall(shooting, sol)
-        if stall.kind == "accuracy" and shooting.rtol > _TIGHTEST:
-            # Once more at a tenth of the tolerance: a residual set by the integration's
-            # error falls with it; one that does not is that accuracy's.
-            tight = max(shooting.rtol / 10, _TIGHTEST)
-            shooting = (shooting.__class__(model, phases, tight, tight * 1e-7, shooting.matrix,
-                                           shooting.k)
-                        if isinstance(shooting, SymmetricShooting)
-                        else Shooting(model, phases, tight, tight * 1e-7))
-            again = _newton(shooting, sol.x0, sol.period, tol, max_iterations, deadline, bar)
-            again.iterations += sol.iterations
-            notes.append(f"Newton stalled within the integration's accuracy "
-                         f"({stall.accuracy:.1e}) at rtol {rtol:g}: solved again at rtol "
-                         f"{tight:g}")
-            sol = again
-            if sol.reason == STALL:
-                stall = _stall(shooting, sol)
-        if sol.reason == STALL and stall.kind == "accuracy":
-            sol.reason = ""
-            accuracy = stall.accuracy
-        elif sol.reason == STALL:
-            sol.reason = stall.text
-    elif not sol.reason and sol.residual > _POLISH * tol:
-        # Converged, but the polishing step did not take the residual below the
-        # tolerance's level: why not, from a fresh Newton step.
-        if sol.step is None:
-            sol.step = np.linalg.lstsq(shooting.jacobian(sol.shot),
-                                       np.r_[-shooting.gap(sol.shot, sol.x0), 0.0],
-                                       rcond=None)[0]
-        stall = _stall(shooting, sol)
-        if stall.kind == "discontinuous":
-            notes.append(f"converged to the tolerance {tol:g} but no further: {stall.text}")
-        elif stall.kind == "accuracy":
-            accuracy = stall.accuracy
-    if not sol.reason and not isinstance(shooting, SymmetricShooting):
-        k = _returns_at(shooting, sol.x0, sol.period)
-        if k > 1:
-            again = _newton(shooting, sol.x0, sol.period / k, tol, max_iterations, deadline)
-            if not again.reason and abs(again.period * k / sol.period - 1.0) < 1e-6:
+    try:
+        if sol.reason == STALL:
+            stall = _stall(shooting, sol)
+            if stall.kind == "accuracy" and shooting.rtol > _TIGHTEST:
+                # Once more at a tenth of the tolerance: a residual set by the integration's
+                # error falls with it; one that does not is that accuracy's.
+                tight = max(shooting.rtol / 10, _TIGHTEST)
+                shooting = (shooting.__class__(model, phases, tight, tight * 1e-7,
+                                               shooting.matrix, shooting.k)
+                            if isinstance(shooting, SymmetricShooting)
+                            else Shooting(model, phases, tight, tight * 1e-7))
+                shooting.deadline = deadline
+                again = _newton(shooting, sol.x0, sol.period, tol, max_iterations, deadline,
+                                bar)
                 again.iterations += sol.iterations
+                notes.append(f"Newton stalled within the integration's accuracy "
+                             f"({stall.accuracy:.1e}) at rtol {rtol:g}: solved again at rtol "
+                             f"{tight:g}")
                 sol = again
+                if sol.reason == STALL:
+                    stall = _stall(shooting, sol)
+            if sol.reason == STALL and stall.kind == "accuracy":
+                sol.reason = ""
+                accuracy = stall.accuracy
+            elif sol.reason == STALL:
+                sol.reason = stall.text
+        elif not sol.reason and sol.residual > _POLISH * tol:
+            # Converged, but the polishing step did not take the residual below the
+            # tolerance's level: why not, from a fresh Newton step.
+            if sol.step is None:
+                sol.step = np.linalg.lstsq(shooting.jacobian(sol.shot),
+                                           np.r_[-shooting.gap(sol.shot, sol.x0), 0.0],
+                                           rcond=None)[0]
+            stall = _stall(shooting, sol)
+            if stall.kind == "discontinuous":
+                notes.append(f"converged to the tolerance {tol:g} but no further: "
+                             f"{stall.text}")
+            elif stall.kind == "accuracy":
+                accuracy = stall.accuracy
+        if not sol.reason and not isinstance(shooting, SymmetricShooting):
+            # The minimal period, if the budget leaves time for it (else the orbit
+            # converged at a period that may be a multiple).
+            k = _returns_at(shooting, sol.x0, sol.period)
+            if k > 1:
+                again = _newton(shooting, sol.x0, sol.period / k, tol, max_iterations,
+                                deadline)
+                if not again.reason and abs(again.period * k / sol.period - 1.0) < 1e-6:
+                    again.iterations += sol.iterations
+                    sol = again
+    except OutOfTime:
+        pass
+    shooting.deadline = None
     shot = sol.shot
     if isinstance(shooting, SymmetricShooting):
         shot = shooting.full(shot if shot.monodromy is not None

@@ -18,9 +18,121 @@ import numpy as np
 from fivdisc import core
 from fivdisc.case import Case
 from fivdisc.engine.equilibrium import Equilibrium, sliding_equilibrium, slip_phases
-from fivdisc.errors import CaseError, SimulationError
+from fivdisc.errors import AnalysisError, CaseError, FivdiscError, SimulationError
+from fivdisc.limits import duration_words
 from fivdisc.model import layout as lay
 from fivdisc.model.build import Model, build_model, model_at
+
+#: Fastest rate [1/s] of a model whose linearisation is analysed. The eigenvalues are
+#: computed to about 2.2e-16 times the largest of them: 2e-4 1/s here, so that growth
+#: rates of order 1/s still decide stability. Beyond it they are round-off (measured on
+#: Table 1: the disc modes' growth rates hold to 1e-6 up to a slider damping rate of
+#: 1e15 1/s, change sign at 1e17 and are noise at 1e23, with Hopf points "at 0 Hz").
+#: A physical brake's fastest rate is below 1e7 1/s.
+MAX_RATE = 1e12
+# Case keys behind the names in the slider rates of
+# fivdisc.engine.integration.time_scales (the inertia is mass * track_radius^2).
+_RATE_KEYS = {"inertia": ("mass", "track_radius")}
+
+
+def model_rates(model: Model) -> list[tuple[str, float]]:
+    """The rates [1/s] of :func:`fivdisc.engine.integration.time_scales` and the disc's
+    spin at its largest speed, times the largest nodal-diameter count (at least 1)."""
+    from fivdisc.engine.integration import time_scales
+
+    omega = abs(float(np.max(np.abs(model.speed.omega(np.array([0.0]))))))
+    turns = max(1, int(np.max(model.l, initial=0)))
+    with np.errstate(all="ignore"):
+        spin = omega * turns
+    return [*time_scales(model),
+            (f"speed.value: the disc's spin times {turns} (its largest nodal-diameter count, "
+             "at least 1)", spin)]
+
+
+def _rate_settings(case: Case, what: str) -> str:
+    """The case's keys and values behind one rate of :func:`model_rates`, in words."""
+    import re
+
+    head, _, expression = what.partition(": ")
+    if head in ("slider",) or head.startswith("sliders."):
+        names = [n for n in re.findall(r"[a-z_]+", expression) if n != "sqrt"]
+        keys = [k for n in names for k in _RATE_KEYS.get(n, (n,))]
+        shown = [f"{head}.{k} = {case.get(f'{head}.{k}')!r}" for k in dict.fromkeys(keys)]
+        return f" ({', '.join(shown)})"
+    if head == "speed.value":
+        return f" (speed.value = {case.get('speed.value')!r} rad/s)" if (
+            case.speed.profile == "constant") else ""
+    if what.startswith("disc.damping_ratio"):
+        return f" (disc.damping_ratio = {case.disc.damping_ratio!r})"
+    return ""
+
+
+def check_rates(model: Model, where: str = "") -> None:
+    """Refuse a model whose linearisation cannot decide stability: a rate of
+    :func:`model_rates` that is not finite or exceeds :data:`MAX_RATE`.
+
+    Parameters
+    ----------
+    model
+        The model (of a constant-speed case).
+    where
+        Prefixes the message (e.g. ``"--x slider.normal_damping = 1e+20: "``).
+
+    Raises
+    ------
+    AnalysisError
+        Naming the rate, the keys and values that set it, and what is allowed.
+    """
+    for what, rate in model_rates(model):
+        if not rate <= MAX_RATE:
+            raise AnalysisError(
+                f"{where}{what} = {rate:.3g} 1/s{_rate_settings(model.case, what)} is out of "
+                f"range for a stability analysis: must be <= {MAX_RATE:g} 1/s (the "
+                "eigenvalues are computed to about 2.2e-16 times the fastest rate of the "
+                "model, so beyond it the growth rates that decide stability are round-off); "
+                "change that parameter"
+            )
+
+
+def check_jacobian(model: Model, state: np.ndarray, jac: np.ndarray, where: str = "") -> None:
+    """Refuse a slip Jacobian (`jac`, at `state`) that is not finite, naming its first
+    such entry, and the friction law's settings when the law is the cause (the Jacobian
+    of the same model with constant friction is finite: the law's slope is out of
+    range)."""
+    bad = np.argwhere(~np.isfinite(jac))
+    if bad.size == 0:
+        return
+    i, j = (int(v) for v in bad[0])
+    angles = (["phi"] if model.n_sliders == 1
+              else [f"phi{k}" for k in range(model.n_sliders)])
+    names = [*model.labels, *angles, *(f"{v}_dot" for v in (*model.labels, *angles))]
+    entry = f"d({names[i]})'/d({names[j]}) = {jac[i, j]}"
+    law = model.case.friction
+    if _finite_without_the_law(model, state):
+        shown = ", ".join(f"friction.{k} = {v!r}" for k, v in law.model_dump().items()
+                          if k not in ("law", "static") and isinstance(v, float | int))
+        cause = (f"the slope of the friction law ({law.law}) at the sliding speed is out of "
+                 f"floating-point range ({shown}); change those parameters")
+    else:
+        cause = ("a parameter of the case is out of the range doubles resolve; change the "
+                 "extreme one")
+    raise AnalysisError(f"{where}the linearised slip equations are not finite ({entry}): "
+                        f"{cause}")
+
+
+def _finite_without_the_law(model: Model, state: np.ndarray) -> bool:
+    """Whether the slip Jacobian at `state` is finite with the friction law replaced by
+    constant kinetic friction (the static coefficient's)."""
+    law = model.case.friction
+    if law.law == "exponential" and law.decay == 0.0:
+        return False  # constant already
+    plain = {"law": "exponential", "static": law.static, "kinetic_max": law.static,
+             "kinetic_min": law.static, "decay": 0.0}
+    try:
+        other = build_model(model.case.replace({"friction": plain}))
+    except FivdiscError:
+        return False
+    return bool(np.isfinite(slip_jacobian(other, state)).all())
 
 
 def reduced_indices(model: Model) -> np.ndarray:
@@ -44,6 +156,39 @@ def slip_jacobian(model: Model, state: np.ndarray) -> np.ndarray:
     return jac[idx][:, idx]
 
 
+#: A scan estimated to take longer than this [s] says so before it starts (a
+#: :class:`~fivdisc.errors.FivdiscWarning` with the estimate).
+LONG_SCAN = 60.0
+# Scans of fewer points are not timed beforehand (a point takes milliseconds).
+_TIMED_SCAN = 1000
+
+
+def warn_if_long(points: ParameterPoints, values: Sequence[float], count: int,
+                 what: str, fewer: str) -> None:
+    """Warn (:class:`~fivdisc.errors.FivdiscWarning`) before a scan of `count` points
+    whose time, measured on one point at `values`, exceeds :data:`LONG_SCAN`. `what`
+    names the scan, `fewer` what takes less time."""
+    import time
+    import warnings
+
+    from fivdisc.errors import FivdiscWarning
+
+    if count < _TIMED_SCAN:
+        return
+    seconds = []
+    for _ in range(2):  # the first may load the kernel
+        start = time.perf_counter()
+        point = points.linearise(values)
+        if point is not None:
+            np.linalg.eigvals(point[2])
+        seconds.append(time.perf_counter() - start)
+    total = count * seconds[-1]
+    if total > LONG_SCAN:
+        warnings.warn(f"{what} ({count:,} points) will take about {duration_words(total)} "
+                      f"({seconds[-1] * 1e3:.2g} ms a point, measured on its first); "
+                      f"{fewer} take less", FivdiscWarning, stacklevel=3)
+
+
 def check_keys(case: Case, keys: Sequence[str], options: Sequence[str]) -> None:
     """One-line errors for keys a parameter scan cannot vary.
 
@@ -59,11 +204,17 @@ def check_keys(case: Case, keys: Sequence[str], options: Sequence[str]) -> None:
     Raises
     ------
     CaseError
-        A key that this case does not have, whose value is not a number, or that is
-        given twice.
+        A key that this case does not have, whose value is not a number, that is a
+        simulation setting (the linearisation does not depend on it), or that is given
+        twice.
     """
     seen: dict[str, str] = {}
     for key, option in zip(keys, options, strict=True):
+        if key.startswith("simulation."):
+            raise CaseError(f"{option} = {key} is invalid: the simulation settings do not "
+                            "change the sliding equilibrium or its eigenvalues, so a scan "
+                            "of them repeats one answer; vary a key of disc, slider(s), "
+                            "friction or speed")
         value = case.get(key)
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise CaseError(f"{option} = {key} is invalid: its value {value!r} is not a number; "
@@ -86,15 +237,27 @@ def check_values(option: str, key: str, values: np.ndarray) -> np.ndarray:
     return values
 
 
-def check_box(case: Case, axes: Sequence[tuple[str, np.ndarray]]) -> None:
+def check_box(case: Case, axes: Sequence[tuple[str, np.ndarray]],
+              options: Sequence[str] = ()) -> None:
     """Every axis value, alone and at the box's corners, must give a valid case (the
-    case's own message names the key, the value and what is allowed)."""
+    case's own message names the key, the value and what is allowed), and at every corner
+    of the box of the axes' smallest and largest values the model's rates must allow a
+    stability analysis (:func:`check_rates`: each rate grows or falls with each key, so
+    the corners hold the fastest); `options` name the axes in that message."""
     for key, values in axes:
         for v in values:
             case.replace({key: float(v)})
     corners = np.array(np.meshgrid(*[[v[0], v[-1]] for _, v in axes])).reshape(len(axes), -1)
     for combo in corners.T:
         case.replace({key: float(v) for (key, _), v in zip(axes, combo, strict=True)})
+    ends = np.array(np.meshgrid(*[[np.min(v), np.max(v)] for _, v in axes])
+                    ).reshape(len(axes), -1)
+    names = [*options, *[""] * len(axes)][: len(axes)]
+    for combo in np.unique(ends.T, axis=0):
+        updates = {key: float(v) for (key, _), v in zip(axes, combo, strict=True)}
+        where = ", ".join(f"{name} {key} = {v:g}".strip()
+                          for name, (key, v) in zip(names, updates.items(), strict=True))
+        check_rates(build_model(case.replace(updates)), f"at {where}: ")
 
 
 def _equilibrium_key(model: Model) -> tuple:
@@ -171,7 +334,10 @@ class ParameterPoints:
         eq = self.equilibrium(model, guess)
         if eq is None:
             return None
-        return model, eq, slip_jacobian(model, eq.state)
+        jac = slip_jacobian(model, eq.state)
+        where = ", ".join(f"{k} = {v:g}" for k, v in zip(self.keys, values, strict=True))
+        check_jacobian(model, eq.state, jac, f"at {where}: ")
+        return model, eq, jac
 
     def eigenvalues(self, values: Sequence[float], guess: Equilibrium | None = None
                     ) -> np.ndarray | None:

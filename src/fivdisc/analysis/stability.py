@@ -14,13 +14,16 @@ import xarray as xr
 from fivdisc.analysis.points import (
     ParameterPoints,
     check_box,
+    check_jacobian,
     check_keys,
+    check_rates,
     check_values,
     slip_jacobian,
+    warn_if_long,
 )
 from fivdisc.case import Case, is_case_key, keys_like, unit_of
 from fivdisc.engine.equilibrium import Equilibrium, sliding_equilibrium
-from fivdisc.errors import CaseError, nearest
+from fivdisc.errors import CaseError, SimulationError, nearest
 from fivdisc.limits import check_memory
 from fivdisc.model.build import Model, build_model
 
@@ -187,6 +190,15 @@ def linear_stability(case: Case | Model) -> LinearStability:
         The equilibrium, the eigenvalues and eigenvectors, and the coordinate each
         eigenvector moves most; ``print`` it for a table.
 
+    Raises
+    ------
+    AnalysisError
+        A rate of the model too fast for its eigenvalues to decide stability
+        (:func:`~fivdisc.analysis.points.check_rates`), or a linearisation that is not
+        finite.
+    SimulationError
+        No sliding equilibrium.
+
     See Also
     --------
     perturbation_test : The paper's test of the same question by simulation.
@@ -218,8 +230,17 @@ def linear_stability(case: Case | Model) -> LinearStability:
     True -7.390 1/s C01
     """
     model = case if isinstance(case, Model) else build_model(case)
-    eq = sliding_equilibrium(model)
+    check_rates(model)
+    try:
+        eq = sliding_equilibrium(model)
+    except SimulationError:
+        # A linearisation that is not finite (the friction law's slope out of range) also
+        # stops the root finder, which uses it: that is the cause to name.
+        rest = np.zeros(model.state_size)
+        check_jacobian(model, rest, slip_jacobian(model, rest))
+        raise
     jac = slip_jacobian(model, eq.state)
+    check_jacobian(model, eq.state, jac)
     lam, vec = np.linalg.eig(jac)
     order = np.lexsort((-lam.imag, -lam.real))
     lam = lam[order]
@@ -497,17 +518,16 @@ def stability_map(
     if curves:
         axes.append((curves[0], np.asarray(curves[1], dtype=float)))
     (xkey, xs), (ykey, ys) = axes[:2]
-    size = math.prod(len(values) for _, values in axes)
-    n = 2 * sum(1 if l == 0 else 2 for _, l in case.disc.modes) + 2
-    check_memory(
-        _GRID_BYTES * size + 16.0 * xs.size * n * n,
-        f"a stability map of {' x '.join(str(len(v)) for _, v in axes)} points",
-        "use fewer points per axis",
-    )
-    check_keys(case, [key for key, _ in axes], ["x", "y", "curves"][: len(axes)])
-    check_box(case, axes)
+    check_map_size(case, [len(values) for _, values in axes])
+    names = ["x", "y", "curves"][: len(axes)]
+    check_keys(case, [key for key, _ in axes], names)
+    check_box(case, axes, names)
     cs = axes[2][1] if curves else [None]
     points = ParameterPoints(case, [key for key, _ in axes])
+    warn_if_long(points, [values[0] for _, values in axes],
+                 math.prod(len(values) for _, values in axes),
+                 f"a stability map of {' x '.join(str(len(v)) for _, v in axes)}",
+                 "fewer points per axis")
     growth = np.full((len(cs), ys.size, xs.size), np.nan)
     bar = None
     if progress:
@@ -585,6 +605,37 @@ def stability_map(
     )
 
 
+def check_map_size(case: Case, sizes: Sequence[int]) -> None:
+    """Refuse a stability map of `sizes` points per axis (x, y and curves) whose memory
+    exceeds what the machine has, before any axis' values are made."""
+    n = 2 * sum(1 if l == 0 else 2 for _, l in case.disc.modes) + 2 * len(case.sliders)
+    check_memory(
+        _GRID_BYTES * math.prod(sizes) + 16.0 * sizes[0] * n * n + 8.0 * sum(sizes),
+        f"a stability map of {' x '.join(str(size) for size in sizes)} points",
+        "use fewer points per axis",
+    )
+
+
+def range_size(text: str, option: str) -> int:
+    """How many values ``KEY=START:STOP:N`` or ``KEY=v1,v2,...`` gives, without making
+    them (so that a size can be checked before they are); a usage error if `text` is
+    neither."""
+    usage = f"{option} = {text!r} is invalid: write KEY=START:STOP:N or KEY=v1,v2,..."
+    spec = text.split("=", 1)[1] if "=" in text else None
+    if spec is None:
+        raise CaseError(usage)
+    if ":" not in spec:
+        return spec.count(",") + 1
+    parts = spec.split(":")
+    try:
+        count = int(parts[2]) if len(parts) == 3 else -1
+    except ValueError:
+        raise CaseError(usage) from None
+    if count < 1:
+        raise CaseError(usage)
+    return count
+
+
 def resolve_key(key: str, option: str) -> str:
     """Full dotted case key from a dotted key or an unambiguous last part (``decay``).
 
@@ -606,8 +657,10 @@ def resolve_key(key: str, option: str) -> str:
                     "(every key, with its unit: fivdisc examples default)")
 
 
-def parse_range(text: str, option: str) -> tuple[str, np.ndarray]:
-    """Parse ``KEY=START:STOP:N`` (inclusive linspace) or ``KEY=v1,v2,...``."""
+def parse_range(text: str, option: str, per_value: float = 8.0) -> tuple[str, np.ndarray]:
+    """Parse ``KEY=START:STOP:N`` (inclusive linspace) or ``KEY=v1,v2,...``; refuse N
+    values whose memory, `per_value` bytes each (the work they are for, default the
+    values alone), exceeds what the machine has, before they are made."""
     usage = f"{option} = {text!r} is invalid: write KEY=START:STOP:N or KEY=v1,v2,..."
     if "=" not in text:
         raise CaseError(usage)
@@ -616,7 +669,7 @@ def parse_range(text: str, option: str) -> tuple[str, np.ndarray]:
         if ":" in spec:
             start, stop, num = spec.split(":")
             count = int(num)
-            check_memory(8.0 * count, f"{option} with N = {count} values", "lower N")
+            check_memory(per_value * count, f"{option} with N = {count} values", "lower N")
             values = np.linspace(float(start), float(stop), count)
         else:
             values = np.array([float(v) for v in spec.split(",")])

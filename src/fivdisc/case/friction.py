@@ -102,7 +102,7 @@ class TableFriction(_FrictionLaw):
     law
         "table".
     static
-        mu_s, static coefficient; not below the first tabulated value.
+        mu_s, static coefficient; not below any tabulated value.
     speeds
         Sliding speeds u [m/s]: start at 0, strictly increase, at least two.
     values
@@ -124,6 +124,19 @@ class TableFriction(_FrictionLaw):
                 f"must have as many entries as friction.speeds ({len(self.speeds)})",
                 "values",
                 self.values,
+            )
+        # The curve (monotone between the points, constant beyond) stays within the
+        # values: static friction is its upper limit, as for the other laws' kinetic
+        # coefficients.
+        top = max(range(len(self.values)), key=lambda i: self.values[i])
+        if self.static < self.values[top]:
+            raise rule(
+                f"must be >= every value of friction.values: friction.values[{top}] = "
+                f"{self.values[top]!r} at friction.speeds[{top}] = {self.speeds[top]!r} m/s "
+                "is above it (static friction is the upper limit of friction; a curve that "
+                'rises with speed beyond it: law = "stribeck" with viscous)',
+                "static",
+                self.static,
             )
         return self
 

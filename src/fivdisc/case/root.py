@@ -29,6 +29,14 @@ from fivdisc.limits import MAX_SLIDERS
 # Sliders whose angles differ by no more than this [rad] (modulo 2 pi) are in one place.
 _SAME_ANGLE = 1e-12
 _EPS = float(np.finfo(float).eps)
+#: Largest angle of a place on the disc (a slider's base, a probe) [rad], as for a
+#: slider's initial rotation (:data:`fivdisc.engine.equilibrium.MAX_PHI`): further out a
+#: double resolves the angle to no better than 1e-10 rad, and at 1e300 not at all.
+MAX_ANGLE = 1e6
+#: Least distance between two sliders on one face [m]: closer, they press on one spot of
+#: the disc (a contact spot is micrometres across at least), and a case that puts them
+#: there is one slider given twice.
+MIN_SLIDER_GAP = 1e-6
 
 
 class Case(Table):
@@ -155,16 +163,37 @@ class Case(Table):
                     f"{self.slider_key(j)}.track_radius",
                     r0,
                 )
+            if not abs(slider.angle) <= MAX_ANGLE:
+                raise rule(
+                    f"must lie within +-{MAX_ANGLE:g} rad (further out a double places the "
+                    "slider to no better than 1e-10 rad; only the angle modulo 2 pi counts)",
+                    f"{self.slider_key(j)}.angle",
+                    slider.angle,
+                )
             for i, other in enumerate(self.sliders[:j]):
-                if (other.track_radius, other.face) != (r0, slider.face):
+                if other.face != slider.face:
                     continue
                 # Angles are the same place modulo 2 pi, up to their round-off.
-                gap = abs(math.remainder(slider.angle - other.angle, math.tau))
-                if gap <= _SAME_ANGLE + 8 * _EPS * max(abs(slider.angle), abs(other.angle)):
+                turn = math.remainder(slider.angle - other.angle, math.tau)
+                r1 = other.track_radius
+                gap = math.hypot(r0 - r1, 2.0 * math.sqrt(r0 * r1) * math.sin(turn / 2.0))
+                same = _SAME_ANGLE + 8 * _EPS * max(abs(slider.angle), abs(other.angle))
+                if r0 == r1 and abs(turn) <= same:
                     raise rule(
                         f"puts sliders.{j} where sliders.{i} is (r = {r0!r} m on the "
                         f"{slider.face} face, angles equal modulo 2 pi): sliders on one face "
                         "need different angles or radii",
+                        f"sliders.{j}.angle",
+                        slider.angle,
+                    )
+                if gap < MIN_SLIDER_GAP:
+                    raise rule(
+                        f"puts sliders.{j} {gap:.3g} m from sliders.{i} (r = {r1!r} and "
+                        f"{r0!r} m, angles {other.angle!r} and {slider.angle!r} rad on the "
+                        f"{slider.face} face): sliders on one face must be at least "
+                        f"{MIN_SLIDER_GAP:g} m apart (closer, they press on one spot of the "
+                        "disc: give one slider with their stiffnesses, dampers and preloads "
+                        "added)",
                         f"sliders.{j}.angle",
                         slider.angle,
                     )
@@ -176,6 +205,24 @@ class Case(Table):
                     f"simulation.probes[{i}]",
                     probe,
                 )
+            if not abs(probe[1]) <= MAX_ANGLE:
+                raise rule(
+                    f"theta must lie within +-{MAX_ANGLE:g} rad (further out a double places "
+                    "the probe to no better than 1e-10 rad; only the angle modulo 2 pi "
+                    "counts)",
+                    f"simulation.probes[{i}]",
+                    probe,
+                )
+        sim = self.simulation
+        if sim.initial_state != "equilibrium" and sim.perturbation != type(sim.perturbation)():
+            raise rule(
+                "must keep its defaults unless simulation.initial_state = "
+                '"equilibrium" (it is added to the sliding equilibrium: a run from rest '
+                'would ignore it); set initial_state = "equilibrium", or leave the '
+                "perturbation out",
+                "simulation.perturbation",
+                sim.perturbation,
+            )
         if self.simulation.initial_state == "equilibrium" and self.speed.profile != "constant":
             raise rule(
                 f'must be "rest" when speed.profile = "{self.speed.profile}" '

@@ -34,7 +34,8 @@ class Simulation(Table):
     duration
         Simulated time [s], > 0.
     output_rate
-        Output samples per second [Hz], > 0.
+        Output samples per second [Hz], >= 1e-300 (a run shorter than the sample interval
+        records its start only).
     impact
         Apply the perfectly plastic impact at re-contact (else velocities are kept).
     initial_state
@@ -42,7 +43,7 @@ class Simulation(Table):
         sliding equilibrium plus `perturbation`; constant speed only).
     probes
         (r [m], theta [rad]) points of the disc whose displacement w is recorded;
-        each r within [a, b].
+        each r within [a, b], each theta within +-1e6.
     omega_dot_terms
         Keep the disc's dOmega/dt terms (the paper's printed equations omit them).
     printed_gyroscopic_sign
@@ -71,13 +72,16 @@ class Simulation(Table):
         :func:`fivdisc.energy_balance` can account for the energy of the run.
     perturbation
         Offsets from the sliding equilibrium used when `initial_state` is "equilibrium"
-        (the same offsets for every slider).
+        (the same offsets for every slider); with "rest" only its defaults are accepted
+        (other values would be ignored).
     """
 
     _key: ClassVar[tuple[str, ...]] = ("simulation",)
 
     duration: Real = field(1.0, "s", "", "simulated time", gt=0)
-    output_rate: Real = field(10000.0, "Hz", gt=0)
+    # Its sample interval, 1 / output_rate, must be a number of seconds (5e-324 Hz made it
+    # infinite, and the first sample's time 0 * inf a NaN).
+    output_rate: Real = field(10000.0, "Hz", ge=1e-300)
     impact: Flag = True
     initial_state: Literal["rest", "equilibrium"] = "rest"
     probes: tuple[Probe, ...] = field(((0.1, 0.0), (0.1, 1.0)))

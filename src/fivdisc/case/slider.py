@@ -49,8 +49,8 @@ class Slider(Table):
     preload
         N0, normal preload [N], pressing the slider onto its face.
     angle
-        theta_j, space-fixed angle of the slider's base [rad]; the slider sits at
-        theta_j + phi_j.
+        theta_j, space-fixed angle of the slider's base [rad], within +-1e6; the slider
+        sits at theta_j + phi_j. Sliders on one face are at least 1e-6 m apart.
     face
         "top" (the paper's side, on +w, pressed towards -w) or "bottom" (on -w,
         pressed towards +w).

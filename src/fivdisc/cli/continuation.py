@@ -4,6 +4,8 @@ bifurcations."""
 from __future__ import annotations
 
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import click
@@ -12,6 +14,8 @@ from fivdisc.cli._case import CASE
 from fivdisc.continuation.settings import ContinuationSettings
 
 _DEFAULT = ContinuationSettings()
+# How the first orbit's search options are named in messages.
+_SEARCH_OPTIONS = ("--period", "--transient", "the search window", "--rtol")
 
 
 @click.command(name="continue")
@@ -78,14 +82,56 @@ def continuation(case_file: Path | None, key: str, target: float, back_to: float
     across every switch: each point's period, event signature, Floquet multipliers and
     amplitude measures; folds, period doublings, torus bifurcations and changes of the
     event signature (stick phases appearing, grazing, ...) located to 1e-6 in the key.
-    CASE_FILE is a TOML file or a packaged example.
+    CASE_FILE is a TOML file or a packaged example. Ctrl-C stops the continuation and
+    writes the branch so far.
     """
-    from fivdisc.continuation.checks import check_key, check_window
+    with _interrupts_wait_for_the_branch():
+        _continue(case_file, key, target, back_to, from_file, which, point, hopf_spec, points,
+                  step, max_step, transient, period, rtol, tol, as_json, output, progress)
+
+
+@contextmanager
+def _interrupts_wait_for_the_branch() -> Iterator[None]:
+    """The first Ctrl-C stops the continuation, which keeps the branch so far; a second
+    one, while that branch is being finished and written, is refused with a note (it
+    would lose the branch); a third quits without it."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    count = 0
+
+    def interrupted(signum, frame) -> None:
+        nonlocal count
+        count += 1
+        if count == 2:
+            click.echo("interrupted again: the branch so far is being written; Ctrl-C once "
+                       "more quits without it", err=True)
+            return
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, interrupted)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _continue(case_file: Path | None, key: str, target: float, back_to: float | None,
+              from_file: Path | None, which: int | None, point: int | None,
+              hopf_spec: str | None, points: int, step: float, max_step: float,
+              transient: float | None, period: float | None, rtol: float, tol: float,
+              as_json: bool, output: Path | None, progress: bool) -> None:
+    from fivdisc.continuation.checks import check_key, check_window, full_key
     from fivdisc.continuation.settings import INTERRUPTED
     from fivdisc.continuation.walk import continue_orbit
     from fivdisc.errors import ConvergenceError, FivdiscError
     from fivdisc.files import check_output
 
+    # A key's last part alone (normal_damping), as fivdisc stability takes it.
+    key = full_key(key, "--key")
     inputs = [p for p in (case_file, from_file) if p is not None]
     out = check_output(output, "-o", (".nc",), inputs=inputs) if output else None
     if which is not None and from_file is None:
@@ -150,22 +196,32 @@ def _from_hopf(case_file: Path | None, key: str, target: float, spec: str,
     (which one, on stdout, or on stderr under --json, whose stdout is the JSON)."""
     import numpy as np
 
+    from fivdisc.analysis.eigenbranches import branch_bytes
     from fivdisc.analysis.hopf import hopf_points
     from fivdisc.case import Case, load_case
     from fivdisc.continuation.from_hopf import hopf_cycles
-    from fivdisc.errors import FivdiscError
+    from fivdisc.errors import CaseError, FivdiscError
+    from fivdisc.limits import check_memory
 
     usage = f"--from-hopf = {spec!r} is invalid: write START:STOP:N (N >= 2 values of {key})"
     try:
         start, stop, num = spec.split(":")
-        values = np.linspace(float(start), float(stop), int(num))
+        count = int(num)
+        # The size of the scan, before its values are made.
+        check_memory(branch_bytes(load_case(case_file) if case_file else Case()) * count,
+                     f"--from-hopf with N = {count} values", "lower N")
+        values = np.linspace(float(start), float(stop), count)
     except ValueError:
         raise FivdiscError(usage) from None
     if values.size < 2 or not np.all(np.isfinite(values)) or values[0] == values[-1]:
         raise FivdiscError(usage)
     case = _checked(load_case(case_file) if case_file else Case(), key, target)
     for value in values[[0, -1]]:
-        _checked(case, key, float(value))
+        try:
+            case.replace({key: float(value)})
+        except CaseError as exc:
+            raise CaseError(f"--from-hopf = {spec!r} is invalid: its end {value:g} is not a "
+                            f"value of {key} ({exc})") from None
     found = hopf_points(case, key, values, option="--key")
     if not found:
         raise FivdiscError(f"--from-hopf {spec}: no Hopf point of the sliding equilibrium in "
@@ -221,9 +277,11 @@ def _start(case_file, from_file, which, point, key, target, rtol, tol, transient
     new one continues (None unless from a branch, at one of its points or at a
     bifurcation other than a period doubling or a symmetry breaking); the key and the
     target are checked before any orbit is computed."""
+    from fivdisc.analysis.checks import check_period, check_time
     from fivdisc.analysis.orbits import periodic_orbit, saved_start
     from fivdisc.case import load_case
     from fivdisc.continuation.branch import CONTENT, open_branch
+    from fivdisc.continuation.checks import check_search
     from fivdisc.continuation.starts import broken_start, doubled_start
     from fivdisc.errors import FivdiscError
 
@@ -234,7 +292,9 @@ def _start(case_file, from_file, which, point, key, target, rtol, tol, transient
             raise FivdiscError("continue needs CASE_FILE or --from FILE")
         if point is not None:
             raise FivdiscError("--point needs --from BRANCH (a file of fivdisc continue -o)")
-        return _checked(case, key, target), None, None, search, None
+        case = _checked(case, key, target)
+        check_search(case, search, rtol, _SEARCH_OPTIONS)
+        return case, None, None, search, None
     from fivdisc.files import read_dataset
 
     if read_dataset(from_file, "--from").attrs.get("content") == CONTENT:
@@ -275,6 +335,9 @@ def _start(case_file, from_file, which, point, key, target, rtol, tol, transient
     if case is None:
         raise FivdiscError(f"--from {from_file} stores no case: give CASE_FILE")
     _checked(case, key, target)
+    if period is not None:  # no transient: the search starts from the file's state
+        check_time("--period", period)
+        check_period(case, period, "--period")
     orbit = periodic_orbit(case, saved.state, period=period or saved.period,
                            phases=saved.phases, rtol=rtol, tol=tol, start=saved.start)
     return case, orbit, None, {}, None

@@ -137,11 +137,11 @@ def _write(out: Path, figure, ds) -> None:
 def _branches(case, case_file, x_spec: str, output: Path | None, progress: bool,
               growth_scale: str = "auto") -> None:
 
-    from fivdisc.analysis.eigenbranches import eigen_branches
+    from fivdisc.analysis.eigenbranches import branch_bytes, eigen_branches
     from fivdisc.analysis.hopf import hopf_points, with_hopf_points
     from fivdisc.analysis.stability import parse_range
 
-    key, values = parse_range(x_spec, "--x")
+    key, values = parse_range(x_spec, "--x", branch_bytes(case))
     out, figure = _target(case_file, output, "branches.nc")
     ds = eigen_branches(case, key, values, option="--x", progress=progress)
     hopf = hopf_points(case, key, values, option="--x", branches=ds)
@@ -232,8 +232,17 @@ def _boundary(case, case_file, specs: tuple[str, str], output: Path | None) -> N
         _write(out, None, ds)
     curves = np.unique(ds["branch"].values)
     if curves.size == 0:
-        click.echo("no stability boundary in the box: the sliding equilibrium is "
-                   "stable or unstable throughout")
+        m = int(ds.attrs["seeds"])
+        counts = [(int(ds.attrs[f"seeds_{name}"]), words) for name, words in (
+            ("stable", "stable"), ("unstable", "unstable"),
+            ("without_equilibrium", "without a sliding equilibrium"))]
+        found = " and ".join(f"{words} at {n}" if n < m * m else f"{words} at all {n}"
+                             for n, words in counts if n)
+        spacing = ", ".join(f"{(hi - lo) / (m - 1):.3g} in {key}" for key, (lo, hi) in box)
+        click.echo(f"no stability boundary found at this resolution: the sliding equilibrium "
+                   f"is {found} of the {m} x {m} points of the seed grid (spacing {spacing}); "
+                   "a boundary around a region smaller than that is not seen: trace a "
+                   "smaller box to look closer")
     for b in curves:
         sel = ds["branch"].values == b
         freq = ds["frequency"].values[sel]
@@ -246,9 +255,24 @@ def _boundary(case, case_file, specs: tuple[str, str], output: Path | None) -> N
 def _map(case, case_file, x_spec, y_spec, curve_spec, output, progress) -> None:
     import numpy as np
 
-    from fivdisc.analysis.stability import parse_range, stability_map
+    from fivdisc.analysis.stability import (
+        check_map_size,
+        parse_range,
+        range_size,
+        resolve_key,
+        stability_map,
+    )
 
     out, figure = _target(case_file, output, "stability.nc")
+    specs = {"--x": x_spec, "--y": y_spec, **({"--curves": curve_spec} if curve_spec else {})}
+    # The map's size before any axis' values are made.
+    sizes = [range_size(spec, option) for option, spec in specs.items()]
+    check_map_size(case, sizes)
+    if figure and curve_spec:
+        from fivdisc.plots.stability import check_curves
+
+        check_curves(sizes[2], resolve_key(curve_spec.split("=", 1)[0].strip(), "--curves"),
+                     "--curves")
     axes = {"--x": parse_range(x_spec, "--x"), "--y": parse_range(y_spec, "--y")}
     if curve_spec is not None:
         axes["--curves"] = parse_range(curve_spec, "--curves")

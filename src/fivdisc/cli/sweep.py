@@ -106,6 +106,9 @@ def _verify(store: Path) -> None:
         click.echo(f"being written by {health.holder}")
     if health.broken:
         click.echo(f"variables with missing or damaged metadata: {', '.join(health.broken)}")
+    if health.unflagged is not None and health.unflagged.any():
+        click.echo(f"{int(health.unflagged.sum())} complete points lost their done flags "
+                   "(their values verify by their checksums; a rerun writes the flags again)")
     if health.damaged.any():
         shown = ", ".join(map(str, np.flatnonzero(health.damaged)[:_SHOWN_POINTS]))
         more = " ..." if health.damaged.sum() > _SHOWN_POINTS else ""

@@ -8,6 +8,17 @@ from fivdisc.case import Case, is_case_key
 from fivdisc.errors import CaseError, FivdiscError
 
 
+def full_key(key: str, option: str = "key") -> str:
+    """The dotted case key of `key`, which may be its last part alone (``normal_damping``
+    for ``slider.normal_damping``), as the stability scans take it; a one-line error for
+    an unknown or ambiguous one."""
+    if is_case_key(key):
+        return key
+    from fivdisc.analysis.stability import resolve_key
+
+    return resolve_key(key, option)
+
+
 def check_key(case: Case, key: str, option: str = "key") -> float:
     """The current value of a numeric case key, or a one-line error.
 
@@ -56,3 +67,17 @@ def check_target(case: Case, key: str, to: float) -> float:
         raise CaseError(f"to = {to!r} is invalid: it is the case's own value of {key}; "
                         "give the value to continue to")
     return p0
+
+
+def check_search(case: Case, options: dict, rtol: float,
+                 names: tuple[str, ...] = ("period", "transient", "window", "rtol")) -> None:
+    """The one-line refusals of the first orbit's search (as ``fivdisc orbit`` refuses
+    them, :func:`~fivdisc.analysis.checks.check_orbit_request`): a period guess shorter
+    than any motion of the model or too long to integrate, a transient too long to
+    integrate, a disc without modes, no preload. ``options`` are the search's keyword
+    arguments (``period``, ``transient``, ``window``, ...); ``names`` name the first four
+    in messages."""
+    from fivdisc.analysis.checks import check_orbit_request
+
+    check_orbit_request(case, period=options.get("period"), transient=options.get("transient"),
+                        window=options.get("window", 1.0), rtol=rtol, names=names)

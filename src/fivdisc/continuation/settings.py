@@ -9,6 +9,12 @@ from dataclasses import dataclass
 from typing import Any
 
 from fivdisc.errors import FivdiscError
+from fivdisc.limits import (
+    MAX_SHOOTING_RTOL,
+    MAX_SHOOTING_TOL,
+    MIN_SHOOTING_RTOL,
+    MIN_SHOOTING_TOL,
+)
 
 # A corrector may move the point at most this many step lengths from the predictor.
 MAX_CORRECTION = 0.5
@@ -124,6 +130,14 @@ class ContinuationSettings:
             if isinstance(value, bool) or not isinstance(value, int | float) or not (
                     math.isfinite(value) and value > 0):
                 raise FivdiscError(f"{name} = {value!r} is invalid: must be a finite number > 0")
+        if not MIN_SHOOTING_RTOL <= self.rtol <= MAX_SHOOTING_RTOL:
+            raise FivdiscError(f"rtol = {self.rtol!r} is invalid: must lie in "
+                               f"[{MIN_SHOOTING_RTOL:g}, {MAX_SHOOTING_RTOL:g}]")
+        if not MIN_SHOOTING_TOL <= self.tol <= MAX_SHOOTING_TOL:
+            raise FivdiscError(f"tol = {self.tol!r} is invalid: must lie in "
+                               f"[{MIN_SHOOTING_TOL:g}, {MAX_SHOOTING_TOL:g}] (the shooting "
+                               "residual relative to the orbit's size: above it a trajectory "
+                               "that does not close passes for an orbit)")
         if self.atol is not None and not (isinstance(self.atol, int | float)
                                           and math.isfinite(self.atol) and self.atol > 0):
             raise FivdiscError(f"atol = {self.atol!r} is invalid: must be a finite number > 0 "

@@ -79,7 +79,7 @@ from fivdisc.continuation.borders import (
     switch_tests,
 )
 from fivdisc.continuation.branch import Branch
-from fivdisc.continuation.checks import check_target, check_window
+from fivdisc.continuation.checks import check_search, check_target, check_window, full_key
 from fivdisc.continuation.detection import (
     Bifurcation,
     bifurcation_record,
@@ -229,11 +229,13 @@ def continue_orbit(
     (True, ('slip+ > stick > slip+',), [])
     """
     settings = ContinuationSettings.of(settings, options)
+    key = full_key(key)
     p0 = check_target(case, key, to)
     if back_to is None:
         back_to = p0
     check_window(key, p0, to, back_to)
     if orbit is None:
+        check_search(case, options, settings.rtol)
         orbit = periodic_orbit(case, rtol=settings.rtol, atol=settings.atol_run,
                                tol=settings.tol, progress=progress, **options)
     elif not orbit.converged:

@@ -62,9 +62,9 @@ def time_scales(model: Model) -> list[tuple[str, float]]:
     labels = np.array(model.labels)
     scales = [(f"disc.modes {lab} natural frequency", w) for lab, w in zip(labels, model.omega,
                                                                           strict=True)]
-    scales += [(f"disc.damping_ratio of {lab}", 2.0 * z * w)
-               for lab, z, w in zip(labels, model.damping, model.omega, strict=True)]
-    with np.errstate(all="ignore"):
+    with np.errstate(all="ignore"):  # an overflow is an infinite rate, refused as such
+        scales += [(f"disc.damping_ratio of {lab}", float(2.0 * z * w))
+                   for lab, z, w in zip(labels, model.damping, model.omega, strict=True)]
         rows = [("sqrt(normal_stiffness / mass)", np.sqrt(kern.row("kz") / kern.row("mass"))),
                 ("sqrt(rotational_stiffness / inertia)",
                  np.sqrt(kern.row("kphi") / kern.row("inertia"))),
@@ -113,7 +113,8 @@ def estimate_steps(model: Model, duration: float) -> tuple[float, str, float]:
     tolerance, ``h <= 3.3 / rate`` for a decay rate (dampers), and on an oscillation of
     frequency omega also by the tolerance, ``h omega <= 8 rtol^(1/5)``; the fastest time
     scale of :func:`time_scales`, or the disc's spin times the largest nodal-diameter
-    count, sets the number of steps. Contact and friction only add to it.
+    count, or ``simulation.max_step``, sets the number of steps. Contact and friction
+    only add to it.
     """
     rtol = model.case.simulation.rtol
     accurate = min(_STABLE_STEP, _ACCURATE * rtol**0.2)
@@ -127,10 +128,14 @@ def estimate_steps(model: Model, duration: float) -> tuple[float, str, float]:
         spin = float(np.max(model.l, initial=0) * np.max(np.abs(model.speed.omega(times))))
     scales = [*time_scales(model),
               ("speed: the disc's spin (largest Omega) times the largest l", spin)]
+    max_step = model.case.simulation.max_step
+    if max_step > 0:
+        with np.errstate(all="ignore"):
+            scales.append(("1 / simulation.max_step", float(np.float64(1.0) / max_step)))
     for what, rate in scales:
         rate = math.inf if math.isnan(rate) else rate
         step = (accurate if any(word in what for word in oscillating) or what.startswith(
-            "speed") else _STABLE_STEP)
+            "speed") else 1.0 if what.endswith("max_step") else _STABLE_STEP)
         steps = duration * rate / step
         if not steps <= worst[0]:
             worst = (steps, what, rate)
@@ -158,6 +163,57 @@ def check_steps(model: Model, duration: float, span: str = "simulation.duration"
             f"{duration / steps:.3g} s over {span} = {duration!r} s; change "
             "that parameter, shorten the run or raise simulation.max_steps"
         )
+
+
+#: A run projected to take longer than this [s] says so (a
+#: :class:`~fivdisc.errors.FivdiscWarning` with its estimate) ...
+LONG_RUN = 60.0
+# ... once it has run for this long [s], so that the projection rests on measured steps.
+_TIMED_AFTER = 0.2
+
+
+class LongRunNotice:
+    """Warn once, early in a run, if it will take longer than :data:`LONG_RUN`: the
+    steps estimated (:func:`estimate_steps`, or as many as the run's pace so far needs,
+    whichever is more) at the time a step has taken so far.
+
+    Call :meth:`update` after each call of :meth:`Integration.advance`.
+    """
+
+    def __init__(self, model: Model, duration: float, what: str = "the run",
+                 stop: str = "Ctrl-C stops it and keeps what was computed") -> None:
+        import time
+
+        self.duration = duration
+        self.what, self.stop = what, stop
+        self.estimate = estimate_steps(model, duration)
+        self.start = time.perf_counter()
+        self.done = False
+
+    def update(self, run: Integration) -> None:
+        import time
+        import warnings
+
+        from fivdisc.errors import FivdiscWarning
+        from fivdisc.limits import duration_words
+
+        elapsed = time.perf_counter() - self.start
+        if self.done or elapsed < _TIMED_AFTER:
+            return
+        self.done = True
+        tried = run.steps_tried
+        if tried == 0 or not run.t > 0.0:
+            return
+        per_step = elapsed / tried
+        steps = max(self.estimate[0], tried * self.duration / run.t)
+        total = steps * per_step
+        if total > LONG_RUN:
+            _, what, rate = self.estimate
+            warnings.warn(
+                f"{self.what} will take about {duration_words(total)}: about {steps:.2g} "
+                f"integrator steps at {1.0 / per_step:.2g} a second, measured ({what} = "
+                f"{rate:.3g} 1/s limits the step to {self.duration / self.estimate[0]:.3g} "
+                f"s); {self.stop}", FivdiscWarning, stacklevel=3)
 
 
 class Integration:
@@ -378,11 +434,20 @@ class Integration:
         self.zeno_count = ZENO_RATE_COUNT
         return True
 
-    def run_to(self, target: float) -> int:
-        """Advance until ``target`` is reached or the run ends."""
+    def run_to(self, target: float, deadline: float | None = None,
+               notice: LongRunNotice | None = None) -> int:
+        """Advance until ``target`` is reached or the run ends, or (the status still
+        running) a ``deadline`` of :func:`time.monotonic` passes; ``notice`` is told after
+        each call."""
+        import time
+
         while True:
             status = self.advance(target)
+            if notice is not None:
+                notice.update(self)
             if status != core.ST_RUNNING or self.t >= target:
+                return status
+            if deadline is not None and time.monotonic() > deadline:
                 return status
 
     def events(self) -> tuple[np.ndarray, np.ndarray]:

@@ -12,7 +12,7 @@ from fivdisc import core
 from fivdisc.case import Case
 from fivdisc.engine.conventions import fivdisc_version
 from fivdisc.engine.equilibrium import initial_state
-from fivdisc.engine.integration import STATUS, Integration, check_steps
+from fivdisc.engine.integration import STATUS, Integration, LongRunNotice, check_steps
 from fivdisc.engine.progress import SIMULATED_TIME, progress_bar
 from fivdisc.engine.result import EVENT_KINDS, PHASE_NAMES, Result, build_dataset
 from fivdisc.errors import SimulationError
@@ -145,6 +145,7 @@ def simulate(
                        bar_format=SIMULATED_TIME)
     start = _time.perf_counter()
     status = core.ST_RUNNING
+    notice = LongRunNotice(model, sim.duration)
     with Interrupt() as interrupt:
         try:
             # The kernel's step-size controller restarts at each chunk (the saved outputs
@@ -155,6 +156,7 @@ def simulate(
                 target = sim.duration * chunk / _CHUNKS
                 while not interrupt.requested:
                     status = run.advance(target)
+                    notice.update(run)
                     if bar is not None:
                         bar.update(run.t - bar.n)
                     if status != core.ST_RUNNING or run.t >= target:

@@ -291,19 +291,23 @@ def build_model(case: Case, speed: SpeedProfile | None = None) -> Model:
     # The printed paper flips the sign of 2 l M Omega dC/dt in the D equations only; the
     # l M dOmega/dt C term keeps its sign, so its factor undoes the flip there.
     gyro_sign = np.ones(n) if printed else sgn_a
-    cdamp = 2.0 * zeta_a * omega_a * mass_a
     disc_rows = np.zeros((lay.N_DISC, n))
-    disc_rows[lay.D_SGN] = sgn_a
-    disc_rows[lay.D_L] = l_a
-    disc_rows[lay.D_PARTNER] = partner
-    disc_rows[lay.D_MINV] = 1.0 / mass_a
-    disc_rows[lay.D_KD] = mass_a * omega_a**2
-    disc_rows[lay.D_ML2] = mass_a * l_a**2
-    disc_rows[lay.D_GYR] = gyro_sign * l_a * mass_a
-    disc_rows[lay.D_OMD_FIX] = sgn_a * gyro_sign
-    disc_rows[lay.D_CDAMP] = cdamp
-    if disc.damping_frame == "material":
-        disc_rows[lay.D_CDAMP_OM] = sgn_a * l_a * cdamp
+    # Extreme values (a damping ratio of 1e300) overflow to inf here, silently: the rates
+    # of the model are checked before any run or analysis uses them, and refused in one
+    # line (fivdisc.engine.integration.check_steps, fivdisc.analysis.points.check_rates).
+    with np.errstate(over="ignore", invalid="ignore"):
+        cdamp = 2.0 * zeta_a * omega_a * mass_a
+        disc_rows[lay.D_SGN] = sgn_a
+        disc_rows[lay.D_L] = l_a
+        disc_rows[lay.D_PARTNER] = partner
+        disc_rows[lay.D_MINV] = 1.0 / mass_a
+        disc_rows[lay.D_KD] = mass_a * omega_a**2
+        disc_rows[lay.D_ML2] = mass_a * l_a**2
+        disc_rows[lay.D_GYR] = gyro_sign * l_a * mass_a
+        disc_rows[lay.D_OMD_FIX] = sgn_a * gyro_sign
+        disc_rows[lay.D_CDAMP] = cdamp
+        if disc.damping_frame == "material":
+            disc_rows[lay.D_CDAMP_OM] = sgn_a * l_a * cdamp
     shape = np.array(cols).T.copy() if n else np.zeros((len(sliders), 0))
     slider_rows = np.zeros((lay.N_SLIDER, len(sliders)))
     slider_mass = np.array([s.mass for s in sliders])

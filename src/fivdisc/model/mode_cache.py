@@ -68,20 +68,20 @@ def lookup(key: str) -> Any:
 
 def lookup_values(key: str, radii: list[float]) -> list[float] | None:
     """A radial function's values at ``radii`` [m] stored under ``key`` (the mode and the
-    derivative), or None if any of them is not stored."""
+    derivative), or None. The radii are looked up as one request: numpy's vectorised
+    Bessel functions may round a radius differently in another array, and a model must
+    read back exactly what it computed."""
     stored = lookup(f"values {key}")
-    if not isinstance(stored, dict):
-        return None
-    found = [stored.get(repr(r)) for r in radii]
-    return None if any(v is None for v in found) else found
+    found = stored.get(repr(radii)) if isinstance(stored, dict) else None
+    return found if isinstance(found, list) and len(found) == len(radii) else None
 
 
 def remember_values(key: str, radii: list[float], values: list[float]) -> None:
     """Store a radial function's ``values`` at ``radii`` [m] under ``key``, beside those
-    stored at other radii."""
+    stored for other requests."""
     stored = lookup(f"values {key}")
     merged = dict(stored) if isinstance(stored, dict) else {}
-    merged.update({repr(r): v for r, v in zip(radii, values, strict=True)})
+    merged[repr(radii)] = values
     remember(f"values {key}", merged)
 
 

@@ -11,6 +11,7 @@ import numpy as np
 import xarray as xr
 
 from fivdisc.engine.conventions import axis_label
+from fivdisc.errors import AnalysisError
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -20,6 +21,28 @@ from fivdisc.plots.text import drawing, new_axes, set_title
 __all__ = ["GROWTH_SCALES", "growth_axis", "plot_eigen_branches", "plot_hopf_curves",
            "plot_stability_boundary",
            "plot_stability_map"]
+
+
+#: Most curves (values of a third key) one stability map figure draws: one colour each,
+#: from matplotlib's cycle of ten, and a legend entry each.
+MAX_CURVES = 10
+
+
+def check_curves(count: int, key: str, option: str = "curves") -> None:
+    """Refuse a figure of more than :data:`MAX_CURVES` curves, which it could not tell
+    apart (their colours repeat) nor name (the legend overflows the axes).
+
+    Raises
+    ------
+    AnalysisError
+        Naming `option`, the count and what is allowed.
+    """
+    if count > MAX_CURVES:
+        raise AnalysisError(
+            f"{option} = {key} with {count} values is invalid for a figure: must have at "
+            f"most {MAX_CURVES} (one colour and legend entry each; more repeat the colours "
+            "and overflow the legend); write the map to a .nc file for more"
+        )
 
 
 @drawing
@@ -47,9 +70,11 @@ def plot_stability_map(ds: xr.Dataset, ax: Axes | None = None,
         over the same keys (one per curve value, with `curve_key`), drawn on top (solid,
         black or the value's colour) in place of the grid's contours.
     """
-    fig, ax = new_axes(ax)
     xkey, ykey = ds.attrs["x_key"], ds.attrs["y_key"]
     ckey = ds.attrs.get("curve_key", "")
+    if ckey:
+        check_curves(ds.sizes[ckey], ckey)
+    fig, ax = new_axes(ax)
     absent: list[str] = []
     x, y = ds[xkey].values, ds[ykey].values
     panels = [(None, ds)] if not ckey else [(v, ds.sel({ckey: v})) for v in ds[ckey].values]

@@ -152,6 +152,22 @@ def points_of(per_chunk: np.ndarray, grid: Sequence[int], block: Sequence[int]) 
     return padded[tuple(slice(0, n) for n in grid)].reshape(math.prod(grid), *tail)
 
 
+def written_points(array: Any, grid: Sequence[int]) -> np.ndarray:
+    """Per point (flat, C order), whether its chunk file of `array` exists (a chunk never
+    written, or lost, reads as the fill value)."""
+    block = tuple(array.chunks)[:len(grid)]
+    counts = tuple(-(-g // b) for g, b in zip(grid, block, strict=True))
+    directory = os.path.join(str(array.store_path.store.root), array.path, "c")
+    listed = chunk_files(directory, array.ndim)
+    chunks = np.array([c for c, _ in listed], dtype=np.int64).reshape(-1, array.ndim)
+    own = ((chunks[:, len(grid):] == 0).all(axis=1)
+           & (chunks[:, :len(grid)] < counts).all(axis=1))
+    present = np.zeros(math.prod(counts), dtype=bool)
+    present[np.ravel_multi_index(tuple(chunks[own, :len(grid)].T), counts)] = True
+    return points_of(present.reshape(-1, *(1,) * len(block)) & np.ones((1, *block), bool),
+                     grid, block)
+
+
 def readable_points(array: Any, grid: Sequence[int], points: np.ndarray | None = None,
               undecodable: list[str] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(values, readable) of a Zarr array over the sweep's `grid` (chunked by blocks of

@@ -16,8 +16,9 @@ import numpy as np
 from fivdisc.errors import SweepError
 from fivdisc.sweep.spec import Sweep
 from fivdisc.sweep.store.checksum import checksums
-from fivdisc.sweep.store.chunks import readable_points
+from fivdisc.sweep.store.chunks import readable_points, written_points
 from fivdisc.sweep.store.layout import (
+    CODECS,
     Layout,
     consolidate,
     layout_of,
@@ -87,6 +88,9 @@ class StoreHealth:
         definition (named ``NAME (group attribute)``).
     holder
         Who holds the store's lock (a sweep writing it), or None.
+    unflagged
+        Complete points whose ``done`` flag is lost (its chunk or the variable deleted):
+        their values verify by their checksums, and a rerun writes the flags again.
     """
 
     path: Path
@@ -95,18 +99,21 @@ class StoreHealth:
     failed: np.ndarray
     broken: tuple[str, ...]
     holder: str | None
+    unflagged: np.ndarray | None = None
 
     @property
     def healthy(self) -> bool:
-        """No damaged point and no broken variable (points may still be missing)."""
-        return not self.damaged.any() and not self.broken
+        """No damaged point, no broken variable and no lost flag (points may still be
+        missing)."""
+        return (not self.damaged.any() and not self.broken
+                and (self.unflagged is None or not self.unflagged.any()))
 
 
 def inspect_store(path: Path, attrs: dict[str, Any], undecodable: list[str] | None = None
-             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
-    """(complete, damaged, failed, broken variables) of a store; see :class:`StoreHealth`.
-    The masks are flat, one entry per point. The chunk files that do not decode are
-    appended to `undecodable`."""
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str], np.ndarray]:
+    """(complete, damaged, failed, broken variables, unflagged) of a store; see
+    :class:`StoreHealth`. The masks are flat, one entry per point. The chunk files that
+    do not decode are appended to `undecodable`."""
     layout = layout_of(attrs)
     arrays, broken = open_arrays(path, layout)
     broken += attribute_damage(attrs, layout)
@@ -115,27 +122,36 @@ def inspect_store(path: Path, attrs: dict[str, Any], undecodable: list[str] | No
     if "done" in arrays:
         done, done_readable = readable_points(arrays["done"], grid, None, undecodable)
         done = np.asarray(done, dtype=bool)
+        flagged = written_points(arrays["done"], grid) & done_readable
     else:
         done, done_readable = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
-    # Only the values of points marked done matter: the others are incomplete anyway.
+        flagged = np.zeros(n, dtype=bool)
+    # A point's flag is read where its chunk of `done` is there and decodes; where that
+    # chunk is lost (or `done` itself), a point whose checksum was written is a
+    # candidate too: its values verify by the checksum alone, which covers them all.
+    # Otherwise only the values of points marked done matter: the others are incomplete.
+    if "checksum" in arrays:
+        sums, sums_ok = readable_points(arrays["checksum"], grid, ~flagged, undecodable)
+        candidates = (done & flagged) | (~flagged & sums_ok & (sums != 0))
+    else:
+        candidates = done & flagged
     readable = np.ones(n, dtype=bool)
     columns = {}
     for name in [*layout.variables, "checksum"]:
         if name in arrays:
-            columns[name], ok = readable_points(arrays[name], grid, done & done_readable,
-                                          undecodable)
+            columns[name], ok = readable_points(arrays[name], grid, candidates, undecodable)
             readable &= ok
         else:
             readable[:] = False
-    complete = done & done_readable & readable
+    complete = candidates & readable
     points = np.flatnonzero(complete)
     if points.size:  # every variable readable
         complete[points] = columns["checksum"][points] == checksums(
             attrs["sweep_hash"], points.tolist(),
             [columns[name][points] for name in layout.variables])
-    damaged = ~complete & (done | ~done_readable)
+    damaged = ~complete & ((done & flagged) | ~done_readable)
     failed = complete & (columns["error"] != "") if "error" in columns else np.zeros(n, bool)
-    return complete, damaged, failed, broken
+    return complete, damaged, failed, broken, complete & ~(done & flagged)
 
 
 def read_mask(path: str | PathLike[str]) -> np.ndarray:
@@ -182,8 +198,9 @@ def verify_store(path: str | PathLike[str]) -> StoreHealth:
         `path` is not a sweep store of this version, or its group metadata is damaged.
     """
     path = Path(path)
-    complete, damaged, failed, broken = inspect_store(path, read_attrs(path))
-    return StoreHealth(path, complete, damaged, failed, tuple(broken), holder_of(path))
+    complete, damaged, failed, broken, unflagged = inspect_store(path, read_attrs(path))
+    return StoreHealth(path, complete, damaged, failed, tuple(broken), holder_of(path),
+                       unflagged)
 
 
 def rebuild_group(path: Path, sweep: Sweep, damage: str) -> dict[str, Any]:
@@ -195,7 +212,10 @@ def rebuild_group(path: Path, sweep: Sweep, damage: str) -> dict[str, Any]:
     attrs = json.loads(files["zarr.json"])["attributes"]
     layout = layout_of(attrs)
     _, broken = open_arrays(path, layout)
-    foreign = [name for name in broken if name in layout.coords or name in ("done", "checksum")]
+    # Arrays that are there and are not the sweep's (a missing one is rebuilt by repair;
+    # the points then verify by their checksums or are recomputed).
+    foreign = [name for name in broken if (name in layout.coords or name in ("done", "checksum"))
+               and (path / name / "zarr.json").is_file()]
     if foreign:
         raise SweepError(
             f"{damage.split('; ')[0]}, and it cannot be rebuilt from this sweep: its "
@@ -215,15 +235,37 @@ def repair(path: Path, sweep: Sweep, attrs: dict[str, Any]) -> None:
     _, broken = open_arrays(path, layout)
     group = bool(attribute_damage(attrs, layout))
     files = template_files(sweep)
+    coded = []  # arrays whose codecs alone differ from the sweep's
     for name in layout.arrays:
         meta = path / name / "zarr.json"
         stored = meta.read_bytes() if meta.is_file() else None
-        if name not in broken and structure_of(stored) != structure_of(files[f"{name}/zarr.json"]):
+        expected = files[f"{name}/zarr.json"]
+        if name not in broken and structure_of(stored) != structure_of(expected):
             broken.append(name)
+        elif name not in broken and (structure_of(stored, CODECS)
+                                     != structure_of(expected, CODECS)):
+            coded.append(name)
+    if coded:
+        _restore_codecs(path, attrs, files, coded)
     if not broken and not group:
+        if coded:
+            consolidate(path)
         return
     for name in broken:
         if name in layout.coords:  # its values are rewritten whole
             shutil.rmtree(path / name, ignore_errors=True)
     write_files(path, files, [*broken, ""] if group else broken)
     consolidate(path)
+
+
+def _restore_codecs(path: Path, attrs: dict[str, Any], files: dict[str, bytes],
+                    names: list[str]) -> None:
+    """Give the arrays `names` the sweep's codecs if more points verify with them than
+    with the codecs their metadata names (a changed codec makes every chunk undecodable;
+    chunks written by another version of Zarr may need the stored ones)."""
+    kept = {name: (path / name / "zarr.json").read_bytes() for name in names}
+    before = int(inspect_store(path, attrs)[0].sum())
+    write_files(path, files, names)
+    if int(inspect_store(path, attrs)[0].sum()) < before:
+        for name, content in kept.items():
+            write_files(path, {f"{name}/zarr.json": content}, [name])

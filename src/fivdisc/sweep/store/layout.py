@@ -200,10 +200,13 @@ def read_attrs(path: Path) -> dict[str, Any]:
     require_zarr()
     if not path.is_dir():
         raise SweepError(f"{path} is not a sweep store: no such directory")
-    if not (path / "zarr.json").is_file():
-        raise SweepError(f"{path} exists and is not a Zarr store (it has no zarr.json)")
     rerun = ("rerun the sweep that wrote it to rebuild it from the sweep file, or delete "
              "the store to start over")
+    if not (path / "zarr.json").is_file():
+        if any((path / name / "zarr.json").is_file() for name in ("done", "checksum")):
+            raise DamagedGroup(  # a sweep store's arrays, its group's metadata lost
+                f"{path} has damaged metadata ({path / 'zarr.json'} is missing); {rerun}")
+        raise SweepError(f"{path} exists and is not a Zarr store (it has no zarr.json)")
     try:
         attrs = dict(open_group(path).attrs)
     except Exception as exc:  # zarr raises several types for damaged metadata
@@ -344,18 +347,24 @@ def template_files(sweep: Sweep) -> dict[str, bytes]:
     return {key: buffer.to_bytes() for key, buffer in files.items()}
 
 
-# Array metadata a rerun restores from the sweep if it differs (the codecs are left: chunks
-# written with other codecs fail to decode, and their points are recomputed).
+# Array metadata a rerun restores from the sweep if it differs. The codecs are restored
+# only where the sweep's verify more points than the stored ones (see health.repair):
+# chunks written by another version of Zarr may use other codecs, and decode only with
+# those.
 STRUCTURE = ("shape", "data_type", "chunk_grid", "chunk_key_encoding", "fill_value",
               "dimension_names", "node_type")
+CODECS = ("codecs",)
 
 
-def structure_of(text: bytes | None) -> dict[str, Any] | None:
+def structure_of(text: bytes | None, keys: Sequence[str] = STRUCTURE
+                 ) -> dict[str, Any] | None:
+    """The entries `keys` of an array's metadata (its ``zarr.json``), None if it is not
+    a JSON object."""
     try:
         meta = json.loads(text or b"")
     except ValueError:
         return None
-    return {key: meta.get(key) for key in STRUCTURE} if isinstance(meta, dict) else None
+    return {key: meta.get(key) for key in keys} if isinstance(meta, dict) else None
 
 
 def write_files(path: Path, files: dict[str, bytes], names: Sequence[str]) -> None:

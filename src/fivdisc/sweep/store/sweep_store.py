@@ -142,14 +142,20 @@ class SweepStore:
         chunk files that do not decode are removed: their points are not complete, and
         writing one of them again would read the rest of its chunk first."""
         undecodable: list[str] = []
-        complete = inspect_store(self.path, read_attrs(self.path),
-                            None if self.refusal else undecodable)[0]
+        complete, *_, unflagged = inspect_store(self.path, read_attrs(self.path),
+                                                None if self.refusal else undecodable)
         for file in undecodable:
             if os.path.isdir(file) and not os.path.islink(file):
                 shutil.rmtree(file, ignore_errors=True)
             else:
                 with contextlib.suppress(FileNotFoundError):
                     os.unlink(file)
+        if not self.refusal:
+            # Points that verify by their checksums where their done flags were lost (a
+            # deleted done/ or chunk of it): their flags are written again.
+            lost = np.flatnonzero(unflagged)
+            for run in self._runs([PointOutcome(int(i), None) for i in lost]):
+                self._write_region({"done": np.ones(len(run), dtype=bool)}, run)
         return complete
 
     def errors(self, points: np.ndarray) -> dict[int, str]:
@@ -170,16 +176,7 @@ class SweepStore:
         """
         if self.refusal:
             raise SweepError(self.refusal)
-        shape = self.sweep.shape
-        outcomes = sorted(outcomes, key=lambda o: o.index)
-        runs: list[list[PointOutcome]] = []
-        for outcome in outcomes:
-            # A run stays within one row of the last axis, so that it is a region.
-            if (runs and runs[-1][-1].index + 1 == outcome.index
-                    and outcome.index % shape[-1] != 0):
-                runs[-1].append(outcome)
-            else:
-                runs.append([outcome])
+        runs = self._runs(outcomes)
         names = checksummed(self.sweep)
         for run in runs:
             data = {
@@ -200,6 +197,19 @@ class SweepStore:
             self._write_region(data, run)
         for run in runs:
             self._write_region({"done": np.ones(len(run), dtype=bool)}, run)
+
+    def _runs(self, outcomes: Sequence[PointOutcome]) -> list[list[PointOutcome]]:
+        """`outcomes` in runs of consecutive points, each within one row of the last axis
+        (so that it is a region)."""
+        shape = self.sweep.shape
+        runs: list[list[PointOutcome]] = []
+        for outcome in sorted(outcomes, key=lambda o: o.index):
+            if (runs and runs[-1][-1].index + 1 == outcome.index
+                    and outcome.index % shape[-1] != 0):
+                runs[-1].append(outcome)
+            else:
+                runs.append([outcome])
+        return runs
 
     def _write_region(self, columns: dict[str, np.ndarray], run: list[PointOutcome]) -> None:
         """Write values of the consecutive points of `run`, all in one row of the last axis."""
@@ -232,7 +242,7 @@ def open_sweep(path: str | PathLike[str]) -> xr.Dataset:
     """
     path = Path(path)
     attrs = read_attrs(path)
-    complete, _, _, broken = inspect_store(path, attrs)
+    complete, _, _, broken, _ = inspect_store(path, attrs)
     if broken:
         raise SweepError(
             f"{path} is damaged: variable(s) {', '.join(broken)} are missing or unreadable; "
