@@ -34,7 +34,7 @@ import numpy as np
 from fivdisc.core._core import floor_dopri_linear
 
 from fivdisc import core
-from fivdisc.model.layout import SEPARATION, SLIP
+from fivdisc.model.layout import Phase
 
 
 def _dopri_linear(op, y, t_final, rtol, atol):
@@ -55,7 +55,7 @@ def _operators(model) -> dict[str, tuple]:
 
 
     n_s = model.n_sliders
-    ph = np.full(n_s, SLIP, dtype=np.int64)
+    ph = np.full(n_s, Phase.SLIP, dtype=np.int64)
     sg = np.ones(n_s, dtype=np.int64)
     y = np.zeros(model.state_size)
     y[: model.n] = 1e-6
@@ -67,7 +67,7 @@ def _operators(model) -> dict[str, tuple]:
     for j in range(n_s):
         jac[model.index("z", j)] = 0.0
         jac[model.index("z_dot", j)] = 0.0
-    free = core.jacobian(cm, 0.0, y, np.full(n_s, SEPARATION, dtype=np.int64), sg)
+    free = core.jacobian(cm, 0.0, y, np.full(n_s, Phase.SEPARATION, dtype=np.int64), sg)
     u, sv, vt = np.linalg.svd(jac - free)
     rank = int(np.sum(sv > 1e-12 * sv[0]))
     b = sp.csr_matrix(free)

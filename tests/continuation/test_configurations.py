@@ -18,8 +18,8 @@ from fivdisc.continuation.borders import groups
 from fivdisc.continuation.walk import continue_orbit
 from fivdisc.engine.integration import Integration
 from fivdisc.engine.result import EVENT_KINDS
-from fivdisc.model import layout as lay
 from fivdisc.model.build import build_model
+from fivdisc.model.layout import Phase
 
 PAD = {"track_radius": 0.1, "mass": 0.1, "normal_stiffness": 3e4, "normal_damping": 0.1,
        "rotational_stiffness": 2e3, "rotational_damping": 0.1, "preload": 500.0}
@@ -51,7 +51,7 @@ def _returns(case: Case, state: np.ndarray, phases: np.ndarray, periods: int,
     0's sticks and the states there."""
     model = build_model(case)
     x = np.array(state, dtype=float)
-    x[model.index("phi_dot") + np.flatnonzero(phases == lay.STICK)] = case.speed.value
+    x[model.index("phi_dot") + np.flatnonzero(phases == Phase.STICK)] = case.speed.value
     run = Integration(model, x, duration=periods * period, rtol=1e-12, atol=1e-19,
                       phases=phases, stop_on=("stick",))
     times, states = [], []

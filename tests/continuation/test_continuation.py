@@ -385,8 +385,8 @@ _GRAZE_SPAN = 0.004  # [s]: one period of the disc mode, 4.2 ms
 
 def _graze_run(phi0: float, max_step: float = 0.0):
     from fivdisc.engine.integration import Integration
-    from fivdisc.model import layout as lay
     from fivdisc.model.build import build_model
+    from fivdisc.model.layout import Phase
 
     model = build_model(_GRAZE)
     y = np.zeros(model.state_size)
@@ -395,7 +395,7 @@ def _graze_run(phi0: float, max_step: float = 0.0):
     y[model.index("phi_dot")] = 0.01
     run = Integration(model, y, duration=_GRAZE_SPAN, output_rate=1.0 / _GRAZE_SPAN,
                       rtol=1e-6, atol=1e-12, max_step=max_step,
-                      phases=np.array([lay.STICK]))
+                      phases=np.array([Phase.STICK]))
     run.run_to(_GRAZE_SPAN)
     times, _ = run.events()
     return times, run.out_y[1, : model.state_size], run.stats["steps"]
@@ -436,7 +436,7 @@ def test_fig13_branch_ends_where_its_stick_phase_splits():
     """The Fig. 13 orbit continued up in the disc speed: near 6.576 rad/s the friction
     needed to stick touches mu_s N at an interior maximum of the stick phase, the slider
     slips there and the flow map jumps, so the orbit ends. The continuation locates the
-    signature change to 1e-6; plain runs from the last orbit's point with steps capped at
+    stick split to 1e-6; plain runs from the last orbit's point with steps capped at
     0.1 us (independent of the continuation and of the kernel's dip search) show one
     stick phase 2e-6 below the located speed and a split one 2e-6 above it.
 
@@ -451,14 +451,14 @@ def test_fig13_branch_ends_where_its_stick_phase_splits():
     case = FIGURES[13].case
     orbit = periodic_orbit(case, transient=5.0, window=0.05)
     br = continue_orbit(case, "speed.value", 8.0, orbit=orbit, max_points=40)
-    assert "does not persist past the signature change" in br.stop_reason
+    assert "does not persist past the stick split" in br.stop_reason
     six = periodic_orbit(case.replace({"speed.value": 6.58}), transient=3.0, window=0.05)
     assert six.period == pytest.approx(6 * br.period[-1], rel=1e-4)
     assert np.all(np.abs(6 * br.period / six.period - 1) > 1e-5)
     states = br.dataset["state"].values
     steps = np.linalg.norm(np.diff(states, axis=0), axis=1)
     assert np.all(steps < 0.1 * np.linalg.norm(states[1:], axis=1))
-    (end,) = [b for b in br.bifurcations() if b["kind"] == "signature change"]
+    (end,) = [b for b in br.bifurcations() if b["kind"] == "stick split"]
     assert end["signature_before"] == ("slip+ > stick > slip+",)
     assert end["signature_after"][0].count("stick") == 2
     x, period = end["state"], end["period"]

@@ -17,8 +17,8 @@ from fivdisc.continuation.borders import order_key, pad_classes
 from fivdisc.continuation.walk import continue_orbit
 from fivdisc.engine.integration import Integration
 from fivdisc.errors import ConvergenceError
-from fivdisc.model import layout as lay
 from fivdisc.model.build import build_model
+from fivdisc.model.layout import Phase
 
 DATA = Path(__file__).parents[1] / "data"
 CASE = Case.from_toml((DATA / "three_pads.toml").read_text(encoding="utf-8"))
@@ -42,7 +42,7 @@ def run_events(case: Case, state: np.ndarray, phases: np.ndarray, duration: floa
         case = case.replace({"speed.value": speed})
     model = build_model(case)
     x = np.array(state, dtype=float)
-    rates = model.index("phi_dot") + np.flatnonzero(np.asarray(phases) == lay.STICK)
+    rates = model.index("phi_dot") + np.flatnonzero(np.asarray(phases) == Phase.STICK)
     x[rates] = case.speed.value
     run = Integration(model, x, duration=duration, rtol=1e-12, atol=1e-19, phases=phases)
     run.run_to(duration)

@@ -25,8 +25,8 @@ import pytest
 from fivdisc.case import Case
 from fivdisc.engine.integration import Integration
 from fivdisc.engine.result import EVENT_KINDS
-from fivdisc.model import layout as lay
 from fivdisc.model.build import build_model
+from fivdisc.model.layout import Phase
 
 RTOL, ATOL = 1e-12, 1e-16
 BASE = {"disc": {"density": 720.0, "modes": [[0, 0], [0, 1]]}, "speed": {"value": 1.0}}
@@ -109,7 +109,7 @@ def test_tangent_matches_flow_map_one_slider():
     separation."""
     model = build_model(ONE)
     x0, phases = _start(model, _kicked(model), 0.005)
-    assert phases[0] == lay.SEPARATION
+    assert phases[0] == Phase.SEPARATION
     err = _tangent_error(model, x0, phases, 0.0115,
                          {"recontact", "separation", "stick", "slip"})
     assert err < 1e-6
@@ -168,9 +168,9 @@ def test_sticking_collapses_the_slider_rate():
     run = Integration(model, np.zeros(model.state_size), duration=0.5)
     run.set_tangents(np.eye(model.state_size))
     run.advance(0.0)
-    while run.ph[0] != lay.STICK and run.t < 0.5:
+    while run.ph[0] != Phase.STICK and run.t < 0.5:
         run.advance(run.t + 1e-4)
-    assert run.ph[0] == lay.STICK
+    assert run.ph[0] == Phase.STICK
     tangents = run.tangents()
     phid = model.index("phi_dot")
     assert np.all(tangents[:, phid] == 0.0)
@@ -198,7 +198,7 @@ def test_tangent_linear_rhs_equals_the_complex_step(friction):
     cm = core.core_model(model)
     rng = np.random.default_rng(3)
     nd = model.state_size
-    for phase, sign in ((lay.SLIP, 1), (lay.SLIP, -1), (lay.STICK, 1), (lay.SEPARATION, 1)):
+    for phase, sign in ((Phase.SLIP, 1), (Phase.SLIP, -1), (Phase.STICK, 1), (Phase.SEPARATION, 1)):
         for _ in range(5):
             y = rng.standard_normal(nd) * 1e-4
             y[model.index("phi_dot")] = 6.0 * (1 - 0.9 * sign * rng.random())

@@ -15,8 +15,8 @@ from fivdisc.case import Case, load_case
 from fivdisc.core import core_model, jacobian, kinetic_friction, solve_lcp
 from fivdisc.engine.simulation import simulate
 from fivdisc.examples import DIRECTORY as EXAMPLES
-from fivdisc.model import layout as lay
 from fivdisc.model.build import build_model
+from fivdisc.model.layout import Phase
 
 from support.cases import kick
 
@@ -79,7 +79,7 @@ def _free_disc_eigenvalues(case: Case, speed: float) -> tuple[np.ndarray, object
     the disc block of the Jacobian is decoupled from it."""
     model = build_model(case.replace({"speed.value": speed}))
     y = np.zeros(model.state_size)
-    jac = jacobian(core_model(model), 0.0, y, np.array([lay.SEPARATION]), np.array([1]))
+    jac = jacobian(core_model(model), 0.0, y, np.array([Phase.SEPARATION]), np.array([1]))
     n = model.n
     idx = np.r_[0:n, n + 2 : 2 * n + 2]
     return np.linalg.eigvals(jac[np.ix_(idx, idx)]), model

@@ -13,6 +13,7 @@ from fivdisc.engine.simulation import simulate
 from fivdisc.errors import SimulationError
 from fivdisc.model import layout as lay
 from fivdisc.model.build import build_model
+from fivdisc.model.layout import Phase
 from fivdisc.model.speed import SpeedProfile
 
 from reference.model import jacobi_integral, mode_data_from_case
@@ -96,7 +97,7 @@ def test_impact_map_equal_velocities_and_energy_loss():
     n, omega = model.n, 2 * np.pi
     rng = np.random.default_rng(7)
     cm = core_model(model)
-    flying = np.array([lay.SEPARATION])
+    flying = np.array([Phase.SEPARATION])
     sign = np.array([1])
     for trial in range(50):
         y = np.zeros(model.state_size)

@@ -184,3 +184,37 @@ def test_no_module_is_named_like_a_public_name_of_its_package():
             if f"{package}.{name}" in MODULES:
                 clashes.append(f"{package}.{name} is a module and a name from {home}")
     assert not clashes, "\n".join(clashes)
+
+
+def _from_imports(module: str) -> list[ast.ImportFrom]:
+    path = MODULES[module][0]
+    return [node for node in ast.walk(ast.parse(path.read_text(), str(path)))
+            if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module]
+
+
+def _reaches_core(node: ast.ImportFrom) -> bool:
+    return node.module.startswith("fivdisc.core") or (
+        node.module == "fivdisc" and any(a.name == "core" for a in node.names))
+
+
+def test_above_the_engine_nothing_reaches_the_core():
+    # The analyses and everything above them use the core through the engine's face
+    # (fivdisc.engine.integration, fivdisc.engine.evaluation).
+    engine = _layer("fivdisc.engine")
+    reaching = sorted(f"{module} imports the core"
+                      for module in MODULES if _layer(module) > engine
+                      for node in _from_imports(module) if _reaches_core(node))
+    assert not reaching, "\n".join(reaching)
+    # the check sees the engine's own import of it
+    assert any(_reaches_core(node) for node in _from_imports("fivdisc.engine.evaluation"))
+
+
+def test_no_private_name_crosses_a_layer():
+    crossing = sorted(
+        f"{module} imports {alias.name} from {node.module}"
+        for module in MODULES
+        for node in _from_imports(module)
+        if node.module in MODULES and _layer(node.module) != _layer(module)
+        for alias in node.names if alias.name.startswith("_")
+    )
+    assert not crossing, "\n".join(crossing)

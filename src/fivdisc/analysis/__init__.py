@@ -25,6 +25,7 @@ _API = {
     "fivdisc.analysis.orbits": ("PeriodicOrbit", "periodic_orbit", "orbit_symmetry"),
     "fivdisc.analysis.symmetry": ("CaseSymmetry", "OrbitSymmetry", "case_symmetry"),
     "fivdisc.analysis.cycle": ("Cycle", "one_period"),
+    "fivdisc.analysis.kinds": ("BifurcationKind",),
     "fivdisc.analysis.exponents": ("LyapunovSpectrum", "lyapunov"),
     "fivdisc.analysis.regimes": ("Regime", "cross_check"),
 }

@@ -18,10 +18,10 @@ import numpy as np
 from fivdisc.engine.integration import Integration
 from fivdisc.engine.result import EVENT_KINDS
 from fivdisc.errors import FivdiscError
-from fivdisc.model import layout as lay
 from fivdisc.model.build import Model
+from fivdisc.model.layout import Phase
 
-__all__ = ["MEASURES", "Cycle", "one_period", "phase_label"]
+__all__ = ["MEASURES", "Cycle", "cyclic_signature", "one_period", "phase_label"]
 
 #: Amplitude measures per slider: name -> (long name, unit). Each is kept as its
 #: largest (``_max``) and smallest (``_min``) value over a period.
@@ -38,9 +38,9 @@ _SAMPLES = 2000
 
 def phase_label(phase: int, sign: int) -> str:
     """``slip+``, ``slip-``, ``stick`` or ``flight``."""
-    if phase == lay.STICK:
+    if phase == Phase.STICK:
         return "stick"
-    if phase == lay.SEPARATION:
+    if phase == Phase.SEPARATION:
         return "flight"
     return "slip+" if sign > 0 else "slip-"
 
@@ -85,15 +85,20 @@ class Cycle:
     dips: tuple[tuple[int, str, float, float], ...] = ()
 
     def cyclic(self) -> tuple[str, ...]:
-        """The signature as a cycle, independent of where on the orbit it starts: per
-        slider, the rotation of its phase sequence (without the repeated first phase)
-        that sorts first."""
-        out = []
-        for sig in self.signature:
-            parts = sig.split(" > ")
-            ring = parts[:-1] if len(parts) > 1 and parts[0] == parts[-1] else parts
-            out.append(min(" > ".join(ring[i:] + ring[:i]) for i in range(len(ring))))
-        return tuple(out)
+        """The signature as a cycle (:func:`cyclic_signature`)."""
+        return cyclic_signature(self.signature)
+
+
+def cyclic_signature(signature: tuple[str, ...]) -> tuple[str, ...]:
+    """An event signature as a cycle, independent of where on the orbit it starts: per
+    slider, the rotation of its phase sequence (without the repeated first phase) that
+    sorts first."""
+    out = []
+    for sig in signature:
+        parts = sig.split(" > ")
+        ring = parts[:-1] if len(parts) > 1 and parts[0] == parts[-1] else parts
+        out.append(min(" > ".join(ring[i:] + ring[:i]) for i in range(len(ring))))
+    return tuple(out)
 
 
 def one_period(model: Model, x0: np.ndarray, phases: np.ndarray, period: float,
@@ -111,7 +116,7 @@ def one_period(model: Model, x0: np.ndarray, phases: np.ndarray, period: float,
                       atol=atol, phases=phases, stop_on=EVENT_KINDS, max_step=max_step)
     run.advance(0.0)
     seqs = [[phase_label(run.ph[j], run.sg[j])] for j in range(ns)]
-    stick_free = [not np.any(run.ph == lay.STICK)]
+    stick_free = [not np.any(run.ph == Phase.STICK)]
     seen = 0
     while run.t < period:
         run.advance(period)
@@ -124,7 +129,7 @@ def one_period(model: Model, x0: np.ndarray, phases: np.ndarray, period: float,
             label = phase_label(run.ph[j], run.sg[j])
             if seqs[j][-1] != label:
                 seqs[j].append(label)
-        stick_free += [not np.any(run.ph == lay.STICK)] * (rows.shape[0] - seen)
+        stick_free += [not np.any(run.ph == Phase.STICK)] * (rows.shape[0] - seen)
         seen = rows.shape[0]
         if run.status_name == "success":
             break
@@ -133,11 +138,12 @@ def one_period(model: Model, x0: np.ndarray, phases: np.ndarray, period: float,
                                                                                strict=True))
     y = run.out_y[: run.n_samples]
     aux = run.out_aux[: run.n_samples]
+    col = model.columns
     columns = {
-        "phi": y[:, model.index("phi"): model.index("phi") + ns],
-        "phi_dot": y[:, model.index("phi_dot"): model.index("phi_dot") + ns],
-        "normal_force": aux[:, :ns],
-        "w": aux[:, 3 * ns: 4 * ns],
+        "phi": y[:, model.slices.phi],
+        "phi_dot": y[:, model.slices.phi_dot],
+        "normal_force": aux[:, col.normal_force],
+        "w": aux[:, col.w],
     }
     measures = {}
     for name, values in columns.items():
@@ -151,18 +157,18 @@ def one_period(model: Model, x0: np.ndarray, phases: np.ndarray, period: float,
 def _dips(model: Model, y: np.ndarray, aux: np.ndarray, dt: float
           ) -> tuple[tuple[int, str, float, float], ...]:
     """Interior minima of each phase's margin over the samples (see :class:`Cycle`)."""
-    ns = model.n_sliders
-    mus = float(model.kernel.opts[lay.O_MUS])
+    ns, col = model.n_sliders, model.columns
+    mus = model.friction_value("static")
     omega = abs(float(model.speed.omega(0.0))) or 1.0
     out = []
     for j in range(ns):
-        phase = aux[:, 2 * ns + j]
-        normal, force = aux[:, j], aux[:, ns + j]
+        phase = aux[:, col.phase][:, j]
+        normal, force = aux[:, col.normal_force][:, j], aux[:, col.friction_force][:, j]
         rate = y[:, model.index("phi_dot", j)]
         with np.errstate(divide="ignore", invalid="ignore"):
             stick = (mus * normal - np.abs(force)) / (mus * normal)
         slip = np.abs(omega - rate) / omega
-        for label, code, values in (("stick", lay.STICK, stick), ("slip", lay.SLIP, slip)):
+        for label, code, values in (("stick", Phase.STICK, stick), ("slip", Phase.SLIP, slip)):
             inside = phase == code
             for i in range(2, phase.size - 2):
                 if not (inside[i - 2:i + 3].all() and values[i] <= values[i - 1]

@@ -25,7 +25,7 @@ from fivdisc.analysis.points import (
 )
 from fivdisc.analysis.stability import mode_labels
 from fivdisc.case import Case
-from fivdisc.engine.equilibrium import Equilibrium, _evaluate
+from fivdisc.engine.equilibrium import Equilibrium, slip_evaluation
 from fivdisc.limits import check_memory
 from fivdisc.model.build import Model
 
@@ -214,7 +214,7 @@ def eigen_branches(case: Case, key: str, values: Sequence[float], option: str = 
         if labelled is None or abs(value - own) < abs(values[labelled[0]] - own):
             labelled = (i, model, jac)
         force[i], angle[i] = eq.normal_force, eq.phi
-        under[i] = _evaluate(model, eq.state)[1]["w"]
+        under[i] = slip_evaluation(model, eq.state)[1]["w"]
     if bar is not None:
         bar.close()
     lam = follow(lam)

@@ -21,7 +21,6 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from fivdisc import core
 from fivdisc.analysis.normalform import first_lyapunov
 from fivdisc.analysis.points import (
     ParameterPoints,
@@ -30,7 +29,13 @@ from fivdisc.analysis.points import (
     slip_jacobian,
 )
 from fivdisc.case import Case
-from fivdisc.engine.equilibrium import Equilibrium, _evaluate, sliding_equilibrium, slip_phases
+from fivdisc.engine.equilibrium import (
+    Equilibrium,
+    sliding_equilibrium,
+    slip_evaluation,
+    slip_phases,
+)
+from fivdisc.engine.evaluation import unslaved
 from fivdisc.errors import AnalysisError, SimulationError
 from fivdisc.model.build import Model
 
@@ -179,11 +184,11 @@ def _full_layout(model: Model, eq: Equilibrium, vector: np.ndarray
     idx = reduced_indices(model)
     full = np.zeros((2, model.state_size))
     full[0, idx], full[1, idx] = vector.real, vector.imag
-    full = core.unslaved(core.core_model(model), 0.0, eq.state, ph, sg, full)
+    full = unslaved(model, eq.state, ph, sg, full)
     state = eq.state.copy()
     # The slaved rows of the equilibrium itself: z = w under the slider (zdot = 0).
-    _, aux = _evaluate(model, state)
-    state[model.n + model.n_sliders + np.arange(model.n_sliders)] = aux["w"]
+    _, aux = slip_evaluation(model, state)
+    state[model.slices.z] = aux["w"]
     vec = full[0] + 1j * full[1]
     vec /= np.linalg.norm(vec)
     big = np.argmax(np.abs(vec))

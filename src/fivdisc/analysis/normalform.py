@@ -22,7 +22,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from fivdisc.analysis.points import reduced_indices, slip_jacobian
-from fivdisc.model import layout as lay
 from fivdisc.model.build import Model
 
 __all__ = ["FirstLyapunov", "first_lyapunov", "lyapunov_coefficient"]
@@ -86,24 +85,21 @@ def _velocity_scale(model: Model, state: np.ndarray) -> tuple[float, float]:
     law is a cubic on each piece only: no step may cross a knot; else inf). On a piece
     the law is a cubic, whose differences of the Jacobian are exact: the largest step
     inside the piece is best."""
-    kern = model.kernel_args
-    opts = kern.opts
-    radius = kern.row("radius")
+    radius = model.kernel.row("radius")
     omega_c = float(model.speed.omega(0.0))
-    phid = state[model.index("phi_dot"): model.index("phi_dot") + model.n_sliders]
+    phid = state[model.slices.phi_dot]
     rel = omega_c - phid
     scale = float(np.min(np.abs(rel)))
     limit = np.inf
-    law = int(opts[lay.O_LAW])
+    law = model.law
     r = float(np.max(radius))
-    if law == lay.LAW_EXPONENTIAL and opts[lay.O_ALPHA] > 0.0:
-        scale = min(scale, 1.0 / (opts[lay.O_ALPHA] * r))
-    elif law == lay.LAW_STRIBECK:
-        scale = min(scale, opts[lay.O_VS] / r)
-    elif law == lay.LAW_TABLE:
-        knots = np.asarray(kern.table)[:, 0]
+    if law == "exponential" and model.friction_value("decay") > 0.0:
+        scale = min(scale, 1.0 / (model.friction_value("decay") * r))
+    elif law == "stribeck":
+        scale = min(scale, model.friction_value("stribeck_velocity") / r)
+    elif law == "table":
         u = radius * rel
-        gaps = np.abs(u[:, None] - knots[None, :]) / radius[:, None]
+        gaps = np.abs(u[:, None] - model.table_knots[None, :]) / radius[:, None]
         limit = float(np.min(gaps))
     return scale, limit
 
@@ -157,8 +153,8 @@ def first_lyapunov(model: Model, state: np.ndarray, omega: float,
     """
     jac = slip_jacobian(model, state) if jacobian is None else jacobian
     idx = reduced_indices(model)
-    n, ns = model.n, model.n_sliders
-    rates = slice(2 * n + ns, 2 * n + 2 * ns)
+    # The sliders' rates among the reduced unknowns.
+    rates = np.flatnonzero(np.isin(idx, np.r_[model.slices.phi_dot]))
     q, _, lam = _critical_vectors(jac, omega)
     slider = int(np.argmax(np.abs(q[rates])))
     scale, limit = _velocity_scale(model, state)
@@ -171,7 +167,7 @@ def first_lyapunov(model: Model, state: np.ndarray, omega: float,
     # A step h along the critical vector, scaled to a slip-speed amplitude of 1/2,
     # moves the slip speed by at most h / 2.
     step = min(_FIRST_STEP * scale, 1.9 * limit)
-    l1, error, c1 = lyapunov_coefficient(jacobian_at, state[idx], omega, 2 * n + ns + slider,
+    l1, error, c1 = lyapunov_coefficient(jacobian_at, state[idx], omega, int(rates[slider]),
                                          step, jac)
     return FirstLyapunov(l1, error, abs(lam.imag), slider, c1)
 

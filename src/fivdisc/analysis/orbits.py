@@ -40,8 +40,8 @@ from fivdisc.analysis.symmetry import (
 from fivdisc.case import Case
 from fivdisc.engine.integration import Integration, LongRunNotice, tangent_step
 from fivdisc.errors import ConvergenceError, FivdiscError
-from fivdisc.model import layout as lay
 from fivdisc.model.build import Model, build_model
+from fivdisc.model.layout import Phase
 
 __all__ = ["PeriodicOrbit", "SavedStart", "Shooting", "SymmetricShooting", "orbit_symmetry",
            "periodic_orbit", "saved_start"]
@@ -344,7 +344,7 @@ class Shooting:
         speed of this model: the kernel keeps a slider stuck at the start only if it
         moves exactly with the disc, so a point inside a stick phase stays one when the
         disc speed is changed (a continuation in the speed)."""
-        stuck = np.flatnonzero(self.phases == lay.STICK)
+        stuck = np.flatnonzero(self.phases == Phase.STICK)
         if stuck.size == 0:
             return x0
         x0 = np.array(x0, dtype=float)
@@ -480,7 +480,11 @@ def verdict_of(mult: np.ndarray, trivial: int) -> str:
 
 
 @dataclass
-class _Newton:
+class NewtonResult:
+    """Where Newton shooting (:func:`newton_shooting`) ended: the last iterate
+    ``(x0, period)`` [state, s], its shot and scaled residual, the iterations taken, and
+    ``reason`` ("" when converged, else what ended the iteration)."""
+
     x0: np.ndarray
     period: float
     shot: Shot
@@ -527,7 +531,7 @@ class Stall:
     accuracy: float
 
 
-def _stall(shooting: Shooting, sol: _Newton) -> Stall:
+def _stall(shooting: Shooting, sol: NewtonResult) -> Stall:
     """Classify a stall of Newton shooting at ``sol``'s iterate: within the integration's
     own accuracy, on a discontinuity of the shooting map (a line search along the Newton
     step, bisected to where the residual jumps, and the switches whose order flips
@@ -606,8 +610,8 @@ class OutOfTime(Exception):
     step does not try a smaller step after it)."""
 
 
-def _newton(shooting: Shooting, x0: np.ndarray, period: float, tol: float,
-            max_iterations: int, deadline: float, bar=None) -> _Newton:
+def newton_shooting(shooting: Shooting, x0: np.ndarray, period: float, tol: float,
+                    max_iterations: int, deadline: float, bar=None) -> NewtonResult:
     """Newton shooting on (x0, T) from a guess, each step halved until it reduces the
     residual; ``reason`` is "" when converged, else what ended the iteration."""
     sc = shooting.scale
@@ -646,7 +650,7 @@ def _newton(shooting: Shooting, x0: np.ndarray, period: float, tol: float,
             try:
                 trial = shooting.shoot(trial_x, trial_t)
             except OutOfTime:
-                return _Newton(x0, period, shot, residual, iterations,
+                return NewtonResult(x0, period, shot, residual, iterations,
                                "the time budget ran out")
             except FivdiscError:
                 continue
@@ -657,11 +661,11 @@ def _newton(shooting: Shooting, x0: np.ndarray, period: float, tol: float,
         else:
             if residual >= tol:
                 reason = STALL
-            return _Newton(x0, period, shot, residual, iterations, reason, step)
+            return NewtonResult(x0, period, shot, residual, iterations, reason, step)
         if bar is not None:
             bar.update()
             bar.set_postfix_str(f"residual {residual:.2e}")
-    return _Newton(x0, period, shot, residual, iterations, reason)
+    return NewtonResult(x0, period, shot, residual, iterations, reason)
 
 
 # A search whose Newton iterations are estimated to take longer than this in all [s]
@@ -706,7 +710,7 @@ def _returns_at(shooting: Shooting, x0: np.ndarray, period: float) -> int:
     x0 = shooting.held(x0)
     stuck = np.zeros(x0.size, dtype=bool)
     rates = shooting.model.index("phi_dot")
-    stuck[rates + np.flatnonzero(shooting.phases == lay.STICK)] = True
+    stuck[rates + np.flatnonzero(shooting.phases == Phase.STICK)] = True
     sc = shooting.scale
     for k in range(_MAX_DIVISOR, 1, -1):
         try:
@@ -937,7 +941,7 @@ def periodic_orbit(
         start = start or "from the given state"
         if period is None:
             period = _first_return(model, *_probe(model, x0, phases, window, rtol, atol_run))
-    phases = (np.full(model.n_sliders, lay.SLIP) if phases is None
+    phases = (np.full(model.n_sliders, Phase.SLIP) if phases is None
               else np.asarray(phases, dtype=np.int64))
     shooting: Shooting = Shooting(model, phases, rtol, atol_run)
     deadline = time.monotonic() + time_budget
@@ -958,7 +962,7 @@ def periodic_orbit(
     try:
         with progress_bar(max_iterations, "Newton shooting", "iteration",
                           show=progress) as bar:
-            sol = _newton(shooting, x0, period, tol, max_iterations, deadline, bar)
+            sol = newton_shooting(shooting, x0, period, tol, max_iterations, deadline, bar)
     except OutOfTime as exc:  # in the first shot: no iterate to report
         raise ConvergenceError(f"periodic_orbit: not converged: time_budget = "
                                f"{time_budget:g} s ran out ({exc})", result=None,
@@ -976,7 +980,7 @@ def periodic_orbit(
                             if isinstance(shooting, SymmetricShooting)
                             else Shooting(model, phases, tight, tight * 1e-7))
                 shooting.deadline = deadline
-                again = _newton(shooting, sol.x0, sol.period, tol, max_iterations, deadline,
+                again = newton_shooting(shooting, sol.x0, sol.period, tol, max_iterations, deadline,
                                 bar)
                 again.iterations += sol.iterations
                 notes.append(f"Newton stalled within the integration's accuracy "
@@ -1008,7 +1012,7 @@ def periodic_orbit(
             # converged at a period that may be a multiple).
             k = _returns_at(shooting, sol.x0, sol.period)
             if k > 1:
-                again = _newton(shooting, sol.x0, sol.period / k, tol, max_iterations,
+                again = newton_shooting(shooting, sol.x0, sol.period / k, tol, max_iterations,
                                 deadline)
                 if not again.reason and abs(again.period * k / sol.period - 1.0) < 1e-6:
                     again.iterations += sol.iterations
@@ -1177,12 +1181,12 @@ def _sticks(model: Model, x0: np.ndarray, phases: np.ndarray, period: float, rto
     """Whether a pad sticks on the orbit through ``x0`` over one period."""
     from fivdisc.engine.integration import Integration
 
-    if np.any(phases == lay.STICK):
+    if np.any(phases == Phase.STICK):
         return True
     run = Integration(model, x0, duration=period, rtol=rtol, atol=atol, phases=phases)
     run.run_to(period)
     _, rows = run.events()
-    return bool(np.any(rows[:, 2] == lay.STICK)) if rows.size else False
+    return bool(np.any(rows[:, 2] == Phase.STICK)) if rows.size else False
 
 
 class SavedStart(NamedTuple):

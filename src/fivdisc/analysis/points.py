@@ -11,16 +11,14 @@ cannot change it (the sliders' dampers).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from functools import cache
 
 import numpy as np
 
-from fivdisc import core
 from fivdisc.case import Case
 from fivdisc.engine.equilibrium import Equilibrium, sliding_equilibrium, slip_phases
+from fivdisc.engine.evaluation import jacobian
 from fivdisc.errors import AnalysisError, CaseError, FivdiscError, SimulationError
 from fivdisc.limits import duration_words
-from fivdisc.model import layout as lay
 from fivdisc.model.build import Model, build_model, model_at
 
 #: Fastest rate [1/s] of a model whose linearisation is analysed. The eigenvalues are
@@ -138,20 +136,15 @@ def _finite_without_the_law(model: Model, state: np.ndarray) -> bool:
 def reduced_indices(model: Model) -> np.ndarray:
     """Kernel-state indices of the slip equations' variables ``(q, phi, qdot, phidot)``:
     in contact the sliders' own z, zdot are slaved to the disc."""
-    return _reduced(model.n, model.n_sliders)
-
-
-@cache
-def _reduced(n: int, ns: int) -> np.ndarray:
-    half = n + 2 * ns
-    return np.r_[0 : n + ns, half : half + n + ns]
+    sl = model.slices
+    return np.r_[sl.q, sl.phi, sl.q_dot, sl.phi_dot]
 
 
 def slip_jacobian(model: Model, state: np.ndarray) -> np.ndarray:
     """Exact (complex-step) Jacobian of the slip equations (s = +1 for every slider) at
     ``state``, in the variables ``(q, phi, qdot, phidot)``."""
     ph, sg = slip_phases(model)
-    jac = core.jacobian(core.core_model(model), 0.0, state, ph, sg)
+    jac = jacobian(model, state, ph, sg)
     idx = reduced_indices(model)
     return jac[idx][:, idx]
 
@@ -263,10 +256,8 @@ def check_box(case: Case, axes: Sequence[tuple[str, np.ndarray]],
 def _equilibrium_key(model: Model) -> tuple:
     # The sliders' dampers do not enter the equilibrium: scans over c_z, c_phi reuse one
     # solve.
-    slider = model.kernel_args.slider.copy()
-    slider[[lay.S_CZ, lay.S_SCZ, lay.S_CPHI]] = 0.0
-    kern = model.kernel_args._replace(slider=slider)
-    return tuple(a.tobytes() for a in kern)
+    undamped = model.with_sliders(cz=0.0, cphi=0.0)
+    return tuple(a.tobytes() for a in undamped.kernel_args)
 
 
 class ParameterPoints:

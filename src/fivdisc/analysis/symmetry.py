@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fivdisc.analysis.kinds import BifurcationKind as Kind
 from fivdisc.case import Case
 from fivdisc.errors import FivdiscError
 from fivdisc.model.build import Model
@@ -135,7 +136,7 @@ def _pad_key(slider) -> tuple:
 def _rotation(model: Model, alpha: float, pads: np.ndarray) -> np.ndarray:
     """P of a turn of the disc by ``alpha`` with pad j taking pad ``pads[j]``'s values."""
     n, ns = model.n, model.n_sliders
-    half = n + 2 * ns
+    half = model.slices.q_dot.start
     block = np.zeros((half, half))
     i = 0
     while i < n:
@@ -149,7 +150,7 @@ def _rotation(model: Model, alpha: float, pads: np.ndarray) -> np.ndarray:
         block[i, i], block[i, i + 1] = c, -s
         block[i + 1, i], block[i + 1, i + 1] = s, c
         i += 2
-    for offset in (n, n + ns):
+    for offset in (model.slices.phi.start, model.slices.z.start):
         for j in range(ns):
             block[offset + j, offset + pads[j]] = 1.0
     return np.kron(np.eye(2), block)
@@ -159,12 +160,13 @@ def _mirror(model: Model, pads: np.ndarray, z_sign: float) -> np.ndarray:
     """P of the reflection in the mid-plane: every modal coordinate and slider deflection
     changes sign, pad j takes its facing pad ``pads[j]``'s values."""
     n, ns = model.n, model.n_sliders
-    half = n + 2 * ns
+    half = model.slices.q_dot.start
     block = np.zeros((half, half))
     block[:n, :n] = -np.eye(n)
+    phi, z = model.slices.phi.start, model.slices.z.start
     for j in range(ns):
-        block[n + j, n + pads[j]] = 1.0
-        block[n + ns + j, n + ns + pads[j]] = z_sign
+        block[phi + j, phi + pads[j]] = 1.0
+        block[z + j, z + pads[j]] = z_sign
     return np.kron(np.eye(2), block)
 
 
@@ -324,13 +326,13 @@ def classify_reduced(mu: complex, k: int) -> Crossing | None:
     if m % k == 0 or abs(delta) > RESONANT:
         return None
     if abs(mu.imag) <= 1e-6 * abs(mu):
-        return Crossing("symmetry breaking",
+        return Crossing(Kind.SYMMETRY_BREAKING,
                         f"a real multiplier -1 of the T/{k} map (+1 of the period): orbits "
                         f"without the T/{k} symmetry branch off (a pitchfork of the "
                         "symmetry)")
     turns = abs(k * delta)
     every = 1 / max(turns, 1e-300)
-    return Crossing("symmetry breaking",
+    return Crossing(Kind.SYMMETRY_BREAKING,
                     f"a pair of the T/{k} map crosses the unit circle at the angle "
                     f"2 pi ({m}/{k} {'+' if delta >= 0 else '-'} {abs(delta):.2g}): near the "
                     f"{m}:{k} resonance, a Neimark-Sacker bifurcation of the T/{k} map that "

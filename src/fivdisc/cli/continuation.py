@@ -278,6 +278,7 @@ def _start(case_file, from_file, which, point, key, target, rtol, tol, transient
     bifurcation other than a period doubling or a symmetry breaking); the key and the
     target are checked before any orbit is computed."""
     from fivdisc.analysis.checks import check_period, check_time
+    from fivdisc.analysis.kinds import BifurcationKind as Kind
     from fivdisc.analysis.orbits import periodic_orbit, saved_start
     from fivdisc.case import load_case
     from fivdisc.continuation.branch import CONTENT, open_branch
@@ -321,10 +322,10 @@ def _start(case_file, from_file, which, point, key, target, rtol, tol, transient
         value, state, per, kind = b["parameter"], b["state"], b["period"], b["kind"]
         phases = b["phases"]
         case = _checked(case, key, target).replace({key: value})
-        if kind == "period doubling":
+        if kind == Kind.PERIOD_DOUBLING:
             orbit, along = doubled_start(case, state, per, phases, rtol=rtol)
             return case, orbit, along, {}, None
-        if kind == "symmetry breaking":
+        if kind == Kind.SYMMETRY_BREAKING:
             orbit, along = broken_start(case, state, per, phases, b, rtol=rtol)
             return case, orbit, along, {}, None
         orbit = periodic_orbit(case, state, period=per, phases=phases, rtol=rtol, tol=tol,

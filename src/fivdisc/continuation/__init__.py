@@ -18,6 +18,7 @@ _API = {
     "fivdisc.continuation.from_hopf": ("hopf_cycles",),
     "fivdisc.continuation.starts": ("doubled_start",),
     "fivdisc.continuation.detection": ("Bifurcation",),
+    "fivdisc.analysis.kinds": ("BifurcationKind",),
     "fivdisc.continuation.branch": ("Branch", "open_branch"),
 }
 

@@ -38,14 +38,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from fivdisc.analysis.cycle import EVENT_WORDS, SIMULTANEOUS, Cycle
-from fivdisc.analysis.orbits import Shooting, _newton
+from fivdisc.analysis.orbits import Shooting, newton_shooting
 from fivdisc.continuation.problem import OrbitProblem, Point
 from fivdisc.continuation.settings import NEAR_SWITCHES, PAST, SETTLES
 from fivdisc.engine.equilibrium import contact_forces
 from fivdisc.engine.integration import Integration
 from fivdisc.engine.result import EVENT_KINDS
 from fivdisc.errors import FivdiscError
-from fivdisc.model import layout as lay
+from fivdisc.model.layout import EventKind, Phase
 
 # Where the state just before a switch is taken: this fraction of the period before it.
 _BEFORE = 1e-9
@@ -185,7 +185,7 @@ def switch_tests(problem: OrbitProblem, point: Point) -> list[Test]:
     period = point.period
     model = problem.model(point.value)
     shooting = Shooting(model, point.phases, problem.rtol, problem.atol, problem.scale)
-    mus = float(model.kernel.opts[lay.O_MUS])
+    mus = model.friction_value("static")
     omega = float(model.speed.omega(0.0))
     rates = model.index("phi_dot")
     tests: list[Test] = []
@@ -216,7 +216,7 @@ def switch_tests(problem: OrbitProblem, point: Point) -> list[Test]:
         y, ph, sg = run.state, np.array(run.ph), np.array(run.sg)
         normal, force = contact_forces(model, y, ph, sg, before)
         margin = _margins(mus, normal, force)
-        stuck_before = ph == lay.STICK
+        stuck_before = ph == Phase.STICK
         members = [lab for lab in group if lab[0] in ("stick", "slip", "reversal")]
         # A group's cascade tests are keyed by the group (its kind and its count among
         # groups of that kind) and the place in it: which identical pad the integration
@@ -228,17 +228,17 @@ def switch_tests(problem: OrbitProblem, point: Point) -> list[Test]:
         for i, lab in enumerate(members):
             kind, b, _ = lab
             if kind == "stick":
-                ph[b] = lay.STICK
+                ph[b] = Phase.STICK
                 y[rates + b] = omega
             elif kind == "slip":
-                ph[b] = lay.SLIP
+                ph[b] = Phase.SLIP
                 sg[b] = 1 if force[b] > 0 else -1
             else:
                 sg[b] = -sg[b]
             n2, f2 = contact_forces(model, y, ph, sg, before)
             after = _margins(mus, n2, f2)
             rest = {m[1] for m in members[i + 1:]}
-            for a in np.flatnonzero(stuck_before & (ph == lay.STICK)):
+            for a in np.flatnonzero(stuck_before & (ph == Phase.STICK)):
                 a = int(a)
                 if a == b:
                     continue
@@ -332,7 +332,7 @@ def other_piece(problem: OrbitProblem, lo: Point, p: float
     found = []
     for shooting in tries:
         try:
-            sol = _newton(shooting, shooting.held(lo.x), lo.period, problem.tol, 20,
+            sol = newton_shooting(shooting, shooting.held(lo.x), lo.period, problem.tol, 20,
                           math.inf)
         except FivdiscError:
             continue
@@ -389,7 +389,7 @@ def forward_run(problem: OrbitProblem, lo: Point, value: float, periods: int) ->
             break
         t_ev, rows = run.events()
         for t_i, row in zip(t_ev[seen:], rows[seen:], strict=True):
-            if EVENT_KINDS[int(row[0])] == "stick":
+            if row[0] == EventKind.STICK:
                 count[int(row[3])] += 1
             if EVENT_KINDS[int(row[0])] == kind and int(row[3]) == pad:
                 times.append(float(t_i))

@@ -8,6 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fivdisc.analysis.cycle import Cycle
+from fivdisc.analysis.kinds import BifurcationKind as Kind
 from fivdisc.analysis.symmetry import RESONANT, classify_reduced, isotypic
 from fivdisc.continuation.problem import OrbitProblem, Point
 from fivdisc.continuation.settings import LOCATE, REAL
@@ -84,18 +86,18 @@ def outside_counts(mult: np.ndarray, trivial: int) -> tuple[int, int, int]:
 
 def nearest_multiplier(mult: np.ndarray, trivial: int, kind: str) -> complex:
     others = np.delete(mult, trivial)
-    if kind == "period doubling":
+    if kind == Kind.PERIOD_DOUBLING:
         return complex(others[np.argmin(np.abs(others + 1.0))])
     cplx = others[np.abs(others.imag) > REAL * np.abs(others)]
     return complex(cplx[np.argmin(np.abs(np.abs(cplx) - 1.0))]) if cplx.size else 0j
 
 
 def test_value(pt: Point, kind: str) -> float:
-    if kind == "fold":
+    if kind == Kind.FOLD:
         return float(pt.tangent[-1])
-    if kind == "period doubling":
+    if kind == Kind.PERIOD_DOUBLING:
         return float(nearest_multiplier(pt.multipliers, pt.trivial, kind).real + 1.0)
-    if kind == "branch point":
+    if kind == Kind.BRANCH_POINT:
         others = np.delete(pt.multipliers, pt.trivial)
         real = others[np.abs(others.imag) <= REAL * np.abs(others)]
         return float(real.real[np.argmin(np.abs(real.real - 1.0))] - 1.0) if real.size else 1.0
@@ -108,18 +110,18 @@ def multipliers_of_kind(pt: Point, kind: str) -> np.ndarray:
     (torus; one of each pair), real positive (branch point)."""
     others = np.delete(pt.multipliers, pt.trivial)
     real = np.abs(others.imag) <= REAL * np.abs(others)
-    if kind == "period doubling":
+    if kind == Kind.PERIOD_DOUBLING:
         return others[real & (others.real < 0)]
-    if kind == "torus":
+    if kind == Kind.TORUS:
         return others[~real & (others.imag > 0)]
     return others[real & (others.real > 0)]
 
 
 def passage(mu: complex, kind: str) -> float:
     """One multiplier's test function: zero where it passes -1, the unit circle or +1."""
-    if kind == "period doubling":
+    if kind == Kind.PERIOD_DOUBLING:
         return mu.real + 1.0
-    if kind == "torus":
+    if kind == Kind.TORUS:
         return abs(mu) - 1.0
     return mu.real - 1.0
 
@@ -138,14 +140,14 @@ def crossings(a: Point, b: Point, kind: str) -> list[tuple[complex, complex]]:
 def smooth_kinds(a: Point, b: Point) -> list[str]:
     kinds = []
     if a.tangent[-1] * b.tangent[-1] < 0:
-        kinds.append("fold")
+        kinds.append(Kind.FOLD)
     oa, ob = outside_counts(a.multipliers, a.trivial), outside_counts(b.multipliers, b.trivial)
     if oa[1] != ob[1]:
-        kinds.append("period doubling")
+        kinds.append(Kind.PERIOD_DOUBLING)
     if oa[2] != ob[2]:
-        kinds.append("torus")
-    if oa[0] != ob[0] and "fold" not in kinds:
-        kinds.append("branch point")
+        kinds.append(Kind.TORUS)
+    if oa[0] != ob[0] and Kind.FOLD not in kinds:
+        kinds.append(Kind.BRANCH_POINT)
     return kinds
 
 
@@ -156,7 +158,7 @@ def located(problem: OrbitProblem, a: Point, b: Point, s_ab: float, kind: str,
     the interval is halved until each holds one, and each passage is followed by its own
     multiplier: the multiplier nearest the circle jumps from one pair to the other
     between them, and a root search on it would find the jump."""
-    if kind == "fold":
+    if kind == Kind.FOLD:
         return [locate(problem, a, b, s_ab, kind, deadline)]
     passing = crossings(a, b, kind)
     if not passing:
@@ -184,7 +186,7 @@ def locate(problem: OrbitProblem, a: Point, b: Point, s_ab: float, kind: str,
     from scipy.optimize import brentq
 
     p_tol = LOCATE * max(abs(a.value), 1e-12) / problem.ps
-    if kind == "signature change":
+    if kind == Kind.SIGNATURE_CHANGE:
         lo, hi, s_lo, s_hi = a, b, 0.0, s_ab
         key = a.cycle.cyclic()
         while abs(hi.z[-1] - lo.z[-1]) > p_tol and s_hi - s_lo > 1e-12:
@@ -220,24 +222,27 @@ def bifurcation_record(problem: OrbitProblem, kind: str, lo: Point, hi: Point, i
     the passing multiplier shows), else of ``lo`` and ``hi``. A smooth one on a symmetric
     orbit is classified by its critical eigenvector's symmetry (:func:`symmetric_kind`)."""
     before, after = sides if sides is not None else (lo, hi)
-    at = hi if kind == "signature change" else lo
+    at = hi if kind == Kind.SIGNATURE_CHANGE else lo
     rotation = math.nan
     note = ""
-    if kind == "torus":
+    if kind == Kind.TORUS:
         pair = nearest_multiplier(at.multipliers, at.trivial, kind)
         rotation = abs(math.atan2(pair.imag, pair.real)) / (2 * math.pi)
         note = f"a complex pair crosses the unit circle, rotation number {rotation:.6f}"
-    elif kind == "period doubling":
+    elif kind == Kind.PERIOD_DOUBLING:
         note = "a real multiplier crosses -1: an orbit of twice the period branches off"
-    elif kind == "fold":
+    elif kind == Kind.FOLD:
         note = "the branch turns back in the parameter (fold of cycles)"
-    elif kind == "branch point":
+    elif kind == Kind.BRANCH_POINT:
         note = "a real multiplier crosses +1 without a fold"
     else:
         sides_ = [f"slider {j}: {u} -> {v}" for j, (u, v) in
                   enumerate(zip(lo.cycle.signature, hi.cycle.signature, strict=True)) if u != v]
         note = "the event signature changes (" + "; ".join(sides_) + ")"
-    if kind in ("torus", "period doubling", "branch point"):
+        kind, what = discontinuity_kind(lo.cycle, hi.cycle)
+        if what:
+            note = f"{what}: {note}"
+    if kind in (Kind.TORUS, Kind.PERIOD_DOUBLING, Kind.BRANCH_POINT):
         found = symmetric_kind(kind, at, before, after)
         if found is not None:
             new_kind, extra = found
@@ -250,6 +255,55 @@ def bifurcation_record(problem: OrbitProblem, kind: str, lo: Point, hi: Point, i
                        before=before.multipliers, after=after.multipliers,
                        signature_before=lo.cycle.signature, signature_after=hi.cycle.signature,
                        rotation=rotation, point=index, note=note, phases=at.phases.copy())
+
+
+# What each discontinuity-induced kind means, in words.
+TOUCHES = {Kind.GRAZING: "grazing of the stick boundary (the slip speed touches zero: a "
+                         "stick phase appears or vanishes)",
+           "flight": "grazing of the separation boundary (the normal force touches zero: a "
+                     "flight appears or vanishes)",
+           Kind.STICK_SPLIT: "a stick phase splits (the friction needed to stick touches "
+                             "mu_s N inside it: a short slip appears or vanishes)"}
+# The phase that begins at an event of each kind.
+_BEGINS = {"stick": "stick", "slip": "slip", "reversal": "reversal", "separation": "flight",
+           "recontact": "slip"}
+
+
+def _shortest(cycle: Cycle, j: int) -> tuple[str, str]:
+    """The phase of slider ``j`` shortest over ``cycle``'s period, and the phase after
+    it."""
+    ev = sorted((t, kind) for t, kind, slider in cycle.events if slider == j)
+    if len(ev) < 2:
+        return "", ""
+    times = np.array([t for t, _ in ev])
+    i = int(np.argmin(np.diff(np.r_[times, times[0] + cycle.period])))
+    return _BEGINS[ev[i][1]], _BEGINS[ev[(i + 1) % len(ev)][1]]
+
+
+def discontinuity_kind(before: Cycle, after: Cycle) -> tuple[Kind, str]:
+    """The name of a change of the event signature between two orbits of a branch, and
+    what it is in words: a phase appearing or vanishing in each slider that changes is
+    the shortest phase of the side that has it; a stick phase or a flight is a grazing
+    (of the stick or of the separation boundary), a slip between two sticks a stick
+    split; any other change (a slip reversal, phases exchanged) a signature change."""
+    found = set()
+    for j, (u, v) in enumerate(zip(before.cyclic(), after.cyclic(), strict=True)):
+        if u == v:
+            continue
+        nu, nv = len(u.split(" > ")), len(v.split(" > "))
+        if nu == nv:
+            return Kind.SIGNATURE_CHANGE, ""
+        phase, following = _shortest(after if nv > nu else before, j)
+        if phase == "slip" and following == "stick":
+            found.add(Kind.STICK_SPLIT)
+        elif phase in ("stick", "flight"):
+            found.add(Kind.GRAZING if phase == "stick" else "flight")
+        else:
+            return Kind.SIGNATURE_CHANGE, ""
+    if len(found) != 1:
+        return Kind.SIGNATURE_CHANGE, ""
+    what = found.pop()
+    return (Kind.GRAZING if what == "flight" else what), TOUCHES[what]
 
 
 def _reduced_crossings(a: Point, b: Point) -> list[tuple[complex, complex]]:
@@ -268,7 +322,7 @@ def _reduced_crossings(a: Point, b: Point) -> list[tuple[complex, complex]]:
 
 def symmetric_kind(kind: str, at: Point, before: Point, after: Point
                    ) -> tuple[str, str] | None:
-    """What a smooth bifurcation of a symmetric orbit is: ``("symmetry breaking",
+    """What a smooth bifurcation of a symmetric orbit is: ``(Kind.SYMMETRY_BREAKING,
     note)`` when its critical eigenvector breaks the orbit's symmetry (on the reduced map
     of a spatio-temporal symmetry, a crossing at the angle ``2 pi m / k``, ``m != 0``, or
     near it: :func:`fivdisc.analysis.symmetry.classify_reduced`; on an in-phase orbit, an
@@ -294,14 +348,14 @@ def symmetric_kind(kind: str, at: Point, before: Point, after: Point
                           f"multiplier crosses at the angle 2 pi x {theta:.6f}{where}")
     if at.sym is not None and at.sym.spatial:
         mult, vecs = np.linalg.eig(at.shot.monodromy)
-        crit = nearest_multiplier(at.multipliers, at.trivial, kind) if kind != "branch point" \
+        crit = nearest_multiplier(at.multipliers, at.trivial, kind) if kind != Kind.BRANCH_POINT \
             else 1.0 + 0j
         i = int(np.argmin(np.abs(mult - crit)))
         for el in at.sym.spatial:
             m = isotypic(vecs[:, i], el)
             if m != 0:
                 forced = " (the symmetry makes it a double multiplier)" if el.order > 2 else ""
-                return ("symmetry breaking",
+                return (Kind.SYMMETRY_BREAKING,
                         f"the critical multiplier {mult[i]:.6f}{forced} has an eigenvector "
                         f"that the {el.label} does not map to itself (the orbit is "
                         f"{at.symmetry}): orbits without that symmetry branch off")
@@ -317,9 +371,9 @@ def without_fold_echoes(found: list[Bifurcation]) -> list[Bifurcation]:
     quantities, so where the fold lies within their errors of a point of the branch the
     passage may be counted in the interval beside the turn. A fold is that passage; it
     is not reported twice."""
-    folds = [b.point for b in found if b.kind == "fold"]
+    folds = [b.point for b in found if b.kind == Kind.FOLD]
     return [b for b in found
-            if not (b.kind == "branch point" and any(abs(b.point - f) <= 1 for f in folds))]
+            if not (b.kind == Kind.BRANCH_POINT and any(abs(b.point - f) <= 1 for f in folds))]
 
 
 def closed_on(found: list[Bifurcation], new: int) -> Bifurcation | None:
@@ -327,10 +381,10 @@ def closed_on(found: list[Bifurcation], new: int) -> Bifurcation | None:
     to 1e-5, ten times the location's accuracy), else None: the branch is a closed curve
     and has come round."""
     for b in found[new:]:
-        if b.kind != "fold":
+        if b.kind != Kind.FOLD:
             continue
         for earlier in found[:new]:
-            if (earlier.kind == "fold"
+            if (earlier.kind == Kind.FOLD
                     and abs(earlier.parameter - b.parameter) <= 1e-5 * abs(b.parameter)
                     and abs(earlier.period - b.period) <= 1e-5 * b.period):
                 return earlier
@@ -356,7 +410,7 @@ def slip_margin(problem: OrbitProblem, a: Point) -> float:
 def grazing(problem: OrbitProblem, a: Point, index: int) -> Bifurcation:
     """The end of a branch of slipping orbits lost where its slip speed touches zero."""
     period, p = a.period, a.value
-    return Bifurcation(kind="grazing", parameter=p, period=period, state=a.x.copy(),
+    return Bifurcation(kind=Kind.GRAZING, parameter=p, period=period, state=a.x.copy(),
                        before=a.multipliers, after=a.multipliers,
                        signature_before=a.cycle.signature, signature_after=a.cycle.signature,
                        point=index,

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from fivdisc.analysis.hopf import HopfPoint
+from fivdisc.analysis.kinds import BifurcationKind as Kind
 from fivdisc.continuation.branch import Branch
 from fivdisc.continuation.checks import check_target
 from fivdisc.continuation.problem import OrbitProblem
@@ -202,12 +203,12 @@ def _judge(result: Branch, hopf: Any, earlier: dict[str, Any] | None = None) -> 
     # with the equilibrium from there to the Hopf value, and may reach beyond the
     # grazing value, where they are not followed: the range is then open on that side.
     grazing = [b["parameter"] for b in result.bifurcations()
-               if b["kind"] == "grazing" and (b["parameter"] - hopf.value) * unstable_side < 0]
+               if b["kind"] == Kind.GRAZING and (b["parameter"] - hopf.value) * unstable_side < 0]
     # A fold next to a stable point is the farthest end of those stable orbits, located
     # more exactly than any point computed beside it.
     n = len(p)
     folds = [b["parameter"] for b in result.bifurcations()
-             if b["kind"] == "fold" and (b["parameter"] - hopf.value) * unstable_side < 0
+             if b["kind"] == Kind.FOLD and (b["parameter"] - hopf.value) * unstable_side < 0
              and any(result.stable[i] for i in (b["point"], b["point"] + 1) if i < n)]
     if earlier is not None and np.isfinite(earlier["bistable"][0]):
         # The earlier branch's range: its end away from the Hopf point, a bound if it was.

@@ -62,6 +62,7 @@ from typing import Any
 import numpy as np
 
 from fivdisc.analysis.cycle import order_changes
+from fivdisc.analysis.kinds import BifurcationKind as Kind
 from fivdisc.analysis.orbits import (
     PeriodicOrbit,
     periodic_orbit,
@@ -81,6 +82,7 @@ from fivdisc.continuation.borders import (
 from fivdisc.continuation.branch import Branch
 from fivdisc.continuation.checks import check_search, check_target, check_window, full_key
 from fivdisc.continuation.detection import (
+    TOUCHES,
     Bifurcation,
     bifurcation_record,
     closed_on,
@@ -320,7 +322,7 @@ def walk_on(problem: OrbitProblem, walk: Walk, to: float, back_to: float | None,
                               "(a period growing without bound: a homoclinic orbit?)")
             return
         passed = landing or np.sign(target - b.z[-1]) != side
-        turned = any(f.kind == "fold" for f in walk.bifurcations)
+        turned = any(f.kind == Kind.FOLD for f in walk.bifurcations)
         back = turned and away(b, began, to) and not away(a, began, to)
         if (passed and not landing) or back:
             try:
@@ -340,7 +342,7 @@ def walk_on(problem: OrbitProblem, walk: Walk, to: float, back_to: float | None,
             ds = max(min_step, min(ds, settings.step))
             failed = False
             continue
-        folds = [f for f in walk.bifurcations if f.kind == "fold"]
+        folds = [f for f in walk.bifurcations if f.kind == Kind.FOLD]
         if back or (not turned and folds and away(b, began, to)):
             walk.stop = Stop(f"the branch turned at the fold at {problem.key} = "
                               f"{folds[-1].parameter:.9g} and came back to {problem.key} = "
@@ -453,10 +455,10 @@ def record_between(problem: OrbitProblem, walk: Walk, a: Point, b: Point, s_ab: 
     index = len(walk.points) - 1
     if a.cycle.cyclic() != b.cycle.cyclic():
         try:
-            lo, hi = locate(problem, a, b, s_ab, "signature change", deadline)
+            lo, hi = locate(problem, a, b, s_ab, Kind.SIGNATURE_CHANGE, deadline)
         except ConvergenceError:
             lo, hi = a, b
-        walk.bifurcations.append(bifurcation_record(problem, "signature change", lo, hi, index))
+        walk.bifurcations.append(bifurcation_record(problem, Kind.SIGNATURE_CHANGE, lo, hi, index))
         return b
     classes = pad_classes(a) or pad_classes(b)
     if _piece(a, classes) != _piece(b, classes):
@@ -465,7 +467,7 @@ def record_between(problem: OrbitProblem, walk: Walk, a: Point, b: Point, s_ab: 
         lo, hi, p_hi = br.lo, br.hi, br.p_hi
         width = abs(p_hi - lo.value) / problem.ps
         if hi is not None and float(np.linalg.norm(hi.z - lo.z)) <= 10.0 * width + 1e-9:
-            bif = bifurcation_record(problem, "switching order", lo, hi, index)
+            bif = bifurcation_record(problem, Kind.SWITCHING_ORDER, lo, hi, index)
             bif.note = ("switches of different pads change order, the flow map continuous "
                         "there (its derivative jumps): " + "; ".join(order_changes(lo.cycle,
                                                                                    hi.cycle)))
@@ -510,7 +512,7 @@ def _across(problem: OrbitProblem, walk: Walk, br: Bracket, index: int,
                 other = pt
                 break
     if other is not None:
-        bif = Bifurcation(kind="discontinuity", parameter=0.5 * (lo.value + p_hi),
+        bif = Bifurcation(kind=Kind.DISCONTINUITY, parameter=0.5 * (lo.value + p_hi),
                           period=lo.period, state=lo.x.copy(), before=lo.multipliers,
                           after=other.multipliers, signature_before=lo.cycle.signature,
                           signature_after=other.cycle.signature, point=index,
@@ -560,7 +562,7 @@ def end_of_branch(problem: OrbitProblem, walk: Walk, a: Point, reason: str, ds: 
         if lo is not walk.points[-1]:
             walk.points.append(lo)
             index += 1
-        walk.bifurcations.append(bifurcation_record(problem, "signature change", lo, hi,
+        walk.bifurcations.append(bifurcation_record(problem, Kind.SIGNATURE_CHANGE, lo, hi,
                                                     index))
         x, phases = problem.anchored(hi.x, hi.period, hi.value, hi.phases, hi.cycle)
         return problem.point_at(x, hi.period, hi.value, phases,
@@ -636,7 +638,7 @@ def _end(problem: OrbitProblem, walk: Walk, br: Bracket, index: int,
                 restart = other_piece_at(problem, lo, fwd)
                 if restart is not None:
                     walk.bifurcations.append(Bifurcation(
-                        kind="gap", parameter=at, period=lo.period, state=lo.x.copy(),
+                        kind=Kind.GAP, parameter=at, period=lo.period, state=lo.x.copy(),
                         before=lo.multipliers, after=restart.multipliers,
                         signature_before=lo.cycle.signature,
                         signature_after=restart.cycle.signature, point=index,
@@ -646,7 +648,7 @@ def _end(problem: OrbitProblem, walk: Walk, br: Bracket, index: int,
     confirm = f"; {fwd.text}" if fwd is not None else ""
     sig_after = lo.cycle.signature
     if ahead is not None and ahead.test.kind in ("margin", "gap"):
-        kind = "discontinuity end"
+        kind = Kind.DISCONTINUITY_END
         jump = ahead.test.jump
         what = (f"{ahead.test.text}: it reaches zero at {key} = {ahead.at:.9g}, where the "
                 "switches of different pads change order"
@@ -660,7 +662,7 @@ def _end(problem: OrbitProblem, walk: Walk, br: Bracket, index: int,
                          f"does not persist past it{confirm}")
         return None
     elif ahead is not None and ahead.test.kind == "cascade":
-        kind = "cascade end"
+        kind = Kind.CASCADE_END
         what = (f"{ahead.test.text}: it reaches zero at {key} = {ahead.at:.9g}, where the "
                 "load turns into a relief and the pads no longer switch together"
                 if ahead.at != lo.value else
@@ -669,14 +671,16 @@ def _end(problem: OrbitProblem, walk: Walk, br: Bracket, index: int,
         stop = (f"the orbit does not persist past the end of its release cascade at {key} = "
                 f"{at:.9g}")
     elif ahead is not None:
-        kind = "signature change"
         sig_after = _predicted(lo.cycle.signature, ahead.test)
+        # A dip reaching zero: inside a stick phase a split, inside a slip a grazing.
+        kind = {"stick": Kind.STICK_SPLIT, "slip": Kind.GRAZING}.get(
+            ahead.test.key[2] if ahead.test.key[0] == "dip" else "", Kind.SIGNATURE_CHANGE)
         what = (f"{ahead.test.text}: it reaches zero at {key} = {ahead.at:.9g}, where a phase "
-                "appears or vanishes")
-        stop = f"the orbit does not persist past the signature change at {key} = {at:.9g}"
+                "appears or vanishes" + (f" ({TOUCHES[kind]})" if kind in TOUCHES else ""))
+        stop = f"the orbit does not persist past the {kind} at {key} = {at:.9g}"
     else:
         walk.bifurcations.append(Bifurcation(
-            kind="end", parameter=at, period=lo.period, state=lo.x.copy(),
+            kind=Kind.END, parameter=at, period=lo.period, state=lo.x.copy(),
             before=lo.multipliers, after=lo.multipliers, signature_before=lo.cycle.signature,
             signature_after=lo.cycle.signature, point=index,
             note=f"{why}; no test function of the orbit vanishes there{confirm}",
@@ -694,12 +698,12 @@ def _end(problem: OrbitProblem, walk: Walk, br: Bracket, index: int,
 
 def other_piece_at(problem: OrbitProblem, lo: Point, fwd) -> Point | None:
     """The orbit a settled forward run found, as a branch point (Newton at its value)."""
-    from fivdisc.analysis.orbits import Shooting, _newton
+    from fivdisc.analysis.orbits import Shooting, newton_shooting
 
     shooting = Shooting(problem.model(fwd.value), fwd.phases, problem.rtol, problem.atol,
                         problem.scale)
     try:
-        sol = _newton(shooting, fwd.state, fwd.period, problem.tol, 20, math.inf)
+        sol = newton_shooting(shooting, fwd.state, fwd.period, problem.tol, 20, math.inf)
         if sol.reason:
             return None
         x, phases = problem.anchored(shooting.held(sol.x0), sol.period, fwd.value,

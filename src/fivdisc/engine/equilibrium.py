@@ -13,9 +13,11 @@ import numpy as np
 
 from fivdisc import core
 from fivdisc.case import Case
+from fivdisc.engine.evaluation import evaluate
 from fivdisc.errors import SimulationError
 from fivdisc.model import layout as lay
 from fivdisc.model.build import Model, build_model
+from fivdisc.model.layout import Phase
 
 
 @dataclass(frozen=True)
@@ -66,14 +68,14 @@ class Equilibrium:
 def slip_phases(model: Model) -> tuple[np.ndarray, np.ndarray]:
     """Phase and sign arrays of every slider slipping forward (``v = Omega - phidot > 0``)."""
     ns = model.n_sliders
-    return np.full(ns, lay.SLIP, dtype=np.int64), np.ones(ns, dtype=np.int64)
+    return np.full(ns, Phase.SLIP, dtype=np.int64), np.ones(ns, dtype=np.int64)
 
 
-def _evaluate(model: Model, y: np.ndarray) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+def slip_evaluation(model: Model, y: np.ndarray) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """The slip equations' right-hand side at ``y`` and the per-slider quantities of
-    :func:`fivdisc.core.evaluate` (``normal_force``, ``friction_force``, ``w``, ...)."""
-    ph, sg = slip_phases(model)
-    return core.evaluate(core.core_model(model), 0.0, y, ph, sg)
+    :func:`fivdisc.engine.evaluation.evaluate` (``normal_force``, ``friction_force``,
+    ``w``, ...), every slider slipping with the disc faster."""
+    return evaluate(model, y, *slip_phases(model))
 
 
 def contact_forces(model: Model, y: np.ndarray, phases: np.ndarray, signs: np.ndarray,
@@ -82,18 +84,15 @@ def contact_forces(model: Model, y: np.ndarray, phases: np.ndarray, signs: np.nd
     state ``y`` in the given phases and slip signs, as they are: no phase is chosen
     again (a stuck slider beyond its static limit stays stuck, its friction force the
     reaction that would hold it)."""
-    _, aux = core.evaluate(core.core_model(model), float(t),
-                           np.asarray(y, dtype=float)[: model.state_size].copy(),
-                           np.asarray(phases, dtype=np.int64),
-                           np.asarray(signs, dtype=np.int64))
+    _, aux = evaluate(model, np.asarray(y, dtype=float)[: model.state_size].copy(), phases,
+                      signs, t)
     return (np.asarray(aux["normal_force"], dtype=float).copy(),
             np.asarray(aux["friction_force"], dtype=float).copy())
 
 
 def _unknowns(model: Model) -> np.ndarray:
-    """State indices of the equilibrium's unknowns (q, phi) and of their accelerations."""
-    n, ns = model.n, model.n_sliders
-    return np.r_[0 : n + ns]
+    """State indices of the equilibrium's unknowns (q, phi)."""
+    return np.r_[model.slices.q, model.slices.phi]
 
 
 def sliding_equilibrium(
@@ -173,7 +172,7 @@ def sliding_equilibrium(
     n, ns = model.n, model.n_sliders
     kern = model.kernel_args
     unknowns = _unknowns(model)
-    acc_index = unknowns + n + 2 * ns
+    acc_index = np.r_[model.slices.q_dot, model.slices.phi_dot]
     radius, n0 = kern.row("radius"), kern.row("n0")
     inertias = np.append(model.modal_mass, kern.row("inertia"))
     # Rigid-disc guess: N = N0, friction balanced by the in-plane spring; the disc
@@ -224,7 +223,7 @@ def sliding_equilibrium(
             f"no sliding equilibrium found at Omega = {omega_c} rad/s ({sol.message.strip()})"
         )
     y = state(sol.x)
-    _, aux = _evaluate(model, y)
+    _, aux = slip_evaluation(model, y)
     nf = aux["normal_force"]
     if contact and np.any(nf <= 0.0):
         j = int(np.argmin(nf))
@@ -260,8 +259,7 @@ def initial_state(model: Model, initial=None) -> np.ndarray:
         initial = sim.initial_state
     n, ns = model.n, model.n_sliders
     y = np.zeros(model.state_size)
-    phi = slice(model.index("phi"), model.index("phi") + ns)
-    phi_dot = slice(model.index("phi_dot"), model.index("phi_dot") + ns)
+    phi, phi_dot = model.slices.phi, model.slices.phi_dot
     if isinstance(initial, str):
         if initial == "rest":
             return y
@@ -283,8 +281,8 @@ def initial_state(model: Model, initial=None) -> np.ndarray:
             raise SimulationError(
                 f"initial has unknown keys {sorted(unknown)}: allowed are {sorted(allowed)}"
             )
-        blocks = (("q", slice(0, n), n, "modal coordinate"),
-                  ("q_dot", slice(n + 2 * ns, 2 * n + 2 * ns), n, "modal coordinate"),
+        blocks = (("q", model.slices.q, n, "modal coordinate"),
+                  ("q_dot", model.slices.q_dot, n, "modal coordinate"),
                   ("phi", phi, ns, "slider"), ("phi_dot", phi_dot, ns, "slider"))
         for key, sl, size, what in blocks:
             if key not in initial:

@@ -17,6 +17,7 @@ from fivdisc.engine.result import EVENT_KINDS
 from fivdisc.errors import FivdiscError
 from fivdisc.model import layout as lay
 from fivdisc.model.build import Model
+from fivdisc.model.layout import Phase
 
 # Switches closer than this, this many times in a row, are taken as Zeno/chattering.
 ZENO_DT = 1e-10
@@ -258,7 +259,7 @@ class Integration:
         y = np.concatenate([np.asarray(y0, dtype=float), np.zeros(n_acc)])
         n_sl = model.n_sliders
         n_out = int(np.floor(duration * output_rate + 1e-9)) + 1 if output_rate > 0 else 0
-        ph = np.full(n_sl, lay.SLIP, dtype=np.int64)
+        ph = np.full(n_sl, Phase.SLIP, dtype=np.int64)
         if phases is not None:
             ph[:] = phases
         bp = model.speed.breakpoints

@@ -18,6 +18,7 @@ import numpy as np
 from fivdisc.engine.record import Record
 from fivdisc.engine.selection import select_slider  # noqa: F401 - its documented path
 from fivdisc.errors import FivdiscError
+from fivdisc.model.layout import ENERGY_NAMES, EventKind, Phase
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -27,10 +28,10 @@ if TYPE_CHECKING:
     from fivdisc.case import Case
     from fivdisc.model.speed import SpeedProfile
 
-PHASE_NAMES = ("slip", "stick", "separation")
+PHASE_NAMES = tuple(p.label for p in Phase)
 # Run attributes that are arrays (one entry per slider or state component).
 _ARRAY_ATTRS = ("final_phase", "final_state")
-EVENT_KINDS = ("stick", "slip", "reversal", "separation", "recontact")
+EVENT_KINDS = tuple(k.label for k in EventKind)
 # Every simulation result keeps some of these (a reproduced figure's runs only what the
 # figure draws, and the phases).
 _RESULT_VARIABLES = ("phase", "phi", "phi_dot", "q", "w", "normal_force", "friction_force")
@@ -63,18 +64,17 @@ def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarr
     attrs : dict
         Global attributes (status, message, statistics, case text, ...).
     """
-    n, ns = model.n, model.n_sliders
-    q = out_y[:, :n]
-    q_dot = out_y[:, n + 2 * ns : 2 * n + 2 * ns]
+    sl, col = model.slices, model.columns
+    q = out_y[:, sl.q]
+    q_dot = out_y[:, sl.q_dot]
 
     def block(what: str) -> np.ndarray:
-        start = model.index(what)
-        return out_y[:, start : start + ns]
+        return out_y[:, getattr(sl, what)]
 
-    normal = out_aux[:, :ns]
-    friction = out_aux[:, ns : 2 * ns]
-    phase = out_aux[:, 2 * ns : 3 * ns]
-    w_under = out_aux[:, 3 * ns : 4 * ns]
+    normal = out_aux[:, col.normal_force]
+    friction = out_aux[:, col.friction_force]
+    phase = out_aux[:, col.phase]
+    w_under = out_aux[:, col.w]
     ev_t, ev_i = events
     probes = np.asarray(model.case.simulation.probes, dtype=float).reshape(-1, 2)
     sliders = model.case.sliders
@@ -84,7 +84,7 @@ def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarr
     data = {
         "phi": _var(per, block("phi"), "rad", "slider circumferential angle"),
         "phi_dot": _var(per, block("phi_dot"), "rad/s", "slider angular velocity"),
-        "disc_speed": _var("time", out_aux[:, 4 * ns], "rad/s", "disc spinning speed"),
+        "disc_speed": _var("time", out_aux[:, col.disc_speed], "rad/s", "disc spinning speed"),
         "normal_force": _var(per, normal, "N", "normal contact force"),
         "friction_force": _var(
             per, friction, "N", "friction force on the slider (positive along +phi)"
@@ -117,12 +117,9 @@ def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarr
         "event_slider": _var("event", ev_i[:, 3].astype(np.int16), "1",
                              "slider that switched"),
     }
-    n_dyn = model.state_size
-    if out_y.shape[1] > n_dyn:
-        from fivdisc.model.layout import ENERGY_NAMES
-
+    if out_y.shape[1] > model.state_size:
         data["energy_work"] = _var(
-            ("time", "energy_term"), out_y[:, n_dyn:], "J",
+            ("time", "energy_term"), out_y[:, sl.energy], "J",
             "work done since t = 0 by each kind of force (impact terms: sum of the jumps)",
         )
     coords = {
@@ -131,7 +128,8 @@ def build_dataset(model, out_y: np.ndarray, out_aux: np.ndarray, times: np.ndarr
                        {"units": "1", "long_name": "modal coordinate (C/D, k, l)"}),
         "k": _var("coordinate", model.k, "1", "nodal circles"),
         "l": _var("coordinate", model.l, "1", "nodal diameters"),
-        "slider": ("slider", np.arange(ns), {"units": "1", "long_name": "slider index"}),
+        "slider": ("slider", np.arange(model.n_sliders),
+                   {"units": "1", "long_name": "slider index"}),
         "angle": _var("slider", np.array([s.angle for s in sliders]), "rad",
                       "space-fixed angle of the slider's base"),
         "face": ("slider", np.array([s.face for s in sliders], dtype=str),

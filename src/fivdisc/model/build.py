@@ -12,6 +12,10 @@ from fivdisc.model import layout as lay
 from fivdisc.model.plate import AnnularPlate, PlateMode
 from fivdisc.model.speed import SpeedProfile
 
+# The friction laws by the core's code (KernelModel.opts[O_LAW]).
+_LAWS = {lay.LAW_EXPONENTIAL: "exponential", lay.LAW_STRIBECK: "stribeck",
+         lay.LAW_TABLE: "table"}
+
 
 @dataclass(frozen=True, eq=False)
 class Model:
@@ -125,12 +129,41 @@ class Model:
             opts[lay.FRICTION_SLOTS[name]] = value
         return replace(self, kernel=self.kernel._replace(opts=opts))
 
+    @cached_property
+    def slices(self) -> lay.StateSlices:
+        """Where ``q``, ``phi``, ``z``, ``q_dot``, ``phi_dot``, ``z_dot`` (and the energy
+        accumulators, after them) lie in the state vector."""
+        return lay.StateSlices.of(self.n, self.n_sliders, lay.N_ENERGY)
+
+    @cached_property
+    def columns(self) -> lay.OutputColumns:
+        """The columns of an integration's per-sample output (``out_aux``)."""
+        return lay.OutputColumns.of(self.n_sliders)
+
     def index(self, what: str, j: int = 0) -> int:
         """Position of slider j's ``"phi"``, ``"z"``, ``"phi_dot"`` or ``"z_dot"`` in the
         state vector."""
-        n, s = self.n, self.n_sliders
-        offset = {"phi": n, "z": n + s, "phi_dot": 2 * n + 2 * s, "z_dot": 2 * n + 3 * s}
-        return offset[what] + j
+        return getattr(self.slices, what).start + j
+
+    @property
+    def law(self) -> str:
+        """The friction law the model holds: ``"exponential"``, ``"stribeck"`` or
+        ``"table"``."""
+        return _LAWS[int(self.kernel.opts[lay.O_LAW])]
+
+    def friction_value(self, name: str) -> float:
+        """A friction parameter the model holds (a key of the case's ``[friction]`` table:
+        ``"static"``, ``"decay"``, ``"stribeck_velocity"``, ...), after
+        :meth:`with_friction`."""
+        return float(self.kernel.opts[lay.FRICTION_SLOTS[name]])
+
+    @property
+    def table_knots(self) -> np.ndarray:
+        """The relative sliding speeds [m/s] where a tabulated friction law's pieces
+        start (empty for the other laws)."""
+        if self.law != "table":
+            return np.empty(0)
+        return np.asarray(self.kernel.table)[:, 0]
 
     def shape_matrix(self, r, theta) -> np.ndarray:
         """``(len(r), n)`` matrix mapping q to the disc's w at points (r [m], theta [rad])."""

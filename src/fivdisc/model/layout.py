@@ -21,20 +21,113 @@ fields (``src/fivdisc/core/src/model.hpp``).
 
 from __future__ import annotations
 
+from enum import IntEnum
 from typing import NamedTuple
 
 import numpy as np
 
-SLIP = 0
-STICK = 1
-SEPARATION = 2
 
-# Event kinds (columns of the event table).
-EV_STICK = 0
-EV_SLIP = 1
-EV_REVERSAL = 2
-EV_SEPARATION = 3
-EV_RECONTACT = 4
+class Phase(IntEnum):
+    """A slider's contact phase, as the state's phase codes, the ``phase`` variable of a
+    result and the event table hold it (an ``int``: arrays of phases are integer arrays).
+
+    Examples
+    --------
+    >>> from fivdisc import Phase
+    >>> Phase.STICK.label, Phase(2)
+    ('stick', <Phase.SEPARATION: 2>)
+    """
+
+    SLIP = 0
+    STICK = 1
+    SEPARATION = 2
+
+    @property
+    def label(self) -> str:
+        """The name results and messages use (``"slip"``, ``"stick"``, ``"separation"``)."""
+        return self.name.lower()
+
+
+class EventKind(IntEnum):
+    """The kind of a switch, as the first column of the event table holds it.
+
+    ``STICK``: the slip speed reaches zero and the static margin holds; ``SLIP``: a
+    stuck slider's friction reaches its static limit; ``REVERSAL``: the slip speed
+    changes sign without sticking; ``SEPARATION``: the normal force reaches zero;
+    ``RECONTACT``: the gap closes.
+
+    Examples
+    --------
+    >>> from fivdisc import EventKind
+    >>> EventKind(4).label
+    'recontact'
+    """
+
+    STICK = 0
+    SLIP = 1
+    REVERSAL = 2
+    SEPARATION = 3
+    RECONTACT = 4
+
+    @property
+    def label(self) -> str:
+        """The name results and ``stop_on`` use (``"stick"``, ``"slip"``, ...)."""
+        return self.name.lower()
+
+
+class StateSlices(NamedTuple):
+    """Where each block of the state vector ``y`` lies (the layout above), for ``n``
+    modal coordinates and ``S`` sliders: ``y[slices.phi_dot]`` are the sliders' rates.
+
+    Examples
+    --------
+    >>> from fivdisc.model.layout import StateSlices
+    >>> StateSlices.of(n=2, sliders=1).phi_dot
+    slice(6, 7, None)
+    """
+
+    q: slice
+    phi: slice
+    z: slice
+    q_dot: slice
+    phi_dot: slice
+    z_dot: slice
+    energy: slice
+
+    @classmethod
+    def of(cls, n: int, sliders: int, energy: int = 0) -> StateSlices:
+        """The slices for ``n`` modal coordinates, ``sliders`` sliders and ``energy``
+        accumulators."""
+        sizes = (n, sliders, sliders, n, sliders, sliders, energy)
+        ends = np.cumsum(sizes).tolist()
+        return cls(*(slice(e - k, e) for e, k in zip(ends, sizes, strict=True)))
+
+
+class OutputColumns(NamedTuple):
+    """The columns of an integration's per-sample output ``out_aux`` for ``S`` sliders:
+    per slider the normal force [N], the friction force [N], the phase and the disc's
+    deflection under it [m] (slices of ``S`` columns), then the disc speed [rad/s] (one
+    column).
+
+    Examples
+    --------
+    >>> from fivdisc.model.layout import OutputColumns
+    >>> OutputColumns.of(2).phase, OutputColumns.of(2).disc_speed
+    (slice(4, 6, None), 8)
+    """
+
+    normal_force: slice
+    friction_force: slice
+    phase: slice
+    w: slice
+    disc_speed: int
+
+    @classmethod
+    def of(cls, sliders: int) -> OutputColumns:
+        s = sliders
+        return cls(slice(0, s), slice(s, 2 * s), slice(2 * s, 3 * s), slice(3 * s, 4 * s),
+                   4 * s)
+
 
 # Rows of KernelModel.disc (one column per modal coordinate).
 D_SGN = 0  # +1 for a cosine (C) coordinate, -1 for a sine (D) coordinate

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from fivdisc.analysis.cycle import MEASURES
+from fivdisc.analysis.kinds import BifurcationKind as Kind
 from fivdisc.case import describe_key
 from fivdisc.continuation.branch import Branch
 from fivdisc.errors import FivdiscError
@@ -28,12 +29,13 @@ BRANCH_MEASURES = ("period", *MEASURES, *(f"{m}_{e}" for m in MEASURES for e in 
 #: calls too short to show dashed.
 NARROW = 0.02
 # Short labels of the bifurcations on a figure.
-_MARKS = {"fold": ("LP", "s"), "period doubling": ("PD", "D"), "torus": ("NS", "o"),
-          "branch point": ("BP", "^"), "signature change": ("DIB", "v"),
-          "grazing": ("GR", "v"), "symmetry breaking": ("SB", "P"),
-          "switching order": ("SO", "v"), "discontinuity": ("JUMP", "X"),
-          "discontinuity end": ("END", "X"), "cascade end": ("END", "X"),
-          "end": ("LOST", "x"), "gap": ("GAP", "x")}
+_MARKS = {Kind.FOLD: ("LP", "s"), Kind.PERIOD_DOUBLING: ("PD", "D"), Kind.TORUS: ("NS", "o"),
+          Kind.BRANCH_POINT: ("BP", "^"), Kind.SIGNATURE_CHANGE: ("DIB", "v"),
+          Kind.GRAZING: ("GR", "v"), Kind.STICK_SPLIT: ("SPLIT", "v"),
+          Kind.SYMMETRY_BREAKING: ("SB", "P"),
+          Kind.SWITCHING_ORDER: ("SO", "v"), Kind.DISCONTINUITY: ("JUMP", "X"),
+          Kind.DISCONTINUITY_END: ("END", "X"), Kind.CASCADE_END: ("END", "X"),
+          Kind.END: ("LOST", "x"), Kind.GAP: ("GAP", "x")}
 
 
 def _columns(branch: Branch, measure: str, slider: int) -> list[tuple[str, np.ndarray, str]]:
@@ -121,7 +123,7 @@ def draw_branch(ax: Axes, branch: Branch, measure: str = "period", slider: int =
     span_x, span_y = _spans(x, curves)
     placed: list[tuple[float, float]] = []
     for b in branch.bifurcations():
-        label, marker = _MARKS.get(b["kind"], ("?", "x"))
+        label, marker = _MARKS[Kind(b["kind"])]
         i = b["point"]
         j = min(i + 1, x.size - 1)
         for _, y, _ in curves:
