@@ -194,7 +194,7 @@ def equivariance_error(model: Model, matrix: np.ndarray, samples: int = 3,
                                 kern.row("mass")])
     base = sliding_equilibrium(model).state
     omega = float(model.speed.omega(0.0))
-    rates = slice(model.index("phi_dot"), model.index("phi_dot") + model.n_sliders)
+    rates = model.slices.phi_dot
     worst = 0.0
     for _ in range(samples):
         x = base + 0.1 * scale * rng.standard_normal(base.size) * np.linalg.norm(base / scale)

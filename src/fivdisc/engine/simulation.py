@@ -277,8 +277,8 @@ class Deflection:
     def beyond(self, y: np.ndarray) -> bool:
         """Whether the state ``y`` is non-finite or deflects the disc beyond the limit."""
         model = self.model
-        q = y[: model.n]
-        phi = y[model.index("phi") : model.index("phi") + model.n_sliders]
+        q = y[model.slices.q]
+        phi = y[model.slices.phi]
         if not (np.all(np.isfinite(q)) and np.all(np.isfinite(phi))):
             self.largest = np.inf
             return True
