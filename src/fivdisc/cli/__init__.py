@@ -127,14 +127,6 @@ def main() -> None:
     gc.set_threshold(*_GC_THRESHOLDS)
     try:
         cli(prog_name="fivdisc")
-    except SystemExit as exc:
-        if exc.code not in (0, None):
-            # An error's traceback may hold the compiled core's objects in reference
-            # cycles; left to the exit, nanobind reports each as leaked (some twenty lines
-            # after the one-line error). Freed now: an error need not be quick.
-            exc.__context__ = exc.__cause__ = None
-            gc.collect()
-        raise
     finally:
         # Every output is written and closed by now. The interpreter's shutdown then
         # collects garbage across all the imported libraries' objects, a noticeable part

@@ -290,6 +290,12 @@ struct PyIntegrator {
 
 NB_MODULE(_core, m) {
     m.doc() = "fivdisc's compiled core: the non-smooth integrator and the right-hand side (C++).";
+    // The command line freezes the garbage collector once its output is written (a full
+    // collection over scipy's and xarray's objects costs a short command up to 0.4 s), so
+    // a model or run left in a reference cycle is still alive when this module is torn
+    // down; nanobind would report each as a leak on stderr after every such command. No
+    // object of this module owns anything but memory, which the exit returns.
+    nb::set_leak_warnings(false);
 
     // CoreError is fivdisc's own error (FivdiscError) and a ValueError.
     nb::object base = nb::module_::import_("fivdisc.errors").attr("FivdiscError");
