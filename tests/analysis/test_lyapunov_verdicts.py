@@ -11,7 +11,7 @@ import json
 import numpy as np
 import pytest
 
-from fivdisc.analysis.exponents import LyapunovSpectrum, lyapunov
+from fivdisc.analysis.exponents import RECURRENT, LyapunovSpectrum, lyapunov
 from fivdisc.analysis.orbits import periodic_orbit
 from fivdisc.analysis.stability import linear_stability
 from fivdisc.case import Case
@@ -128,3 +128,34 @@ def test_the_command_exits_0_with_a_verdict_on_a_periodic_orbit(tmp_path):
     assert res.exit_code == 1
     (line,) = messages(res.stderr)
     assert line.startswith("error: lambda_1 = ") and "--n 2" in line
+
+
+def test_a_positive_exponent_of_a_recurrent_motion_is_undecided():
+    """Three identical pads from their equilibrium, with the default transient (0.6 s):
+    over the measurement the motion stays near an unstable periodic orbit (the pads'
+    sticks recur to 3e-4 of their interval), where the finite-time exponent is positive
+    at three uncertainties. It is not chaos: with a 6 s transient the motion has left for
+    the stable orbit of the pads sticking in turn, whose largest exponent (the flow
+    direction's) is consistent with zero. So the verdict of the first is undecided, and
+    says why."""
+    from support.cases import THREE_PADS
+
+    short = lyapunov(THREE_PADS, n=2)
+    assert short.bounds(0)[0] > 0  # positive over the window, at three uncertainties
+    assert short.recurrence < RECURRENT
+    assert short.verdict(0) == "undecided"
+    assert "stays near a periodic orbit" in short.explain(0)
+    long = lyapunov(THREE_PADS, n=2, transient=6.0)
+    assert long.verdict(0) == "zero"
+
+
+@pytest.mark.parametrize(("recurrence", "verdict"), [
+    (np.nan, "positive"),  # no sticks to judge the motion by
+    (0.6, "positive"),  # irregular sticks
+    (1e-3, "undecided"),  # sticks that recur: near a periodic orbit
+])
+def test_the_recurrence_of_sticks_decides_a_positive_verdict(recurrence, verdict):
+    spec = LyapunovSpectrum(np.array([2.0, -1.0]), np.array([0.1, 0.1]), np.ones(1),
+                            np.zeros((1, 2)), 0.0, 1.0, 1.0, recurrence)
+    assert spec.verdict(0) == verdict
+    assert spec.verdict(1) == "negative"

@@ -20,6 +20,7 @@ many exponents as free coordinates exist.
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -30,6 +31,7 @@ from fivdisc.engine.integration import Integration, check_steps, tangent_step
 from fivdisc.engine.progress import SIMULATED_TIME, progress_bar
 from fivdisc.errors import FivdiscError
 from fivdisc.model.build import Model, build_model
+from fivdisc.model.layout import EventKind
 
 __all__ = ["LyapunovSpectrum", "lyapunov"]
 
@@ -41,6 +43,11 @@ SIGNIFICANCE = 3.0
 
 # Blocks of the run whose exponents give the uncertainty (their spread).
 _BLOCKS = 10
+#: Largest :attr:`LyapunovSpectrum.recurrence` of a motion that stays near a periodic
+#: orbit: its sticks recur at intervals equal to 1e-2 or better. An irregular stick-slip
+#: motion's intervals differ by a good part of themselves (the paper's Fig. 19a slider at
+#: a constant 6 pi rad/s: 0.6); the three-pad case's motion near its unstable orbit, 3e-4.
+RECURRENT = 1e-2
 # Sets of tangent vectors from independent random starts for more than one exponent: the
 # difference of their exponents is what the start still does to the estimate (Notes of
 # `lyapunov`). The largest exponent alone keeps one set: sweeps compute it at every point.
@@ -74,6 +81,13 @@ class LyapunovSpectrum:
     transient, duration, interval : float
         Length of the transient, of the measurement and the re-orthonormalisation
         interval [s].
+    recurrence : float
+        How regularly the sliders stick over the measurement: the largest, over the
+        sliders that stick at least three times, of the standard deviation of the
+        intervals between a slider's successive sticks over their mean [-]; nan where
+        none does. Below :data:`RECURRENT` the motion stays near a periodic orbit, and a
+        positive exponent is that orbit's instability over this window, not chaos: its
+        verdict is undecided (:meth:`verdict`).
 
     See Also
     --------
@@ -103,6 +117,7 @@ class LyapunovSpectrum:
     transient: float
     duration: float
     interval: float
+    recurrence: float = math.nan
 
     @property
     def largest(self) -> float:
@@ -157,11 +172,14 @@ class LyapunovSpectrum:
         Otherwise it is undecided: an uncertainty is unknown, it lies between one and
         three uncertainties from zero (neither near it nor clearly away), or no other
         exponent measures the scale (with one exponent, none: compute two). A longer
-        measurement shrinks ``u`` and decides it.
+        measurement shrinks ``u`` and decides it. A positive exponent of a motion whose
+        sticks recur regularly (:attr:`recurrence` below :data:`RECURRENT`) is undecided
+        too: the motion stays near an unstable periodic orbit over the measurement, and
+        whether it leaves it for chaos or for a stable orbit a longer transient tells.
         """
         low, high = self.bounds(i)
         if low > 0:
-            return POSITIVE
+            return UNDECIDED if self.recurrence < RECURRENT else POSITIVE
         if high < 0:
             return NEGATIVE
         near_low, near_high = self.bounds(i, 1.0)
@@ -202,6 +220,11 @@ class LyapunovSpectrum:
             j = self._resolved_by(i)
             return (f"{head}: consistent with zero (within one uncertainty, and resolved "
                     f"from lambda_{j + 1} = {self.exponents[j]:+.6g} 1/s)")
+        if low > 0:
+            return (f"{head}: undecided at this length: positive over the measurement, "
+                    f"but the sliders' sticks recur to {self.recurrence:.1e} of their "
+                    "interval, so the motion stays near a periodic orbit that is unstable; "
+                    "lengthen the transient to see whether it leaves it")
         few = ("too few re-orthonormalisations: lengthen the measurement or shorten the "
                "interval")
         if not np.isfinite(u):
@@ -247,7 +270,8 @@ class LyapunovSpectrum:
                 "verdicts": verdicts, "verdict": verdicts[0],
                 "conclusive": [bool(c) for c in self.conclusive],
                 "transient": self.transient, "duration": self.duration,
-                "interval": self.interval}
+                "interval": self.interval,
+                "recurrence": self.recurrence if np.isfinite(self.recurrence) else None}
 
     def to_json(self) -> str:
         """:meth:`to_dict` as indented JSON (what ``fivdisc lyapunov --json`` prints)."""
@@ -538,7 +562,20 @@ def _measure(run: Integration, model: Model, limit: Any, free: np.ndarray, n: in
     with np.errstate(invalid="ignore"):
         spread = np.ptp([part.sum(axis=0) / times[-1] for part in sets], axis=0)
     return LyapunovSpectrum(exponents, _uncertainty(logs, times, exponents, spread), times,
-                            running, float(transient), float(duration), float(interval))
+                            running, float(transient), float(duration), float(interval),
+                            _recurrence(run, t0))
+
+
+def _recurrence(run: Integration, since: float) -> float:
+    """:attr:`LyapunovSpectrum.recurrence` of the run's sticks after ``since`` [s]."""
+    times, rows = run.events()
+    keep = (rows[:, 0] == EventKind.STICK) & (times >= since)
+    spreads = []
+    for j in np.unique(rows[keep, 3]):
+        gaps = np.diff(times[keep & (rows[:, 3] == j)])
+        if gaps.size >= 2:
+            spreads.append(gaps.std() / gaps.mean())
+    return float(max(spreads)) if spreads else math.nan
 
 
 def _uncertainty(logs: np.ndarray, times: np.ndarray, exponents: np.ndarray,
