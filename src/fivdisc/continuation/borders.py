@@ -445,6 +445,12 @@ def forward_run(problem: OrbitProblem, lo: Point, value: float, periods: int) ->
                     f"{k} crossing"
                     f"{'s' if k > 1 else ''}, mean {mean:.9g} s; sticks per pad "
                     f"{list(out.sticks)}): no periodic orbit there")
+        others = np.delete(np.abs(lo.multipliers), lo.trivial)
+        if others.size and others.max() > 1.0:
+            # A run leaves an unstable orbit on either side of its end alike.
+            out.text += (f", which does not confirm the end: the branch's last orbit is "
+                         f"unstable (largest multiplier {others.max():.6g}), so a forward "
+                         "run leaves it before the end too")
     return out
 
 
