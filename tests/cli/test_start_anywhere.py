@@ -74,6 +74,30 @@ def test_simulate_from_a_branch_point_runs_on_its_orbit(branch_file, tmp_path):
     assert float(first["phi"].values[0].squeeze()) == pytest.approx(float(y0[1]), abs=1e-12)
 
 
+def test_simulate_from_a_branch_point_at_another_value(branch_file, tmp_path, case_file):
+    """--at runs the point's state at another value of the key (a forward run past an
+    end); a case file's own value is not used silently: the output says which value runs.
+    Second route: the run's sticks come at the closed form's period of the value run."""
+    path, br = branch_file
+    at = 1.05 * br.parameter[3]
+    out = tmp_path / "at.nc"
+    res = run_cli(["simulate", "--from", path, "--point", 3, "--at", at, "-o", out,
+                   "--no-progress"])
+    assert res.exit_code == 0, res.output
+    assert f"note: run at speed.value = {at:.9g}, not the point's" in res.stdout
+    ds = xr.open_dataset(out)
+    sticks = ds["event_time"].values[ds["event_kind"].values.astype(str) == "stick"]
+    # the stable orbit's disc mode decays by 0.92 a period: the last sticks are on the
+    # orbit at the new value
+    assert np.diff(sticks)[-1] == pytest.approx(rigid_disc_closed_form(at)[0], rel=1e-4)
+    res = run_cli(["simulate", case_file(RIGID.replace({"speed.value": at})), "--from", path,
+                   "--point", 3, "-o", tmp_path / "case.nc", "--no-progress"])
+    assert res.exit_code == 0, res.output
+    assert "the branch point's, not CASE_FILE's" in res.stdout
+    bad = run_cli(["simulate", case_file(RIGID), "--at", 1.0, "-o", tmp_path / "b.nc"])
+    assert bad.exit_code != 0 and "--at needs --from BRANCH" in bad.output
+
+
 @pytest.mark.parametrize("command", [["orbit"], ["simulate", "-o", "x.nc"],
                                      ["continue", "--key", "speed.value", "--to", "2"]])
 def test_a_point_needs_a_branch(command, tmp_path, case_file):

@@ -26,10 +26,13 @@ from fivdisc.cli._case import CASE, default_output
 @click.option("--point", type=int,
               help="With --from BRANCH: start from its point K (from 0; negative from the "
               "end).")
+@click.option("--at", "at_value", type=float,
+              help="With --from BRANCH: run at this value of the branch's key instead of "
+              "the point's (a forward run past a branch's end from its last orbit).")
 @click.option("--progress/--no-progress", default=True, show_default=True,
               help="Show a progress bar in simulated time.")
 def simulate(case_file: Path | None, output: Path | None, from_file: Path | None,
-             point: int | None, progress: bool) -> None:
+             point: int | None, at_value: float | None, progress: bool) -> None:
     """Simulate CASE_FILE and write the time histories and events as netCDF.
 
     CASE_FILE is a TOML case file or the name of a packaged example (``fivdisc examples``),
@@ -48,18 +51,31 @@ def simulate(case_file: Path | None, output: Path | None, from_file: Path | None
     from fivdisc.errors import FivdiscError
     from fivdisc.files import NETCDF, check_output
 
-    if point is not None and from_file is None:
-        raise FivdiscError("--point needs --from BRANCH (a file of fivdisc continue -o)")
+    for option, given in (("--point", point), ("--at", at_value)):
+        if given is not None and from_file is None:
+            raise FivdiscError(f"{option} needs --from BRANCH (a file of fivdisc continue -o)")
     case = load_case(case_file) if case_file is not None else None
     initial = phases = None
+    notes = []
     if from_file is not None:
         from fivdisc.analysis.orbits import saved_start
 
         saved = saved_start(from_file, point)
+        if at_value is not None and not saved.key:
+            raise FivdiscError(f"--at needs --from BRANCH: {from_file} holds no branch")
         if case is None:
             case = saved.case
-        elif saved.key:
-            case = case.replace({saved.key: saved.value})
+        if saved.key:
+            value = saved.value if at_value is None else at_value
+            given = case.get(saved.key)
+            case = case.replace({saved.key: value})
+            if at_value is not None:
+                notes.append(f"run at {saved.key} = {value:.9g}, not the point's "
+                             f"{saved.value:.9g} (--at)")
+            elif case_file is not None and given != value:
+                notes.append(f"run at {saved.key} = {value:.9g}, the branch point's, not "
+                             f"CASE_FILE's {given:.9g} (--at VALUE runs the point's state "
+                             "at another value)")
         initial, phases = saved.state, saved.phases
     if case is None:
         raise FivdiscError("simulate needs CASE_FILE, or --from a file that stores its case")
@@ -74,6 +90,8 @@ def simulate(case_file: Path | None, output: Path | None, from_file: Path | None
     click.echo(f"wrote {out}")
     if from_file is not None:
         click.echo(f"started {saved.start} (simulation.initial_state is not used)")
+    for note in notes:
+        click.echo(f"note: {note}")
     for line in result.summary().lines()[1:]:
         click.echo(line)
     if not result.ok:
