@@ -113,6 +113,13 @@ def orbit(case_file: Path | None, period: float | None, transient: float | None,
         click.echo(f"error: no periodic orbit: {err}", err=True)
         sys.exit(1)
     _report(res, case, as_json, out)
+    if res.verdict == "unstable" and guess is None and not as_json:
+        # The search starts where a transient run ended: near an orbit it passes slowly,
+        # which need not be the motion the case settles to.
+        spent = case.simulation.duration if transient is None else transient
+        click.echo(f"note: this orbit is unstable, so a run leaves it: the transient "
+                   f"({spent:g} s) ended near it; a longer --transient may reach the motion "
+                   "the case settles to")
 
 
 @click.command()
