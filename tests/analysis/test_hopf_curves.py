@@ -258,3 +258,21 @@ def test_three_pads_in_speed_and_disc_damping():
             assert abs(h.value - x) < 0.1
             signs.append(np.sign(h.l1))
         assert signs[0] == -signs[1]
+
+
+def test_the_figure_draws_each_style_as_one_line(stribeck):
+    """A curve is drawn in runs of one style: the subcritical part of the Stribeck curve
+    (past its Bautin point) is one dashed line through all its points, not a line per
+    segment (dashes restart on every line, so short segments looked solid)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from fivdisc.plots import plot_hopf_curves
+
+    fig = plot_hopf_curves(stribeck)
+    lines = [ln for ln in fig.axes[0].get_lines() if len(ln.get_xdata()) > 1]
+    dashed = [ln for ln in lines if ln.get_linestyle() == "--"]
+    solid = [ln for ln in lines if ln.get_linestyle() == "-"]
+    sub = int((stribeck["l1"].values > 0).sum())
+    assert dashed and solid
+    assert max(len(ln.get_xdata()) for ln in dashed) >= sub - 1

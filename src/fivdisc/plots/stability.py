@@ -363,10 +363,17 @@ def plot_hopf_curves(ds: xr.Dataset, ax: Axes | None = None,
         color = cycle[modes.index(str(ds["curve_mode"].values[c])) % len(cycle)]
         sub = ds["l1"].values[sel] > 0.0
         outer = ds["on_boundary"].values[sel].astype(bool)
-        for k in range(sel.size - 1):
-            i, j = sel[k], sel[k + 1]
-            ax.plot(x[[i, j]], y[[i, j]], color=color, ls="--" if sub[k] and sub[k + 1]
-                    else "-", lw=2.6 if outer[k] and outer[k + 1] else 1.2)
+        # Each segment's style, drawn as runs of one style: dashes restart on every line,
+        # so a dashed curve of many short segments, one line each, looked solid.
+        styles = [("--" if sub[k] and sub[k + 1] else "-",
+                   2.6 if outer[k] and outer[k + 1] else 1.2) for k in range(sel.size - 1)]
+        start = 0
+        for k in range(1, len(styles) + 1):
+            if k == len(styles) or styles[k] != styles[start]:
+                ls, lw = styles[start]
+                ax.plot(x[sel[start: k + 1]], y[sel[start: k + 1]], color=color, ls=ls,
+                        lw=lw)
+                start = k
     if ds.sizes["curve_index"]:
         ax.plot([], [], color="0.3", lw=1.2, label="supercritical (l1 < 0)")
         ax.plot([], [], color="0.3", lw=1.2, ls="--", label="subcritical (l1 > 0)")
