@@ -55,6 +55,29 @@ def test_a_branch_continued_from_a_hopf_branch_restates_its_kind_and_range(tmp_p
     assert whole["bistable"][1] == pytest.approx(info["bistable"][1], rel=1e-5)
 
 
+def test_an_undetermined_range_names_the_farthest_orbit_reached(tmp_path):
+    """A branch continued from a Hopf branch back towards the Hopf point has not decided
+    the range beyond its farthest orbit, which is its start, not its end (the new user's
+    branch walked down and said "not determined up to" its last value)."""
+    import re
+
+    case = tmp_path / "rigid.toml"
+    case.write_text(RIGID.to_toml())
+    first, back = tmp_path / "hopf.nc", tmp_path / "back.nc"
+    res = run_cli(["continue", case, "--key", "speed.value", "--to", "30", "--from-hopf",
+                   "0.5:30:25", "--points", "3", "--no-progress", "-o", first])
+    assert res.exit_code == 0, res.output
+    hopf = open_branch(first).hopf()["value"]
+    res = run_cli(["continue", "--from", first, "--key", "speed.value", "--to",
+                   hopf + 1e-4, "--points", "5", "--no-progress", "-o", back])
+    assert res.exit_code == 0, res.output
+    branch = open_branch(back)
+    assert branch.parameter[-1] < branch.parameter[0]  # it walked back
+    (said,) = re.findall(r"not determined up to speed.value = ([0-9.]+)", res.stdout)
+    farthest = branch.parameter[np.argmax(np.abs(branch.parameter - hopf))]
+    assert float(said) == pytest.approx(farthest, rel=1e-8)
+
+
 def test_from_hopf_says_which_point_it_takes_and_warns_when_its_orbits_are_unstable(
         tmp_path):
     """Three pads between 0.3 and 5 rad/s: four Hopf points, none where the sliding

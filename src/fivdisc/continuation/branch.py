@@ -388,7 +388,9 @@ class Branch:
                          "Hopf point, so the orbits born there are unstable and sliding is "
                          "stable on neither side")
             elif math.isnan(low) and hopf["bistable_undetermined"]:
-                reach = (f"not determined up to {self.key} = {p[-1]:.9g}{unit}: the "
+                # the branch's farthest orbit from the Hopf point, wherever it walked
+                farthest = p[np.argmax(np.abs(p - hopf["value"]))]
+                reach = (f"not determined up to {self.key} = {farthest:.9g}{unit}: the "
                          "slipping orbits there are unstable and have neither folded nor "
                          "grazed; they bound the basin of stable sliding, and the motion "
                          "beyond them may be a stable vibration (continue further, or "
