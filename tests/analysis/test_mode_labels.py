@@ -27,12 +27,30 @@ SPEEDS = ("speed.value", np.linspace(0.5, 30.0, 60))  # 22 rad/s, the case's, am
 
 def _shares(case, vectors) -> tuple[list[str], np.ndarray]:
     """Coordinates and their shares of each eigenvector's kinetic energy, from the modal
-    masses and the sliders' inertias (velocity rows of the eigenvectors)."""
+    masses and the sliders' inertias (velocity rows of the eigenvectors). Identical pads
+    equally spaced on one face are named by their pattern round the ring instead: the
+    energy of the pads' rates in each discrete Fourier component, pads taken by
+    increasing angle, ``phi~k`` the one whose phase advances ``k/N`` of a cycle from one
+    pad to the next."""
     model = build_model(case)
-    names = [*model.labels, *(["phi"] if len(case.sliders) == 1
-                              else [f"phi{j}" for j in range(len(case.sliders))])]
-    inertia = np.r_[model.modal_mass, [s.mass * s.track_radius**2 for s in case.sliders]]
+    pads = case.sliders
+    names = [*model.labels, *(["phi"] if len(pads) == 1
+                              else [f"phi{j}" for j in range(len(pads))])]
+    inertia = np.r_[model.modal_mass, [s.mass * s.track_radius**2 for s in pads]]
     energy = inertia[:, None] * np.abs(vectors[len(names):]) ** 2
+    ring = len(pads) > 1 and len({s.face for s in pads}) == 1 and all(
+        s.model_dump(exclude={"angle", "perturbation"})
+        == pads[0].model_dump(exclude={"angle", "perturbation"}) for s in pads) and np.allclose(
+        np.diff(np.sort([s.angle % (2 * np.pi) for s in pads])), 2 * np.pi / len(pads))
+    if ring:
+        n, ns = model.n, len(pads)
+        order = np.argsort([s.angle % (2 * np.pi) for s in pads])
+        order = np.roll(order, -int(np.flatnonzero(order == 0)[0]))
+        rates = vectors[len(names) + n:][order]
+        j = np.arange(ns)
+        basis = np.exp(-2j * np.pi * np.outer(j, j) / ns)  # row k: e^{-2 pi i k j / N}
+        energy[n:] = inertia[n] * np.abs(basis @ rates) ** 2 / ns
+        names = [*model.labels, *(f"phi~{k}" for k in range(ns))]
     return names, energy / energy.sum(axis=0)
 
 
@@ -75,17 +93,22 @@ def test_a_single_pad_s_clear_modes_keep_their_dominant_coordinate():
     assert [lin.dominant[i] for i in upper] == [names[r] for r in np.argmax(shares, axis=0)]
 
 
-def test_three_pads_are_named_by_frequency_and_their_energy_is_in_the_pads():
-    lin = linear_stability(THREE_PADS)
-    upper = _upper(lin)
-    names, shares = _shares(THREE_PADS, lin.eigenvectors[:, upper])
-    pads = [k for k, i in enumerate(upper) if lin.dominant[i].startswith("phi")]
-    assert len(pads) == 3
-    pad_rows = [names.index(f"phi{j}") for j in range(3)]
-    assert all(shares[pad_rows, k].sum() > 0.9 for k in pads)
-    # Their shares tie (each pad moves in each mode): the lowest frequency is phi0.
-    by_frequency = sorted(pads, key=lambda k: lin.eigenvalues[upper[k]].imag)
-    assert [lin.dominant[upper[k]] for k in by_frequency] == ["phi0", "phi1", "phi2"]
+def test_three_pads_are_named_by_their_pattern_at_every_speed():
+    """Three identical pads: the three pad modes (their energy in the pads) are named by
+    their pattern round the ring, each by the pattern that holds most of its pads'
+    energy, whatever their frequencies' order (it changes between 19.5 and 22 rad/s,
+    where naming by frequency swapped the names of one eigenvalue)."""
+    for speed in (19.5, 22.0):
+        case = THREE_PADS.replace({"speed.value": speed})
+        lin = linear_stability(case)
+        upper = _upper(lin)
+        names, shares = _shares(case, lin.eigenvectors[:, upper])
+        pads = [k for k, i in enumerate(upper) if lin.dominant[i].startswith("phi")]
+        assert len(pads) == 3
+        rows = [names.index(f"phi~{k}") for k in range(3)]
+        assert all(shares[rows, k].sum() > 0.9 for k in pads)
+        for k in pads:
+            assert lin.dominant[upper[k]] == names[rows[int(np.argmax(shares[rows, k]))]]
 
 
 def test_branches_hopf_points_and_the_table_use_one_label_per_eigenvalue():
@@ -115,7 +138,7 @@ def test_branches_hopf_points_and_the_table_use_one_label_per_eigenvalue():
             assert hp.mode == str(ds["mode"].values[b])
         # Three pad Hopf points near 19.3 rad/s, one per pad mode.
         late = [hp.mode for hp in hopf if 19.0 < hp.value < 20.0]
-        assert sorted(late) == ["phi0", "phi1", "phi2"]
+        assert sorted(late) == ["phi~0", "phi~1", "phi~2"]
 
 
 def test_the_command_writes_and_prints_the_labels_it_draws(tmp_path):

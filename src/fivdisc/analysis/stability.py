@@ -21,6 +21,7 @@ from fivdisc.analysis.points import (
     slip_jacobian,
     warn_if_long,
 )
+from fivdisc.analysis.symmetry import pad_ring
 from fivdisc.case import Case, is_case_key, keys_like, unit_of
 from fivdisc.engine.equilibrium import Equilibrium, sliding_equilibrium
 from fivdisc.errors import CaseError, SimulationError, nearest
@@ -289,7 +290,12 @@ def mode_labels(model: Model, eigenvalues: np.ndarray, vectors: np.ndarray
     ``phi0``, ``phi1``, ``phi2``. Where two modes' shares leave the choice open (they
     would give up less than :data:`LABEL_TIE` of their shares by trading names: the two
     halves of travelling waves, identical pads) the lower frequency takes the
-    coordinate listed first, so that labels do not turn on round-off. A mode left
+    coordinate listed first, so that labels do not turn on round-off. Where the pads are
+    ``N`` identical ones equally spaced on a face (:func:`fivdisc.analysis.symmetry.
+    pad_ring`), their coordinates are their patterns round the ring instead: ``phi~0``
+    the pads in phase, ``phi~k`` the pattern whose phase advances by ``k/N`` of a cycle
+    from one pad to the next in the direction of their angle (the pads' rates ``~
+    exp(2 pi i k j / N)``, pad ``j`` the ``j``-th from pad 0). A mode left
     without a coordinate (real eigenvalues
     outnumber what is left: an overdamped coordinate has two) takes its dominant
     coordinate's name with a prime per earlier use (``"phi0'"``).
@@ -318,6 +324,19 @@ def mode_labels(model: Model, eigenvalues: np.ndarray, vectors: np.ndarray
     real = np.abs(lam.imag) <= 1e-12 * scale
     modes = [i for i in range(lam.size) if real[i] or lam[i].imag > 0]
     shares = energy_shares(model, vectors[:, modes])
+    ring = pad_ring(model)
+    if ring is not None:
+        # Identical pads equally spaced: each mode is spread over every pad alike, so
+        # which pad it is named after would turn on round-off. The pads' part is named
+        # by its pattern round the ring instead (the discrete Fourier components of the
+        # pads' rates, whose energies sum to the pads' by Parseval's theorem).
+        ns = model.n_sliders
+        rates = vectors[model.n + ns + model.n:, :][ring][:, modes]
+        patterns = np.abs(np.fft.fft(rates, axis=0)) ** 2 / ns
+        pads = shares[model.n:].sum(axis=0)
+        shares[model.n:] = patterns * pads / np.where(patterns.sum(axis=0) > 0,
+                                                      patterns.sum(axis=0), 1.0)
+        names = (*model.labels, *(f"phi~{k}" for k in range(ns)))
     rows, cols = linear_sum_assignment(-shares)
     coordinate = dict(zip(cols.tolist(), rows.tolist(), strict=True))  # mode -> coordinate
     # Near-ties follow the frequencies: where two modes would give up less than

@@ -40,7 +40,8 @@ from fivdisc.case import Case
 from fivdisc.errors import FivdiscError
 from fivdisc.model.build import Model
 
-__all__ = ["CaseSymmetry", "Element", "OrbitSymmetry", "case_symmetry", "classify_reduced"]
+__all__ = ["CaseSymmetry", "Element", "OrbitSymmetry", "case_symmetry", "classify_reduced",
+           "pad_ring"]
 
 # Relative change of two angles taken as the same place on the disc [rad].
 _ANGLE = 1e-9
@@ -204,6 +205,24 @@ def equivariance_error(model: Model, matrix: np.ndarray, samples: int = 3,
         worst = max(worst, float(np.linalg.norm((fp - matrix @ f) / scale)
                                  / np.linalg.norm(f / scale)))
     return worst
+
+
+def pad_ring(model: Model) -> np.ndarray | None:
+    """The pads in their order round the track (of increasing angle, from pad 0), where
+    every pad of the case is one of ``N`` identical pads equally spaced on one face (the
+    group ``Z_N``, ``N`` the number of pads): a turn of the disc by ``2 pi / N`` takes
+    each pad's values to the next. None for any other case."""
+    group = case_symmetry(model, check=False)
+    ns = model.n_sliders
+    turn = next((el for el in group.elements
+                 if el.order == ns and el.label == f"turn by {360 / ns:g} degrees"), None)
+    if turn is None:
+        return None
+    ring = [0]
+    while len(ring) < ns:
+        # the pad that takes the last one's values: the next in the direction of angle
+        ring.append(int(np.flatnonzero(turn.pads == ring[-1])[0]))
+    return np.array(ring) if len(set(ring)) == ns else None
 
 
 def case_symmetry(model: Model, check: bool = True) -> CaseSymmetry:
