@@ -1,7 +1,7 @@
 """Cost of a branch of periodic orbits, side by side with one orbit solve in one process.
 
 Run ``python benchmarks/bench_continuation.py [--points 100]``. On the paper's Fig. 13
-case (kernels cached: a warm-up compiles them first) it times
+case (after a warm-up run) it times
 
 1. the baseline: one ``periodic_orbit`` call as ``fivdisc orbit fig13 --transient 5``
    makes it (a 5 s transient, the first return, Newton shooting, the minimal-period

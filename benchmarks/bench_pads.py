@@ -2,7 +2,7 @@
 
 Run ``python benchmarks/bench_pads.py [--points 40] [--rounds 1]``. On the issue's case
 (three identical pads at 0, 120 and 240 degrees, Stribeck friction, four disc modes;
-kernels cached: a warm-up compiles them first) it times
+after a warm-up run) it times
 
 1. the baseline: one ``periodic_orbit`` call as ``fivdisc orbit bist-22-large.toml
    --transient 10`` makes it (a 10 s transient, the first return, Newton shooting, the
@@ -89,7 +89,7 @@ def main() -> None:
           f"{os.cpu_count()} cores")
     start = time.perf_counter()
     orbit = periodic_orbit(case, transient=10.0)
-    print(f"warm-up (transient, first return, Newton; kernels loaded or compiled): "
+    print(f"warm-up (transient, first return, Newton; the first run of the process): "
           f"{time.perf_counter() - start:.1f} s; T = {orbit.period * 1e3:.6f} ms, "
           f"{orbit.symmetry}")
     solves, branches = [], []

@@ -8,7 +8,7 @@ test per module. Each runs in a fresh directory, so that an example may write fi
 the flags ``ELLIPSIS`` and ``NORMALIZE_WHITESPACE``; an example imports what it uses.
 
 The examples are short (simulations of a few milliseconds to 0.05 s, small cases): the
-whole module takes well under a minute once the kernels are compiled.
+whole module takes well under a minute.
 """
 
 from __future__ import annotations
