@@ -128,11 +128,14 @@ class LyapunovSpectrum:
     def conclusive(self) -> np.ndarray:
         """``(n,)`` whether each exponent's sign is known at one uncertainty: its
         uncertainty is finite and smaller than its magnitude (a collapsed direction's
-        -inf is known). What sweeps store as ``largest_lyapunov_inconclusive``; the
-        verdict (:meth:`verdict`) asks for more."""
+        -inf is known), and it is not a positive estimate of a motion whose sticks recur
+        regularly (:attr:`recurrence`: near an unstable periodic orbit, which the motion
+        may yet leave for a stable one). What sweeps store as
+        ``largest_lyapunov_inconclusive``; the verdict (:meth:`verdict`) asks for more."""
         e, u = self.exponents, self.uncertainty
         with np.errstate(invalid="ignore"):
-            return np.isneginf(e) | (np.isfinite(e) & np.isfinite(u) & (u < np.abs(e)))
+            known = np.isneginf(e) | (np.isfinite(e) & np.isfinite(u) & (u < np.abs(e)))
+            return known & ~((e > 0) & (self.recurrence < RECURRENT))
 
     @property
     def verdicts(self) -> tuple[str, ...]:

@@ -7,7 +7,8 @@ axis, draws the exponent with a line at zero, and its uncertainty as error bars 
 the sweep keeps ``largest_lyapunov_uncertainty`` too: a finite-time exponent whose bar
 reaches across zero does not tell chaos from a regular motion. Exponents stored as
 inconclusive (``largest_lyapunov_inconclusive``: uncertainty unknown or larger than the
-exponent) are ringed and named in a legend.
+exponent, or positive where the motion stays near a periodic orbit) are ringed and named
+in a legend.
 """
 
 from __future__ import annotations

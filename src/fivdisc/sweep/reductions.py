@@ -277,7 +277,8 @@ BUILTIN: dict[str, Reduction] = {
             _largest_lyapunov_inconclusive,
             "1",
             "largest_lyapunov is inconclusive: its uncertainty is unknown or larger than "
-            "its magnitude (even its sign is not known)",
+            "its magnitude (even its sign is not known), or it is positive where the "
+            "motion stays near a periodic orbit (its sticks recur regularly)",
             dtype="bool",
             needs_run=False,
         ),
