@@ -159,3 +159,5 @@ def test_the_recurrence_of_sticks_decides_a_positive_verdict(recurrence, verdict
                             np.zeros((1, 2)), 0.0, 1.0, 1.0, recurrence)
     assert spec.verdict(0) == verdict
     assert spec.verdict(1) == "negative"
+    # what sweeps store as largest_lyapunov_inconclusive follows it
+    assert spec.conclusive.tolist() == [verdict == "positive", True]
