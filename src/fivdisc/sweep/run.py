@@ -43,9 +43,11 @@ if TYPE_CHECKING:
 
 __all__ = ["DEFAULT_POOL", "POOLS", "SweepReport", "run_point", "run_sweep"]
 
-# The kinds of local pool. Threads are the default: on 2 cores they compute as many
-# points per second as processes and start the first point about a second sooner
-# (benchmarks/bench_sweep_pool.py; docs/sweep-files.md gives the numbers).
+# The kinds of local pool. Threads are the default: on 2 cores they start the first
+# point about a second sooner (no worker loads fivdisc) and, once running, compute
+# points of 0.2 s or longer as fast as processes; processes are faster on points of
+# ~10 ms, whose Python side takes turns on threads, and survive a point that crashes
+# its process (benchmarks/bench_sweep_pool.py; docs/sweep-files.md gives the numbers).
 POOLS = ("thread", "process")
 DEFAULT_POOL = "thread"
 
@@ -125,12 +127,6 @@ def _how_it_died(codes: Iterable[int | None]) -> str:
     return f"exit status {code}"
 
 
-def _warm_worker() -> None:
-    # Loads the simulator (and xarray, which it needs) in a spawned worker while the
-    # coordinator opens the store, rather than when the worker's first point starts.
-    import fivdisc.engine.simulation  # noqa: F401
-
-
 class _LocalPool:
     """Workers on this machine: threads of this process or spawned processes.
 
@@ -170,13 +166,6 @@ class _LocalPool:
             initializer=_init_local_worker,
             initargs=(os.getpid(),),
         )
-
-    def warm(self) -> None:
-        """Start the worker processes now, to load while the coordinator does other work
-        (processes start with the first submissions; threads need nothing)."""
-        if self.kind == "process":
-            for _ in range(self.workers):
-                self._pool.submit(_warm_worker)
 
     def restart(self) -> None:
         """A new pool in place of one broken by a dead worker."""
@@ -382,17 +371,14 @@ def run_sweep(
     try:
         with store_lock(store):
             started: dict[Any, int] = {}
-            if executor is None:
+            if executor is None and not os.path.lexists(store):
+                # A new store: every point is to be done, so the first ones start now,
+                # while the coordinator loads Zarr and creates the store (about a
+                # second). An existing one is checked first: it may need no worker.
                 executor = _LocalPool(workers or cpus, pool or DEFAULT_POOL)
-                if not os.path.lexists(store):
-                    # A new store: every point is to be done, so the first ones start
-                    # now, while the coordinator loads Zarr and creates the store
-                    # (about a second).
-                    ahead = min(_AHEAD_PER_WORKER * executor.workers, spec.n_points)
-                    for index in range(ahead):
-                        started[executor.submit(index, spec.cases[index], *work)] = index
-                else:
-                    executor.warm()
+                ahead = min(_AHEAD_PER_WORKER * executor.workers, spec.n_points)
+                for index in range(ahead):
+                    started[executor.submit(index, spec.cases[index], *work)] = index
             # Imported here: Zarr and xarray take ~0.5 s to load, which the first
             # points above do not wait for.
             from fivdisc.sweep.store.sweep_store import SweepStore
@@ -407,6 +393,8 @@ def run_sweep(
             if missing and target.refusal:
                 raise SweepError(target.refusal)
             if missing:
+                if executor is None:
+                    executor = _LocalPool(workers or cpus, pool or DEFAULT_POOL)
                 try:
                     _drive(executor, spec, target, todo, started, already, failed, progress)
                 except ClusterLost as exc:
