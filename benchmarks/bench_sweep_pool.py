@@ -13,8 +13,9 @@ of the machine's load falls on both alike. Per sweep it prints the medians of
   created) until the first point starts, and ends, in a worker [s] (issue 37, item 5:
   the first point starts within 0.5 s);
 - ``span``: from the first point's start to the last point's end [s], and
-  ``in span`` = points / span, the pool's throughput without its start and the store's
-  creation;
+  ``in span`` = points / span, the pool's throughput without its start (on threads the
+  span includes the coordinator loading Zarr and creating the store, in the same
+  process: the points take turns with it for the GIL);
 - ``wall``: the whole command [s], and ``points/s`` = points / wall;
 - ``cpu``: processor time of the command and its worker processes (user and system) [s],
   which says more than the wall time on a loaded machine;
