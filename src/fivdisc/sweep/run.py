@@ -323,7 +323,7 @@ def run_sweep(
     progress
         Show a progress bar (points, failures, time left) on stderr.
     pool
-        The local pool: ``"thread"`` (the default, :data:`DEFAULT_POOL`), threads of
+        The local pool: ``"thread"`` (the default), threads of
         this process, which integrate in parallel since the compiled core releases the
         GIL, and start at once; or ``"process"``, spawned processes, which keep a point
         that crashes its process (``os._exit``, a segmentation fault in a user
