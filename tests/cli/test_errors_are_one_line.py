@@ -349,7 +349,7 @@ SEPARATION_INVALID = st.sampled_from([
     ["--x", "1:2"], ["--y", "a:b:c"], ["--profile", "sideways"], ["--workers", "0"],
     ["--figure", "{out}/f.xyz"], ["-o", "{out}/s.nc"], ["--base", "bad.toml"],
     ["--profile", "decelerating", "--duration", "5"], ["--scheduler", "not-an-address"],
-    ["-o", "{out}/no/s.zarr"],
+    ["-o", "{out}/no/s.zarr"], ["--pool", "fork"],
 ])
 REPRODUCE_INVALID = st.sampled_from([
     ["--figures", "2"], ["--figures", "3-"], ["--figures", "x"], ["--all", "--figures", "3"],
@@ -386,6 +386,7 @@ COMMANDS = st.one_of(
              _option("--verify", st.sampled_from(["sweep.zarr", "dir.zarr", "case.toml",
                                                   "{out}/none.zarr"])),
              _option("--workers", INTS),
+             _option("--pool", st.sampled_from(["thread", "fork", ""])),
              _option("--scheduler", st.sampled_from(["", "not-an-address", "foo://x:1"])),
              st.just(["--no-progress"])),
     # the invalid option last, so that no valid one given after it overrides it

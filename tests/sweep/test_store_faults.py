@@ -253,7 +253,8 @@ def test_a_point_whose_worker_dies_is_stored_as_failed(tmp_path: Path, monkeypat
         '[reduce]\nkeep = ["dying_helper:deadly"]\n', encoding="utf-8")
     spec = load_sweep(sweep)
     start = time.perf_counter()
-    report = run_sweep(spec, tmp_path / "s.zarr", workers=2, progress=False)
+    # A process pool: in a thread, the death would be the whole sweep's.
+    report = run_sweep(spec, tmp_path / "s.zarr", workers=2, progress=False, pool="process")
     assert time.perf_counter() - start < 4 * BOUND
     assert list(report.failed) == [2]
     assert report.failed[2] == (f"the worker process died while computing this point ({reason}),"
@@ -262,7 +263,7 @@ def test_a_point_whose_worker_dies_is_stored_as_failed(tmp_path: Path, monkeypat
     assert data["done"].all()
     assert np.isfinite(data["deadly"].values[[0, 1, 3]]).all()
     # The failure is stored: a rerun computes nothing.
-    again = run_sweep(spec, tmp_path / "s.zarr", workers=2, progress=False)
+    again = run_sweep(spec, tmp_path / "s.zarr", workers=2, progress=False, pool="process")
     assert (again.already_done, again.computed) == (4, 0)
 
 

@@ -517,9 +517,9 @@ def _command(sweep_file: Path, store: Path, *extra: str) -> list[str]:
             str(sweep_file), "-o", str(store), *extra, "--no-progress"]
 
 
-def _start(sweep_file: Path, store: Path) -> subprocess.Popen:
+def _start(sweep_file: Path, store: Path, pool: str) -> subprocess.Popen:
     return subprocess.Popen(
-        _command(sweep_file, store, "--workers", "1"), start_new_session=True,
+        _command(sweep_file, store, "--workers", "1", "--pool", pool), start_new_session=True,
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
 
@@ -532,10 +532,11 @@ def _wait_for_points(process: subprocess.Popen, store: Path, count: int) -> None
         time.sleep(0.05)
 
 
-def test_interrupted_and_killed_sweeps_resume(reference, sweep_file, tmp_path) -> None:
+@pytest.mark.parametrize("pool", ["thread", "process"])
+def test_interrupted_and_killed_sweeps_resume(reference, sweep_file, tmp_path, pool) -> None:
     store = tmp_path / "resumed.zarr"
     # Ctrl-C: SIGINT to the whole process group, as a terminal sends it
-    process = _start(sweep_file, store)
+    process = _start(sweep_file, store, pool)
     try:
         _wait_for_points(process, store, 2)
         os.killpg(process.pid, signal.SIGINT)
@@ -548,8 +549,8 @@ def test_interrupted_and_killed_sweeps_resume(reference, sweep_file, tmp_path) -
     assert f"interrupted: {interrupted} of 12 points are stored" in err
     assert 2 <= interrupted < 12
 
-    # SIGKILL to the coordinator only: its workers notice and exit by themselves
-    process = _start(sweep_file, store)
+    # SIGKILL to the coordinator only: worker processes notice and exit by themselves
+    process = _start(sweep_file, store, pool)
     try:
         _wait_for_points(process, store, interrupted + 1)
         process.kill()

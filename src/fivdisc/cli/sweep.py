@@ -25,12 +25,21 @@ _scheduler_option = click.option(
     "--scheduler",
     metavar="ADDRESS",
     help="Run on an existing Dask distributed cluster (e.g. tcp://host:8786) "
-    "instead of a local process pool.",
+    "instead of a local pool.",
 )
 _workers_option = click.option(
     "--workers",
     type=click.IntRange(min=1),
-    help="Processes of the local pool [default: number of CPUs].",
+    help="Threads or processes of the local pool [default: number of CPUs].",
+)
+# The choices are run's POOLS, written out: importing the sweep engine here would slow
+# every command's start.
+_pool_option = click.option(
+    "--pool",
+    type=click.Choice(["thread", "process"]),
+    help="The local pool: threads of this process, which start at once and integrate "
+    "in parallel (the compiled core releases the GIL), or processes, which keep a point "
+    "that crashes its process from ending the sweep [default: thread].",
 )
 _progress_option = click.option(
     "--progress/--no-progress",
@@ -41,17 +50,21 @@ _progress_option = click.option(
 
 
 def _run(
-    spec: Sweep, output: Path, scheduler: str | None, workers: int | None, progress: bool
+    spec: Sweep, output: Path, scheduler: str | None, workers: int | None, progress: bool,
+    pool: str | None = None,
 ) -> SweepReport:
     """Run a sweep into `output`, print what happened; exit 130 on Ctrl-C."""
     from fivdisc.sweep import run_sweep
-    from fivdisc.sweep.store.health import read_mask
 
     if scheduler is not None:
         _quiet_dask()
     try:
-        report = run_sweep(spec, output, scheduler=scheduler, workers=workers, progress=progress)
+        report = run_sweep(spec, output, scheduler=scheduler, workers=workers,
+                           progress=progress, pool=pool)
     except KeyboardInterrupt:
+        # Imported here: it loads Zarr, which the first points of a sweep do not wait for.
+        from fivdisc.sweep.store.health import read_mask
+
         try:
             done = int(read_mask(output).sum())
         except FivdiscError:  # interrupted before the store was created
@@ -141,6 +154,7 @@ def _verify(store: Path) -> None:
 )
 @_scheduler_option
 @_workers_option
+@_pool_option
 @_progress_option
 def sweep(
     sweep_file: Path | None,
@@ -148,6 +162,7 @@ def sweep(
     verify_store: Path | None,
     scheduler: str | None,
     workers: int | None,
+    pool: str | None,
     progress: bool,
 ) -> None:
     """Run the sweep of SWEEP_FILE and store one value per point and reduction.
@@ -167,7 +182,7 @@ def sweep(
 
     require("distributed", "fivdisc sweep")
     if verify_store is not None:
-        if sweep_file is not None or output is not None or scheduler or workers:
+        if sweep_file is not None or output is not None or scheduler or workers or pool:
             raise click.UsageError("--verify STORE takes no sweep file and no other option")
         _verify(verify_store)
         return
@@ -176,7 +191,7 @@ def sweep(
     spec = load_sweep(sweep_file)
     store = check_output(output or default_output(sweep_file, ".zarr"), "-o", ZARR,
                          inputs=[sweep_file], kind="directory")
-    _run(spec, store, scheduler, workers, progress)
+    _run(spec, store, scheduler, workers, progress, pool)
 
 
 @click.command("separation-map")
@@ -225,6 +240,7 @@ def sweep(
 )
 @_scheduler_option
 @_workers_option
+@_pool_option
 @_progress_option
 def separation_map(
     profile: str,
@@ -236,6 +252,7 @@ def separation_map(
     figure: Path | None,
     scheduler: str | None,
     workers: int | None,
+    pool: str | None,
     progress: bool,
 ) -> None:
     """Map where the slider separates from the disc, like the paper's Fig. 27.
@@ -264,7 +281,7 @@ def separation_map(
                          inputs=[base], kind="directory")
     figure = check_output(figure or store.with_suffix(".png"), "--figure", figure_suffixes(),
                           inputs=[base])
-    report = _run(spec, store, scheduler, workers, progress)
+    report = _run(spec, store, scheduler, workers, progress, pool)
     plot_separation_map(report.store, figure)
     click.echo(f"wrote {figure}")
 
@@ -300,6 +317,7 @@ def separation_map(
 )
 @_scheduler_option
 @_workers_option
+@_pool_option
 @_progress_option
 def bifurcation(
     sweep_file: Path,
@@ -309,6 +327,7 @@ def bifurcation(
     branch_file: Path | None,
     scheduler: str | None,
     workers: int | None,
+    pool: str | None,
     progress: bool,
 ) -> None:
     """Draw the bifurcation diagram of a sweep over one key.
@@ -347,7 +366,7 @@ def bifurcation(
                          inputs=[sweep_file], kind="directory")
     figure = check_output(output or default_output(sweep_file, ".png"), "-o",
                           figure_suffixes(), inputs=[sweep_file])
-    report = _run(spec, store, scheduler, workers, progress)
+    report = _run(spec, store, scheduler, workers, progress, pool)
     plot_bifurcation(report.store, figure, section=section, name=sweep_file.stem,
                      branch=branch)
     click.echo(f"wrote {figure}")

@@ -1,11 +1,16 @@
-"""Running a sweep: a local process pool or a Dask cluster, results stored as they finish.
+"""Running a sweep: a local pool (threads or processes) or a Dask cluster, results
+stored as they finish.
 
-Workers only compute; the coordinating process (the one calling :func:`run_sweep`)
-writes every result to the store, so the store has a single writer. Points already
-complete in the store are skipped, which makes an interrupted sweep resumable by
-running it again. A point whose local worker process dies (``os._exit``, a signal) is
-run again alone once the pool is restarted; if its worker dies again, the point is
-stored as failed with how the worker died, and the sweep goes on.
+Workers only compute; the coordinator (the thread calling :func:`run_sweep`) writes
+every result to the store, so the store has a single writer. Points already complete in
+the store are skipped, which makes an interrupted sweep resumable by running it again.
+A point whose local worker process dies (``os._exit``, a signal) is run again alone once
+the pool is restarted; if its worker dies again, the point is stored as failed with how
+the worker died, and the sweep goes on.
+
+The local pool's threads integrate in parallel because the compiled core releases the
+GIL; only the Python-side work of a point (setting up the model, reducing the run)
+takes turns. ``benchmarks/bench_sweep_pool.py`` compares the two local pools.
 """
 
 from __future__ import annotations
@@ -16,25 +21,35 @@ import signal
 import threading
 import time
 from collections import deque
-from collections.abc import Iterable, Sequence
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor
+from collections.abc import Iterable
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, ThreadPoolExecutor
 from concurrent.futures import wait as wait_local
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from multiprocessing import get_context
 from os import PathLike
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from fivdisc.case import Case
-from fivdisc.errors import FivdiscError
-from fivdisc.sweep.reductions import LyapunovSettings, SweepError, evaluate
-from fivdisc.sweep.sections import Section
+from fivdisc.engine.integration import stop_thread_when
+from fivdisc.errors import SweepError
+from fivdisc.sweep.point import PointOutcome, run_point
 from fivdisc.sweep.spec import Sweep
 from fivdisc.sweep.store.lock import store_lock
-from fivdisc.sweep.store.sweep_store import PointOutcome, SweepStore
 
-__all__ = ["SweepReport", "run_sweep"]
+if TYPE_CHECKING:
+    from fivdisc.sweep.store.sweep_store import SweepStore
+
+__all__ = ["DEFAULT_POOL", "POOLS", "SweepReport", "run_point", "run_sweep"]
+
+# The kinds of local pool. Threads are the default: on 2 cores they start the first
+# point about a second sooner (no worker loads fivdisc) and, once running, compute
+# points of 0.2 s or longer as fast as processes; processes are faster on points of
+# ~10 ms, whose Python side takes turns on threads, and survive a point that crashes
+# its process (benchmarks/bench_sweep_pool.py; docs/sweep-files.md gives the numbers).
+POOLS = ("thread", "process")
+DEFAULT_POOL = "thread"
 
 # Points submitted ahead per worker: enough to keep workers busy while the
 # coordinator writes, few enough that an interruption discards little work.
@@ -75,23 +90,6 @@ class SweepReport:
     wall_time: float
 
 
-def run_point(
-    index: int,
-    case: Case,
-    keep: tuple[str, ...],
-    sections: Sequence[Section] = (),
-    lyapunov: LyapunovSettings | None = None,
-) -> PointOutcome:
-    """Compute one point (see :func:`~fivdisc.sweep.reductions.evaluate`); a failure is
-    returned as the outcome's error, not raised."""
-    try:
-        return PointOutcome(index, evaluate(case, keep, sections, lyapunov))
-    except FivdiscError as exc:
-        return PointOutcome(index, None, str(exc))
-    except Exception as exc:  # a user reduction or the solver may raise anything
-        return PointOutcome(index, None, f"{type(exc).__name__}: {exc}")
-
-
 # --- executors -------------------------------------------------------------------------------
 
 
@@ -130,14 +128,36 @@ def _how_it_died(codes: Iterable[int | None]) -> str:
 
 
 class _LocalPool:
-    """A ProcessPoolExecutor whose workers are warmed and die with the coordinator; it
-    can be started again after a worker died."""
+    """Workers on this machine: threads of this process or spawned processes.
 
-    def __init__(self, workers: int) -> None:
+    Threads share the coordinator's loaded modules, so the first point starts at once,
+    and they die with it; a thread cannot be killed, so every thread's integration
+    checks a stop event between kernel calls (:func:`stop_thread_when`). Processes
+    isolate a point that crashes its process; they ignore Ctrl-C, die with the
+    coordinator, and the pool can be started again after one died.
+
+    Parameters
+    ----------
+    workers
+        Threads or processes.
+    kind
+        ``"thread"`` or ``"process"``.
+    """
+
+    def __init__(self, workers: int, kind: str) -> None:
         self.workers = workers
+        self.kind = kind
+        self._stop = threading.Event()
         self._pool = self._start()
 
-    def _start(self) -> ProcessPoolExecutor:
+    def _start(self) -> ThreadPoolExecutor | ProcessPoolExecutor:
+        if self.kind == "thread":
+            return ThreadPoolExecutor(
+                max_workers=self.workers,
+                thread_name_prefix="fivdisc-sweep",
+                initializer=stop_thread_when,
+                initargs=(self._stop,),
+            )
         # spawn, not fork: the coordinator runs threads (tqdm, zarr's I/O loop) that a
         # forked child would inherit in an arbitrary state.
         return ProcessPoolExecutor(
@@ -170,13 +190,22 @@ class _LocalPool:
             processes = list((getattr(self._pool, "_processes", None) or {}).values())
             self._pool.shutdown(wait=True)
             raise _WorkerDied(_how_it_died(p.exitcode for p in processes))
-        # run_point catches everything, so this is e.g. a result that failed to pickle
+        # run_point catches every Exception, so this is e.g. a result that failed to
+        # pickle, or a user reduction's SystemExit
         return PointOutcome(index, None, f"{type(exc).__name__}: {exc}")
 
     def close(self) -> None:
         self._pool.shutdown(wait=True)
 
     def abort(self) -> None:
+        """Stop at once: queued points are dropped, running ones end unfinished (their
+        results are never stored)."""
+        if self.kind == "thread":
+            # A running point's integration raises Stopped at its next kernel call
+            # (about 0.05 s); waiting for that means no thread outlives the sweep.
+            self._stop.set()
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            return
         # ProcessPoolExecutor has no public way (before Python 3.14) to stop tasks that
         # are running; terminate its processes so an interrupted sweep exits at once.
         processes = list((getattr(self._pool, "_processes", None) or {}).values())
@@ -272,11 +301,12 @@ def run_sweep(
     scheduler: str | None = None,
     workers: int | None = None,
     progress: bool = True,
+    pool: str | None = None,
 ) -> SweepReport:
     """Compute the points of `spec` that `store` does not hold yet, storing each as it ends.
 
-    The local pool starts its workers with ``spawn``: a script calling this must
-    guard its entry point with ``if __name__ == "__main__":``.
+    A process pool starts its workers with ``spawn``: a script calling this with
+    ``pool="process"`` must guard its entry point with ``if __name__ == "__main__":``.
 
     Parameters
     ----------
@@ -287,11 +317,17 @@ def run_sweep(
         same sweep (same definition hash), whose complete points are skipped.
     scheduler
         Address of a Dask distributed scheduler (e.g. ``"tcp://127.0.0.1:8786"``) to
-        run on; None runs on a local process pool.
+        run on; None runs on a local pool.
     workers
-        Size of the local process pool (default: the number of CPUs); local pool only.
+        Size of the local pool (default: the number of CPUs); local pool only.
     progress
         Show a progress bar (points, failures, time left) on stderr.
+    pool
+        The local pool: ``"thread"`` (the default), threads of
+        this process, which integrate in parallel since the compiled core releases the
+        GIL, and start at once; or ``"process"``, spawned processes, which keep a point
+        that crashes its process (``os._exit``, a segmentation fault in a user
+        reduction) from ending the sweep. Local pool only.
 
     Returns
     -------
@@ -301,10 +337,10 @@ def run_sweep(
     Raises
     ------
     SweepError
-        Bad `workers`; a store holding another sweep, in use by another coordinator or
-        of an earlier format with points missing (it is read, not written);
-        no connection to `scheduler`, or the cluster lost during the sweep (finished
-        points stay stored; rerunning resumes).
+        Bad `workers` or `pool`; a store holding another sweep, in use by another
+        coordinator or of an earlier format with points missing (it is read, not
+        written); no connection to `scheduler`, or the cluster lost during the sweep
+        (finished points stay stored; rerunning resumes).
     KeyboardInterrupt
         On Ctrl-C, after the workers are stopped; complete points stay stored.
     """
@@ -317,29 +353,50 @@ def run_sweep(
     if workers is not None and workers > cpus:
         raise SweepError(
             f"workers = {workers} is invalid: must be <= {cpus}, the number of CPUs (more "
-            "processes than cores only add memory, some 300 MB each)"
+            "workers than cores only take turns, and processes add some 300 MB each)"
         )
     if workers is not None and scheduler is not None:
         raise SweepError(
             f"workers = {workers} is invalid with a scheduler: the cluster's size is set "
             "where the cluster is started"
         )
+    if pool is not None and pool not in POOLS:
+        raise SweepError(f"pool = {pool!r} is invalid: must be 'thread' or 'process'")
+    if pool is not None and scheduler is not None:
+        raise SweepError(f"pool = {pool!r} is invalid with a scheduler: the cluster's "
+                         "workers compute the points")
+    work = _work(spec)
     # A cluster is reached before the store is touched, so that a bad address changes nothing.
-    pool = _DaskPool(scheduler) if scheduler is not None else None
+    executor = _DaskPool(scheduler) if scheduler is not None else None
     try:
         with store_lock(store):
+            started: dict[Any, int] = {}
+            if executor is None and not os.path.lexists(store):
+                # A new store: every point is to be done, so the first ones start now,
+                # while the coordinator loads Zarr and creates the store (about a
+                # second). An existing one is checked first: it may need no worker.
+                executor = _LocalPool(workers or cpus, pool or DEFAULT_POOL)
+                ahead = min(_AHEAD_PER_WORKER * executor.workers, spec.n_points)
+                for index in range(ahead):
+                    started[executor.submit(index, spec.cases[index], *work)] = index
+            # Imported here: Zarr and xarray take ~0.5 s to load, which the first
+            # points above do not wait for.
+            from fivdisc.sweep.store.sweep_store import SweepStore
+
             target = SweepStore.open(store, spec)
             done = target.completed()
-            todo = deque(int(i) for i in range(spec.n_points) if not done[i])
-            already = spec.n_points - len(todo)
+            missing = [int(i) for i in range(spec.n_points) if not done[i]]
+            already = spec.n_points - len(missing)
+            running = set(started.values())
+            todo = deque(i for i in missing if i not in running)
             failed = target.errors(done)
-            if todo and target.refusal:
+            if missing and target.refusal:
                 raise SweepError(target.refusal)
-            if todo:
-                if pool is None:
-                    pool = _LocalPool(workers or os.cpu_count() or 1)
+            if missing:
+                if executor is None:
+                    executor = _LocalPool(workers or cpus, pool or DEFAULT_POOL)
                 try:
-                    _drive(pool, spec, target, todo, already, failed, progress)
+                    _drive(executor, spec, target, todo, started, already, failed, progress)
                 except ClusterLost as exc:
                     stored = int(target.completed().sum())
                     raise SweepError(
@@ -347,11 +404,11 @@ def run_sweep(
                         "restart the cluster and rerun the same command to compute the rest"
                     ) from None
     except BaseException:
-        if pool is not None:
-            pool.abort()
+        if executor is not None:
+            executor.abort()
         raise
-    if pool is not None:
-        pool.close()
+    if executor is not None:
+        executor.close()
     return SweepReport(
         store=target.path,
         n_points=spec.n_points,
@@ -362,22 +419,28 @@ def run_sweep(
     )
 
 
+def _work(sweep: Sweep) -> tuple[Any, ...]:
+    """What every point computes, as run_point takes it after the point's case
+    (picklable, for the workers)."""
+    return (tuple(sweep.keep), sweep.sections, sweep.lyapunov)
+
+
 def _drive(
     pool: _LocalPool | _DaskPool,
     sweep: Sweep,
     target: SweepStore,
     todo: deque[int],
+    running: dict[Any, int],
     already: int,
     failed: dict[int, str],
     progress: bool,
 ) -> None:
-    """Keep the pool fed, and store results as they come back."""
+    """Keep the pool fed (`running`: futures already submitted -> their points), and store
+    results as they come back."""
     from tqdm import tqdm
 
-    # What every point computes, as run_point takes it (picklable, for the workers).
-    work = (tuple(sweep.keep), sweep.sections, sweep.lyapunov)
+    work = _work(sweep)
     ahead = _AHEAD_PER_WORKER * pool.workers
-    running: dict[Any, int] = {}
     unstored: list[PointOutcome] = []
     # Points that were running when a local worker died: each is run again alone, and
     # stored as failed if its worker dies again.

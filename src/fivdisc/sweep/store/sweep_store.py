@@ -10,15 +10,14 @@ import contextlib
 import os
 import shutil
 from collections.abc import Sequence
-from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import xarray as xr
 
 from fivdisc.errors import SweepError
+from fivdisc.sweep.point import PointOutcome
 from fivdisc.sweep.spec import Sweep
 from fivdisc.sweep.store.checksum import checksummed, checksums
 from fivdisc.sweep.store.chunks import readable_points
@@ -55,26 +54,6 @@ __all__ = [
     "store_lock",
     "verify_store",
 ]
-
-
-@dataclass(frozen=True)
-class PointOutcome:
-    """What one point produced.
-
-    Attributes
-    ----------
-    index
-        The point's index.
-    values
-        Stored name -> value of every kept reduction, and per section its values
-        (``(max_points,)``, NaN padded) and their count; None if the point failed.
-    error
-        "" for success, else why the point failed.
-    """
-
-    index: int
-    values: dict[str, Any] | None
-    error: str = ""
 
 
 class SweepStore:
