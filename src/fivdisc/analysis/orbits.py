@@ -722,7 +722,8 @@ def _probe(model: Model, x0: np.ndarray, phases: np.ndarray | None, window: floa
            rtol: float, atol: float) -> tuple[np.ndarray, float]:
     """Samples of the trajectory from ``x0`` over ``window`` (about 200 per period of the
     fastest mode kept; the output fills in the contact coordinates), and their spacing."""
-    rate = max(200.0 * float(np.max(model.omega)) / (2 * np.pi), 1e4)
+    # (a rigid disc has no modes: the sliders' own motion is slower than 1e4 samples/s)
+    rate = max(200.0 * float(np.max(model.omega, initial=0.0)) / (2 * np.pi), 1e4)
     probe = Integration(model, x0, duration=window, output_rate=rate, rtol=rtol, atol=atol,
                         phases=phases)
     probe.run_to(window)
