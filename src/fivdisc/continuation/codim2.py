@@ -22,10 +22,13 @@ The defining conditions (each zero at the bifurcation, of one sign on either sid
   a spatio-temporal symmetry, of the multiplier followed;
 * ``grazing``: on a slipping orbit its smallest slip speed ``|Omega - phidot| /
   Omega`` (the interior minimum, a parabola through the cycle's samples), which reaches
-  zero where the orbit touches the stick boundary; on a stick-slip orbit its shortest
-  stick phase over the period, which shrinks to zero where the orbit leaves the stick
-  boundary (both one-sided: past the zero the orbit changes its sequence of phases, and
-  an iterate that lands there is pulled back half way);
+  zero where the orbit touches the stick boundary; on a stick-slip orbit the smallest of
+  its stick phases' durations over the period and the rates at which they are reached
+  (``d(Omega - phidot)/dt`` just before sticking, times ``T / Omega``): zero where a
+  stick phase shrinks to nothing or is reached tangentially, the slider's speed
+  touching the disc's without crossing it (both one-sided: past the zero the orbit
+  changes its sequence of phases or ceases to exist, and an iterate that lands there is
+  pulled back half way);
 * ``stick split``: the smallest interior minimum of a stick phase's static margin
   ``(mu_s N - |f|) / (mu_s N)``, zero where the stick phase splits in two (one-sided).
 
@@ -79,8 +82,9 @@ _NEAR = 1e-7
 # A one-sided condition's first secant step, on the previous slice's slope, goes this
 # fraction of the way (the rest on the slice's own slope): past the border it would fail.
 _SHORT = 0.9
-# A one-sided condition's slice starts from the previous slice's orbit where g is
-# _Track.back: 1e-3 at first, doubled (up to this) with each halving of the step of key2.
+# A one-sided condition's slice starts from the previous slice's orbit _Track.back back
+# along its branch (scaled arclength): 1e-3 at first, doubled (up to _MAX_BACK) with each
+# halving of the step of key2.
 _MIN_BACK, _MAX_BACK = 1e-3, 0.1
 # Halvings of the step of key2 before a curve ends.
 _HALVINGS = 6
@@ -153,6 +157,37 @@ def _stick_phases(pt: Point) -> list[float]:
     return out
 
 
+def _approaches(problem: OrbitProblem, pt: Point) -> list[float]:
+    """The rate at which each stick phase of ``pt``'s orbit is reached: the slider's
+    relative acceleration ``d(Omega - phidot)/dt`` just before it sticks, times the period
+    over the disc speed. A backward difference over ``d`` and ``d/2`` before the switch
+    (``d`` = 2e-6 of the period), extrapolated to zero (Richardson): its error is that
+    of the rates over ``d``, about 1e-6."""
+    from fivdisc.engine.integration import Integration
+
+    shooting = problem.shooter(pt.value)
+    model = shooting.model
+    omega = float(model.speed.omega(0.0))
+    start = shooting.held(pt.x)
+    out = []
+    for t, kind, j in pt.cycle.events:
+        if kind != "stick":
+            continue
+        values = []
+        for d in (2e-6 * pt.period, 1e-6 * pt.period):
+            before = t - d
+            if not before > 0:
+                break
+            run = Integration(model, start, duration=before, output_rate=1.0 / before,
+                              rtol=problem.rtol, atol=problem.atol, phases=pt.phases,
+                              max_step=shooting.cap)
+            run.run_to(before)
+            values.append((omega - run.out_y[1, model.index("phi_dot", j)]) / d)
+        if len(values) == 2:
+            out.append(abs(2.0 * values[1] - values[0]) * pt.period / max(abs(omega), 1e-300))
+    return out
+
+
 def _followed(values: np.ndarray, track: _Track) -> complex:
     """The value of ``values`` nearest the one followed (the first time: nearest the unit
     circle)."""
@@ -192,9 +227,10 @@ def condition_value(problem: OrbitProblem, pt: Point, condition: str,
     sig = " ".join(pt.cycle.signature)
     if condition == "grazing":
         if "stick" in sig:
-            sticks = _stick_phases(pt)
-            if sticks:
-                return float(min(sticks)), 0j
+            # a stick phase that shrinks to nothing, or one reached tangentially
+            near = _stick_phases(pt) + _approaches(problem, pt)
+            if near:
+                return float(min(near)), 0j
         slips = [v for j, kind, v, _ in pt.cycle.dips
                  if kind == "slip" and "stick" not in pt.cycle.signature[j]]
         if slips:
@@ -231,56 +267,76 @@ def _on_slice(problem: CurveProblem, start: Point, condition: str, track: _Track
             raise ConvergenceError("past the border", reason="past the border")
         return s, g, pt, mu_s
 
-    older = (0.0, g0, start, mu0)
-    newer = None
+    good = [(0.0, g0, start, mu0)]
     if not (np.isfinite(track.slope) and track.slope != 0.0):
         for probe in (1e-3, -1e-3):
             try:
-                newer = at(probe, mu0)
+                good.append(at(probe, mu0))
                 break
             except ConvergenceError:
                 if not one_sided or probe < 0:
                     raise
-    else:
-        newer = older
-    # A one-sided condition is aimed at half the stopping distance short of its zero:
-    # iterates nearer the border than about 1e-7 (scaled) fall across it in the corrector.
-    slope = track.slope if newer is older else (newer[1] - g0) / newer[0]
-    aim = 0.5 * _NEAR * abs(slope) * sign if one_sided else 0.0
+    power = 1.0  # g ~ (s* - s)^power near the zero: 1, or 1/2 at a square-root end
     bad = math.nan
     for _ in range(_MAX_SECANT):
         if time.monotonic() > deadline:
             raise ConvergenceError("the time budget ran out", reason="the time budget ran out")
-        (sa, ga, _, _), (sb, gb, _, mub) = older, newer
-        ga, gb = ga - aim, gb - aim
-        s = sb - gb * (sb - sa) / (gb - ga) if gb != ga and sb != sa else sb - gb / track.slope
-        if one_sided and newer is older:
-            # the first step on the slope of the previous slice: short of the border
-            s *= _SHORT
+        if one_sided and len(good) > 2:
+            power = min((1.0, 0.5), key=lambda a: _spread(good[-3:], a, sign))
+        sb, mub = good[-1][0], good[-1][3]
+        dist = _to_zero(good[-2:], power, sign, track.slope)
+        if one_sided:
+            # short of the border by half the stopping distance (iterates nearer than
+            # about 1e-7 fall across it in the corrector), the first step on the previous
+            # slice's slope by a tenth of the way
+            dist = (dist * _SHORT if len(good) == 1 else dist) - 0.5 * _NEAR * np.sign(dist)
+        s = sb + dist
         if np.isfinite(bad) and (s - bad) * (sb - bad) <= 0:
             s = 0.5 * (sb + bad)
         try:
-            found = at(s, mub, newer)
+            found = at(s, mub, good[-1])
         except ConvergenceError:
             if not one_sided:
                 raise
             bad = s
+            if len(good) < 3:
+                power = 0.5  # overshot on a straight line: a square-root end
             continue
-        if newer is not older:
-            older = newer
-        newer = found
-        slope = (gb - ga) / (sb - sa) if gb != ga and sb != sa else track.slope
-        if abs(s - sb) < _XTOL or abs(found[1] - aim) <= abs(slope) * _NEAR:
+        good.append(found)
+        left = abs(_to_zero(good[-2:], power, sign, track.slope))
+        if abs(s - sb) < _XTOL or left < (_NEAR if one_sided else _XTOL):
             break
     else:
         reason = f"the condition's secant did not settle in {_MAX_SECANT} steps"
         raise ConvergenceError(reason, reason=reason)
+    newer = good[-1]
     s, g, pt, mu = newer
-    # the slope over the whole secant (its last steps are too short to give one)
-    if s != 0.0 and g != g0:
-        track.slope = (g - g0) / s
+    # the slope over the widest pair of iterates (the last steps are too short to give
+    # one): the first step of the next slice
+    wide = max(good[:-1], key=lambda other: abs(other[0] - s))
+    if wide[0] != s and wide[1] != g:
+        track.slope = (g - wide[1]) / (s - wide[0])
     track.mu = mu
     return pt, g
+
+
+def _to_zero(pair: list[tuple], power: float, sign: float, slope: float) -> float:
+    """The step from the last of ``pair`` ((s, g, ...) points) to where ``g`` vanishes,
+    on the straight line through ``(s, g)``, or through ``(s, (sign g)^(1/power))``
+    (with one point, on ``slope``)."""
+    h = [p[1] if power == 1.0 else max(sign * p[1], 0.0) ** (1.0 / power) for p in pair]
+    if len(pair) == 1 or h[-1] == h[-2] or pair[-1][0] == pair[-2][0]:
+        return -pair[-1][1] / slope
+    return -h[-1] * (pair[-1][0] - pair[-2][0]) / (h[-1] - h[-2])
+
+
+def _spread(three: list[tuple], power: float, sign: float) -> float:
+    """How far apart the zeros predicted by the first two and the last two of ``three``
+    points lie, with ``g`` taken to the ``1/power``: the smaller, the better the power
+    fits."""
+    a = three[1][0] + _to_zero(three[:2], power, sign, math.nan)
+    b = three[2][0] + _to_zero(three[1:], power, sign, math.nan)
+    return abs(a - b) if np.isfinite(a - b) else math.inf
 
 
 @dataclass
@@ -317,16 +373,18 @@ def _first_on(problem: CurveProblem, rows: list[_Row], q: float, condition: str,
     """The first point of the slice at ``key2 = q``: the last point's orbit with ``key``
     extrapolated (:func:`_predicted`), corrected on the hyperplane normal to the last
     point's tangent. For a one-sided condition the orbit is first moved back along the
-    last point's branch to where ``g`` is ``track.back``, or twice the extrapolation's
-    error estimate if that is more (an orbit predicted past the border has no orbit
-    near it to correct to)."""
+    last point's branch by ``track.back`` (scaled arclength), or by twice the
+    extrapolation's error estimate if that is more (an orbit predicted past the border
+    has no orbit near it to correct to)."""
     last = rows[-1]
     a = last.point
     p, error = _predicted(rows, q)
     if condition in _ONE_SIDED and np.isfinite(track.slope) and track.slope != 0.0:
-        dg_dp = track.slope / (a.tangent[-1] * problem.ps) if a.tangent[-1] else 0.0
-        back = min(max(track.back, 2.0 * abs(dg_dp) * error), _MAX_BACK)
-        a = problem.step_from(a, (back * np.sign(last.g or 1.0) - last.g) / track.slope,
+        # back along the arclength, towards larger g: by track.back, or by twice the
+        # extrapolation's error if that is more
+        dp_ds = abs(a.tangent[-1]) * problem.ps
+        back = min(max(track.back, 2.0 * error / dp_ds if dp_ds > 0 else 0.0), _MAX_BACK)
+        a = problem.step_from(a, back * np.sign(track.slope) * (np.sign(last.g) or 1.0),
                               deadline)
         p += a.value - last.point.value
     z = a.z.copy()
@@ -459,7 +517,7 @@ def bifurcation_curve(
         while len(rows) < max_points:
             last = rows[-1]
             q = last.q + h
-            if (q - to2) * np.sign(h) > 1e-12 * max(abs(to2), 1.0):
+            if (q - to2) * np.sign(h) > -1e-9 * abs(h0):
                 q = to2
             saved = _Track(track.mu, track.slope, track.back)
             layout = problem.layout()
