@@ -51,8 +51,8 @@ REGIONS = {-1: "undetermined", 0: "sliding stable only", 1: "bistable",
 _TRIES = (0.3, 0.5, 0.15, 0.7)
 # The branch kinds that end the stable vibration, and the condition each is followed by.
 _ENDS = {"fold": "fold", "grazing": "grazing", "signature change": "grazing",
-         "discontinuity": "grazing", "discontinuity end": "grazing", "end": "grazing",
-         "cascade end": "grazing"}
+         "discontinuity": "border", "discontinuity end": "border", "end": "grazing",
+         "cascade end": "border"}
 
 
 def bistable_region(
@@ -217,7 +217,7 @@ def bistable_region(
     for role, branch, (which, condition) in ends:
         say(f"the {role} in {ykey}")
         rows.append((role, *_both_ways(branch, which, condition, ykey, y_start, lo_y, hi_y,
-                                       points, settings)))
+                                       points, far, settings)))
     say("the equilibrium's stability on the grid")
     xs = np.linspace(xr_[0], xr_[1], nx)
     ys = np.linspace(yr_[0], yr_[1], ny)
@@ -278,9 +278,14 @@ def _stable_end(branch) -> tuple[int, str] | None:
 
 
 def _both_ways(branch, which: int, condition: str | None, ykey: str, y_start: float,
-               lo: float, hi: float, points: int, settings: ContinuationSettings):
+               lo: float, hi: float, points: int, far: float,
+               settings: ContinuationSettings):
     """The bifurcation followed in ``ykey`` from ``y_start`` to both ends of the box,
-    joined in order of ``ykey``: (kind, stop reasons, curve table)."""
+    joined in order of ``ykey``: (kind, stop reasons, curve table of rows ``x, y,
+    period, residual, condition``). Where its defining condition cannot be followed
+    (a border of a kind no condition of :mod:`~fivdisc.continuation.codim2` describes,
+    such as the end of a release cascade of identical pads), the end is located at each
+    value of ``ykey`` by the one-parameter walk instead (:func:`_by_walks`)."""
     from fivdisc.continuation.codim2 import curve_from_branch
 
     parts, stops, kind = [], [], ""
@@ -290,20 +295,62 @@ def _both_ways(branch, which: int, condition: str | None, ykey: str, y_start: fl
         try:
             curve = curve_from_branch(branch, which, ykey, to, condition=condition,
                                       points=points, settings=settings)
+            kind = curve.kind
+            stops.append(f"towards {ykey} = {to:g}: {curve.stop_reason}")
+            parts.append(np.column_stack([curve.parameter, curve.second_parameter,
+                                          curve.period, curve.dataset["residual"].values,
+                                          curve.condition]))
         except (ConvergenceError, FivdiscError) as exc:
-            stops.append(f"towards {ykey} = {to:g}: {exc}")
-            continue
-        kind = curve.kind
-        stops.append(f"towards {ykey} = {to:g}: {curve.stop_reason}")
-        parts.append(np.column_stack([curve.parameter, curve.second_parameter, curve.period,
-                                      curve.dataset["residual"].values, curve.condition]))
-    if not parts:
-        raise FivdiscError(f"the end of the stable vibration could not be followed in {ykey}: "
-                           + "; ".join(stops))
+            table, stop = _by_walks(branch, which, ykey, y_start, to, points, far, settings)
+            kind = f"{branch.bifurcations()[which]['kind']} (by one-parameter walks)"
+            stops.append(f"towards {ykey} = {to:g}: the {condition} not followed ({exc}); "
+                         f"located by one-parameter walks: {stop}")
+            parts.append(table)
     table = np.vstack(parts)
     table = table[np.argsort(table[:, 1], kind="stable")]
     _, keep = np.unique(table[:, 1], return_index=True)
     return kind or str(condition), "; ".join(stops), table[keep]
+
+
+def _by_walks(branch, which: int, ykey: str, y_start: float, to: float, points: int,
+              far: float, settings: ContinuationSettings) -> tuple[np.ndarray, str]:
+    """The end of ``branch``'s stable part at ``points`` values of ``ykey`` from
+    ``y_start`` to ``to``, each located by a one-parameter walk in the branch's key
+    (:func:`~fivdisc.continuation.walk.continue_orbit`, which bisects a border to 1e-7
+    of the key) from an orbit a little before the previous value's end (Newton at the
+    new value of ``ykey``). Rows ``x, y, period, residual, nan`` (no defining condition:
+    the walk's bisection locates it), and why it stopped."""
+    from fivdisc.analysis.orbits import periodic_orbit
+    from fivdisc.continuation.walk import continue_orbit
+
+    key = branch.key
+    rows = []
+    for q in np.linspace(y_start, to, points)[1:]:
+        b = branch.bifurcations()[which]
+        # a start a few per cent of the branch's span before its end
+        span = abs(branch.parameter[b["point"]] - branch.parameter[0])
+        before = np.flatnonzero(np.abs(branch.parameter[: b["point"] + 1]
+                                       - b["parameter"]) >= 0.02 * span)
+        i = int(before[-1]) if before.size else 0
+        case = branch.case.replace({key: float(branch.parameter[i]), ykey: float(q)})
+        try:
+            orbit = periodic_orbit(case, branch.dataset["state"].values[i],
+                                   period=float(branch.period[i]), phases=branch.phases(i),
+                                   rtol=settings.rtol, tol=settings.tol)
+            walked = continue_orbit(case, key, far, orbit=orbit,
+                                    settings=settings.replace(confirm_periods=0))
+        except (ConvergenceError, FivdiscError) as exc:
+            return np.array(rows).reshape(-1, 5), f"no orbit at {ykey} = {q:.6g} ({exc})"
+        end = _stable_end(walked)
+        if end is None:
+            return np.array(rows).reshape(-1, 5), (f"the stable orbit does not end before "
+                                                   f"{key} = {far:g} at {ykey} = {q:.6g}")
+        branch, which = walked, end[0]
+        b = walked.bifurcations()[which]
+        k = min(int(b["point"]), len(walked) - 1)
+        rows.append((float(b["parameter"]), float(q), float(b["period"]),
+                     float(walked.dataset["residual"].values[k]), np.nan))
+    return np.array(rows).reshape(-1, 5), f"reached {ykey} = {to:g}"
 
 
 def _classify(growth: np.ndarray, xs: np.ndarray, ys: np.ndarray, table: np.ndarray,
