@@ -30,12 +30,14 @@ The defining conditions (each zero at the bifurcation, of one sign on either sid
   changes its sequence of phases or ceases to exist, and an iterate that lands there is
   pulled back half way);
 * ``stick split``: the smallest interior minimum of a stick phase's static margin
-  ``(mu_s N - |f|) / (mu_s N)``, zero where the stick phase splits in two (one-sided);
-* ``border``: where switches of different pads change order and the flow map jumps
-  (a discontinuity of the branch): the test function of
-  :func:`~fivdisc.continuation.borders.switch_tests` nearest zero at the start (a gap
-  between two pads' switches, a stuck pad's static margin at another's switch or in a
-  release cascade), followed by its key (one-sided).
+  ``(mu_s N - |f|) / (mu_s N)``, zero where the stick phase splits in two (one-sided).
+
+Not followed: the borders where switches of different pads change order and the flow
+map jumps (a ``discontinuity`` of a branch): there no test function of the orbit need
+reach zero (the in-phase orbit of three identical pads ends with its stick phase at 0.2
+% of the period and its cascade margins at 3e-5, neither moving towards zero);
+:func:`~fivdisc.continuation.region.bistable_region` locates such an end at each value
+of the second key by the one-parameter walk instead.
 
 The curve steps ``key2`` evenly from the start to ``to2``; the first iterate of a slice
 is the previous point with ``key`` extrapolated linearly from the last two points (for a
@@ -68,15 +70,13 @@ __all__ = ["CONDITIONS", "BifurcationCurve", "bifurcation_curve", "curve_from_br
 
 #: The defining conditions a curve can follow.
 CONDITIONS = ("fold", "period doubling", "torus", "symmetry breaking", "grazing",
-              "stick split", "border")
+              "stick split")
 # Conditions that hold on one side only: past their zero the orbit has another sequence
-# of phases or order of switches.
-_ONE_SIDED = ("grazing", "stick split", "border")
+# of phases.
+_ONE_SIDED = ("grazing", "stick split")
 # The branch kinds of fivdisc continue and the condition each is followed by.
 _FROM_KIND = {"fold": "fold", "period doubling": "period doubling", "torus": "torus",
-              "symmetry breaking": "symmetry breaking", "grazing": "grazing",
-              "discontinuity": "border", "discontinuity end": "border",
-              "cascade end": "border"}
+              "symmetry breaking": "symmetry breaking", "grazing": "grazing"}
 # A slice's secant stops once its step moves the scaled unknowns by less than this (the
 # key by less than this relative to its first value): ten times finer than the
 # one-parameter location's 1e-7, so that a curve point is on the bifurcation to 1e-8.
@@ -150,8 +150,6 @@ class _Track:
     mu: complex = 0j
     slope: float = math.nan
     back: float = _MIN_BACK
-    # the border's test function (fivdisc.continuation.borders.Test.key)
-    test: tuple | None = None
 
 
 def _stick_phases(pt: Point) -> list[float]:
@@ -197,28 +195,6 @@ def _approaches(problem: OrbitProblem, pt: Point) -> list[float]:
     return out
 
 
-def _border(problem: OrbitProblem, pt: Point, track: _Track) -> float:
-    """The border's test function at ``pt``
-    (:func:`~fivdisc.continuation.borders.switch_tests`: a gap between switches of
-    different pads over the period, a stuck pad's static margin at another's switch, or
-    in a release cascade): the one ``track`` follows, or the first time the one nearest
-    its border (the last orbit before a border has it nearest zero)."""
-    from fivdisc.continuation.borders import switch_tests
-
-    tests = {t.key: t for t in switch_tests(problem, pt)
-             if t.kind in ("gap", "margin", "cascade")}
-    if track.test is None:
-        ahead = [t for t in tests.values() if t.gone >= 0.0]
-        if not ahead:
-            raise ConvergenceError("no switching border near the orbit",
-                                   reason="no test function of a border is near zero")
-        track.test = min(ahead, key=lambda t: t.gone).key
-    if track.test not in tests:
-        raise ConvergenceError("the border's test function is gone",
-                               reason="the orbit no longer has the border's switches")
-    return float(tests[track.test].gone)
-
-
 def _followed(values: np.ndarray, track: _Track) -> complex:
     """The value of ``values`` nearest the one followed (the first time: nearest the unit
     circle)."""
@@ -255,8 +231,6 @@ def condition_value(problem: OrbitProblem, pt: Point, condition: str,
             others = np.delete(pt.multipliers, pt.trivial)
             mu = _followed(others, track)
         return abs(mu) - 1.0, mu
-    if condition == "border":
-        return _border(problem, pt, track), 0j
     sig = " ".join(pt.cycle.signature)
     if condition == "grazing":
         if "stick" in sig:
@@ -295,7 +269,7 @@ def _on_slice(problem: CurveProblem, start: Point, condition: str, track: _Track
         pt = problem.step_from(from_pt, s - s_from, deadline)
         if one_sided and pt.cycle.cyclic() != start.cycle.cyclic():
             raise ConvergenceError("past the border", reason="past the border")
-        g, mu_s = condition_value(problem, pt, condition, _Track(mu, test=track.test))
+        g, mu_s = condition_value(problem, pt, condition, _Track(mu))
         if one_sided and g * sign < 0:
             raise ConvergenceError("past the border", reason="past the border")
         return s, g, pt, mu_s
@@ -552,7 +526,7 @@ def bifurcation_curve(
             q = last.q + h
             if (q - to2) * np.sign(h) > -1e-9 * abs(h0):
                 q = to2
-            saved = _Track(track.mu, track.slope, track.back, track.test)
+            saved = _Track(track.mu, track.slope, track.back)
             layout = problem.layout()
             try:
                 guess = _first_on(problem, rows, q, condition, track, deadline)

@@ -15,9 +15,10 @@ Hopf point sliding is stable and a large enough disturbance still starts a vibra
    ends or loses stability: a fold of cycles, or a grazing (its stick phase vanishes,
    where it meets the unstable orbits from the Hopf point);
 4. that end followed in ``y`` across the box both ways
-   (:func:`~fivdisc.continuation.codim2.bifurcation_curve`); optionally also the
-   threshold orbits' end (the unstable orbits born at the Hopf point, where they graze
-   the stick boundary or fold);
+   (:func:`~fivdisc.continuation.codim2.bifurcation_curve`; an end at a border where the
+   flow map jumps, which no defining condition describes, by a one-parameter walk at
+   each value of ``y``); optionally also the threshold orbits' end (the unstable orbits
+   born at the Hopf point, where they graze the stick boundary or fold);
 5. on a grid, the equilibrium's stability (:func:`~fivdisc.analysis.stability.stability_map`)
    and, where it is stable, whether the point lies on the vibration's side of its end:
    *sliding unstable*, *bistable* or *sliding only*.
@@ -50,9 +51,10 @@ REGIONS = {-1: "undetermined", 0: "sliding stable only", 1: "bistable",
 # runs that look for the vibration start (fractions of the way), in turn.
 _TRIES = (0.3, 0.5, 0.15, 0.7)
 # The branch kinds that end the stable vibration, and the condition each is followed by.
+# None: a border where the flow map jumps, located by one-parameter walks (_by_walks).
 _ENDS = {"fold": "fold", "grazing": "grazing", "signature change": "grazing",
-         "discontinuity": "border", "discontinuity end": "border", "end": "grazing",
-         "cascade end": "border"}
+         "end": "grazing", "discontinuity": None, "discontinuity end": None,
+         "cascade end": None}
 
 
 def bistable_region(
@@ -209,10 +211,10 @@ def bistable_region(
 
         say("the threshold orbits from the Hopf point")
         cycles = hopf_cycles(hopf, float(far), settings=settings)
-        last = [i for i, b in enumerate(cycles.bifurcations()) if b["kind"] in
-                ("grazing", "fold")]
+        last = [(i, b["kind"]) for i, b in enumerate(cycles.bifurcations())
+                if b["kind"] in ("grazing", "fold")]
         if last:
-            ends.append(("threshold end", cycles, (last[0], None)))
+            ends.append(("threshold end", cycles, last[0]))
     rows = []
     for role, branch, (which, condition) in ends:
         say(f"the {role} in {ykey}")
@@ -282,30 +284,36 @@ def _both_ways(branch, which: int, condition: str | None, ykey: str, y_start: fl
                settings: ContinuationSettings):
     """The bifurcation followed in ``ykey`` from ``y_start`` to both ends of the box,
     joined in order of ``ykey``: (kind, stop reasons, curve table of rows ``x, y,
-    period, residual, condition``). Where its defining condition cannot be followed
-    (a border of a kind no condition of :mod:`~fivdisc.continuation.codim2` describes,
-    such as the end of a release cascade of identical pads), the end is located at each
-    value of ``ykey`` by the one-parameter walk instead (:func:`_by_walks`)."""
+    period, residual, condition``). Where ``condition`` is None (a border where the flow
+    map jumps, which no condition of :mod:`~fivdisc.continuation.codim2` describes), the
+    end is located at each value of ``ykey`` by the one-parameter walk instead
+    (:func:`_by_walks`)."""
     from fivdisc.continuation.codim2 import curve_from_branch
 
     parts, stops, kind = [], [], ""
     for to in (lo, hi):
         if to == y_start:
             continue
-        try:
-            curve = curve_from_branch(branch, which, ykey, to, condition=condition,
-                                      points=points, settings=settings)
+        if condition is not None:
+            try:
+                curve = curve_from_branch(branch, which, ykey, to, condition=condition,
+                                          points=points, settings=settings)
+            except (ConvergenceError, FivdiscError) as exc:
+                stops.append(f"towards {ykey} = {to:g}: the {condition} not followed ({exc})")
+                continue
             kind = curve.kind
             stops.append(f"towards {ykey} = {to:g}: {curve.stop_reason}")
             parts.append(np.column_stack([curve.parameter, curve.second_parameter,
                                           curve.period, curve.dataset["residual"].values,
                                           curve.condition]))
-        except (ConvergenceError, FivdiscError) as exc:
+        else:
             table, stop = _by_walks(branch, which, ykey, y_start, to, points, far, settings)
-            kind = f"{branch.bifurcations()[which]['kind']} (by one-parameter walks)"
-            stops.append(f"towards {ykey} = {to:g}: the {condition} not followed ({exc}); "
-                         f"located by one-parameter walks: {stop}")
+            kind = f"{branch.bifurcations()[which]['kind']} (one-parameter walks)"
+            stops.append(f"towards {ykey} = {to:g}: {stop}")
             parts.append(table)
+    if not parts:
+        raise FivdiscError(f"the end of the stable vibration could not be followed in {ykey}: "
+                           + "; ".join(stops))
     table = np.vstack(parts)
     table = table[np.argsort(table[:, 1], kind="stable")]
     _, keep = np.unique(table[:, 1], return_index=True)
@@ -324,7 +332,10 @@ def _by_walks(branch, which: int, ykey: str, y_start: float, to: float, points: 
     from fivdisc.continuation.walk import continue_orbit
 
     key = branch.key
-    rows = []
+    first = branch.bifurcations()[which]
+    rows = [(float(first["parameter"]), y_start, float(first["period"]),
+             float(branch.dataset["residual"].values[min(int(first["point"]),
+                                                          len(branch) - 1)]), np.nan)]
     for q in np.linspace(y_start, to, points)[1:]:
         b = branch.bifurcations()[which]
         # a start a few per cent of the branch's span before its end
