@@ -163,5 +163,5 @@ def test_bad_conditions_and_keys_are_refused():
         bifurcation_curve(RIGID, SPEED, "hopf", DAMPING, 0.6, **branch_args)
     with pytest.raises(CaseError, match="points = 1 is invalid"):
         bifurcation_curve(RIGID, SPEED, "fold", DAMPING, 0.6, points=1, **branch_args)
-    with pytest.raises(CaseError, match="to2 = -1.0 is invalid|must be >= 0"):
+    with pytest.raises(CaseError, match=r"to2 = -1\.0 is invalid|must be >= 0"):
         bifurcation_curve(RIGID, SPEED, "fold", DAMPING, -1.0, **branch_args)
