@@ -8,9 +8,9 @@
 Each figure is drawn by the command a user would run (``fivdisc bifurcation``,
 ``fivdisc reproduce``, ``fivdisc bistable``), so a figure in the README is what that
 command gives today. The bifurcation diagram also prints the evidence its description in
-the README rests on: per stretch of speeds, the exponents with their uncertainties, the number of distinct
-section values, and the spectral verdict (:func:`fivdisc.classify`) of the slider's
-angle at one speed of each stretch.
+the README rests on: per stretch of speeds, the exponents with their uncertainties, the
+number of distinct section values, and the spectral verdict (:func:`fivdisc.classify`) of
+the slider's angle at one speed of each stretch.
 """
 
 from __future__ import annotations
