@@ -483,9 +483,31 @@ def bifurcation_curve(
     Each point solves the shooting equations ``phi_T(x; p, q) - x = 0`` with the phase
     condition and the defining condition ``g(x, T, p; q) = 0`` at its ``q``: the
     shooting residual is below ``tol``, and the secant on ``g`` along the branch stops
-    once its last step moved the unknowns by less than 1e-9 (scaled), so that ``|g|`` is
-    below its slope times that. Both are stored per point (``residual``,
-    ``condition``).
+    once its last step moved the unknowns by less than 1e-9 (scaled), or, for a
+    one-sided condition, once the zero it predicts lies within 1e-7 (scaled arclength,
+    about the key's relative change): ``|g|`` is below its slope times that, or at a
+    square-root end (``g ~ sqrt(s* - s)``, a stick phase reached tangentially) about
+    the square root of it. Both are stored per point (``residual``, ``condition``).
+
+    Examples
+    --------
+    The grazing of the orbits born at a rigid disc's Hopf point, from the branch's
+    record of it, followed in the slider's damping:
+
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> (hopf,) = fivdisc.hopf_points(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> b = fivdisc.hopf_cycles(hopf, 30.0, confirm_periods=0).bifurcations()[0]
+    >>> curve = fivdisc.bifurcation_curve(
+    ...     rigid.replace({"speed.value": b["parameter"]}), "speed.value", "grazing",
+    ...     "slider.rotational_damping", 0.52, state=b["state"], period=b["period"],
+    ...     phases=b["phases"], points=3)
+    >>> for i in (0, -1):
+    ...     print(f"{curve.second_parameter[i]:.3f} N m s/rad: grazing at "
+    ...           f"{curve.parameter[i]:.5f} rad/s")
+    0.500 N m s/rad: grazing at 10.49852 rad/s
+    0.520 N m s/rad: grazing at 9.98023 rad/s
     """
     settings = ContinuationSettings.of(settings, options)
     key, key2 = full_key(key, "key"), full_key(key2, "key2")
@@ -594,7 +616,7 @@ def curve_from_branch(branch: Branch, which: int, key2: str, to2: float, *,
     ['grazing']
     >>> curve = fivdisc.curve_from_branch(branch, 0, "slider.rotational_damping", 0.55,
     ...                                   points=3)
-    >>> print(curve.stop_reason, bool(abs(curve.condition).max() < 1e-7))
+    >>> print(curve.stop_reason, bool(abs(curve.condition).max() < 1e-6))
     reached slider.rotational_damping = 0.55 True
     """
     bifs = branch.bifurcations()
@@ -634,6 +656,20 @@ class BifurcationCurve(Branch):
     --------
     bifurcation_curve, curve_from_branch : Make one.
     open_curve : Read one written by :meth:`~fivdisc.continuation.branch.Branch.to_netcdf`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> (hopf,) = fivdisc.hopf_points(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> branch = fivdisc.hopf_cycles(hopf, 30.0, confirm_periods=0)
+    >>> curve = fivdisc.curve_from_branch(branch, 0, "slider.rotational_damping", 0.52,
+    ...                                   points=2)
+    >>> curve.kind, curve.key, curve.key2, float(curve.second_parameter[-1])
+    ('grazing', 'speed.value', 'slider.rotational_damping', 0.52)
+    >>> print(f"{curve.at(0.51):.4f} rad/s")
+    10.2359 rad/s
     """
 
     @classmethod
@@ -711,6 +747,19 @@ def open_curve(path) -> BifurcationCurve:
     ------
     FivdiscError
         The file is not a bifurcation curve.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import fivdisc
+    >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
+    >>> (hopf,) = fivdisc.hopf_points(rigid, "speed.value", np.linspace(1.0, 19.0, 7))
+    >>> branch = fivdisc.hopf_cycles(hopf, 30.0, confirm_periods=0)
+    >>> curve = fivdisc.curve_from_branch(branch, 0, "slider.rotational_damping", 0.52,
+    ...                                   points=2)
+    >>> curve.to_netcdf("grazing.nc")
+    >>> fivdisc.open_curve("grazing.nc").dataset.equals(curve.dataset)
+    True
     """
     from fivdisc.continuation.branch import open_branch
 

@@ -9,8 +9,9 @@ Hopf point sliding is stable and a large enough disturbance still starts a vibra
    coefficients and Bautin points (:func:`~fivdisc.analysis.codimension.hopf_curves`);
 2. at one value of ``y`` (the case's, if inside the box), the Hopf point on the stability
    boundary along ``x``, which must be subcritical;
-3. the stable vibration there: the orbit a forward run settles on when the slider starts
-   stuck to the disc (the largest kick) on the equilibrium's stable side of the Hopf point,
+3. the stable vibration there: the orbit a forward run settles on (after 675 periods of
+   the Hopf oscillation) when the slider starts stuck to the disc (the largest kick) on
+   the equilibrium's stable side of the Hopf point,
    continued along ``x`` (:func:`~fivdisc.continuation.walk.continue_orbit`) to where it
    ends or loses stability: a fold of cycles, or a grazing (its stick phase vanishes,
    where it meets the unstable orbits from the Hopf point);
@@ -50,6 +51,9 @@ REGIONS = {-1: "undetermined", 0: "sliding stable only", 1: "bistable",
 # Where along the stable side, from the Hopf point towards the box's far end, the forward
 # runs that look for the vibration start (fractions of the way), in turn.
 _TRIES = (0.3, 0.5, 0.15, 0.7)
+# The transient before the search for the vibration's orbit, in periods of the Hopf
+# point's oscillation (3 s at 225 Hz: the stick-slip of three pads settles within it).
+_TRANSIENT = 675
 # The branch kinds that end the stable vibration, and the condition each is followed by.
 # None: a border where the flow map jumps, located by one-parameter walks (_by_walks).
 _ENDS = {"fold": "fold", "grazing": "grazing", "signature change": "grazing",
@@ -134,8 +138,9 @@ def bistable_region(
     Examples
     --------
     A slider on a rigid disc with exponential friction: sliding loses stability below a
-    subcritical Hopf speed, and the unstable orbits born there graze the stick boundary,
-    where the stable stick-slip orbit ends; between them both motions are stable:
+    subcritical Hopf speed, and the stable stick-slip orbit goes on above it up to where
+    it reaches the disc's speed tangentially (a grazing); rows from the smallest damping
+    (2 sliding unstable, 1 bistable, 0 sliding stable only):
 
     >>> import fivdisc
     >>> rigid = fivdisc.Case(disc={"modes": []}, slider={"rotational_damping": 0.5})
@@ -143,9 +148,9 @@ def bistable_region(
     ...                                  ("slider.rotational_damping", (0.45, 0.55)),
     ...                                  points=3, grid=(9, 3), seeds=3)
     >>> print(region["region"].values)
-    [[2 2 2 1 1 1 1 0 0]
+    [[2 2 2 2 2 1 1 1 0]
      [2 2 2 2 1 1 1 0 0]
-     [2 2 2 2 1 1 0 0 0]]
+     [2 2 2 1 1 1 0 0 0]]
     >>> print(str(region["curve_kind"].values[0]), str(region["curve_role"].values[0]))
     grazing vibration end
     """
@@ -199,7 +204,8 @@ def bistable_region(
     side = -float(hopf.direction)
     far = float(max(xr_) if side > 0 else min(xr_))
     say(f"the stable vibration beyond {xkey} = {hopf.value:.8g}")
-    vib, orbit_text = _vibration(base, xkey, hopf.value, float(far), settings)
+    vib, orbit_text = _vibration(base, xkey, hopf.value, float(far),
+                                 _TRANSIENT * 2.0 * np.pi / hopf.omega, settings)
     ends = []
     end = _stable_end(vib)
     if end is None:
@@ -230,11 +236,11 @@ def bistable_region(
                     y_start, hopf, orbit_text, time.monotonic() - began)
 
 
-def _vibration(base: Case, xkey: str, hopf_value: float, far: float,
+def _vibration(base: Case, xkey: str, hopf_value: float, far: float, transient: float,
                settings: ContinuationSettings):
-    """The stable stick-slip orbit a start stuck to the disc settles on, at values of
-    ``x`` on the stable side of the Hopf point (:data:`_TRIES`), continued to ``far``:
-    the branch and the orbit in words."""
+    """The stable stick-slip orbit a start stuck to the disc settles on after
+    ``transient`` [s], at values of ``x`` on the stable side of the Hopf point
+    (:data:`_TRIES`), continued to ``far``: the branch and the orbit in words."""
     from fivdisc.analysis.orbits import periodic_orbit
     from fivdisc.continuation.walk import continue_orbit
 
@@ -247,7 +253,8 @@ def _vibration(base: Case, xkey: str, hopf_value: float, far: float,
                              "simulation.perturbation.phi_dot": abs(case.speed.value),
                              "simulation.perturbation.phi": 0.0})
         try:
-            orbit = periodic_orbit(case, rtol=settings.rtol, tol=settings.tol)
+            orbit = periodic_orbit(case, transient=transient, rtol=settings.rtol,
+                                   tol=settings.tol)
         except (ConvergenceError, FivdiscError) as exc:
             reasons.append(f"{xkey} = {at:.6g}: {exc}")
             continue
@@ -285,32 +292,33 @@ def _both_ways(branch, which: int, condition: str | None, ykey: str, y_start: fl
     """The bifurcation followed in ``ykey`` from ``y_start`` to both ends of the box,
     joined in order of ``ykey``: (kind, stop reasons, curve table of rows ``x, y,
     period, residual, condition``). Where ``condition`` is None (a border where the flow
-    map jumps, which no condition of :mod:`~fivdisc.continuation.codim2` describes), the
-    end is located at each value of ``ykey`` by the one-parameter walk instead
-    (:func:`_by_walks`)."""
+    map jumps, which no condition of :mod:`~fivdisc.continuation.codim2` describes) or
+    the condition's curve cannot start, the end is located at each value of ``ykey`` by
+    the one-parameter walk instead (:func:`_by_walks`)."""
     from fivdisc.continuation.codim2 import curve_from_branch
 
     parts, stops, kind = [], [], ""
     for to in (lo, hi):
         if to == y_start:
             continue
+        why = ""
         if condition is not None:
             try:
                 curve = curve_from_branch(branch, which, ykey, to, condition=condition,
                                           points=points, settings=settings)
             except (ConvergenceError, FivdiscError) as exc:
-                stops.append(f"towards {ykey} = {to:g}: the {condition} not followed ({exc})")
+                why = f"the {condition} not followed ({exc}); "
+            else:
+                kind = curve.kind
+                stops.append(f"towards {ykey} = {to:g}: {curve.stop_reason}")
+                parts.append(np.column_stack([curve.parameter, curve.second_parameter,
+                                              curve.period, curve.dataset["residual"].values,
+                                              curve.condition]))
                 continue
-            kind = curve.kind
-            stops.append(f"towards {ykey} = {to:g}: {curve.stop_reason}")
-            parts.append(np.column_stack([curve.parameter, curve.second_parameter,
-                                          curve.period, curve.dataset["residual"].values,
-                                          curve.condition]))
-        else:
-            table, stop = _by_walks(branch, which, ykey, y_start, to, points, far, settings)
-            kind = f"{branch.bifurcations()[which]['kind']} (one-parameter walks)"
-            stops.append(f"towards {ykey} = {to:g}: {stop}")
-            parts.append(table)
+        table, stop = _by_walks(branch, which, ykey, y_start, to, points, far, settings)
+        kind = f"{branch.bifurcations()[which]['kind']} (one-parameter walks)"
+        stops.append(f"towards {ykey} = {to:g}: {why}located by one-parameter walks: {stop}")
+        parts.append(table)
     if not parts:
         raise FivdiscError(f"the end of the stable vibration could not be followed in {ykey}: "
                            + "; ".join(stops))
