@@ -94,7 +94,8 @@ def region_lines(ds) -> list[str]:
     vibration it starts from, each curve with every point's residuals."""
     xkey, ykey = ds.attrs["x_key"], ds.attrs["y_key"]
     lines = [f"at {ykey} = {ds.attrs['y_start']:.10g}: {ds.attrs['hopf']}",
-             f"stable vibration: {ds.attrs['vibration']}"]
+             f"stable vibration: {ds.attrs['vibration']}",
+             f"it ends: {ds.attrs['vibration_end']}"]
     for c in range(ds.sizes["curve"]):
         sel = ds["curve"].values == c
         lines.append(f"{ds['curve_role'].values[c]} ({ds['curve_kind'].values[c]}), "

@@ -110,8 +110,8 @@ def bistable_region(
         ``hopf_on_boundary``; dimension ``special`` with ``special_kind`` (Bautin, double
         Hopf, ...), ``special_x``, ``special_y``. Attributes ``x_key``, ``y_key``,
         ``x_range``, ``y_range``, ``y_start`` (the value of ``y`` the orbits were found
-        at), ``hopf_value``, ``vibration`` (the vibration's orbit in words), ``seconds``
-        and the case.
+        at), ``hopf_value``, ``vibration`` (the vibration's orbit in words),
+        ``vibration_end`` (its end at ``y_start``, in words), ``seconds`` and the case.
 
     Raises
     ------
@@ -212,6 +212,9 @@ def bistable_region(
         raise FivdiscError(f"the stable vibration ({orbit_text}) does not end between "
                            f"{xkey} = {hopf.value:g} and {far:g}: widen --x")
     ends.append(("vibration end", vib, end))
+    record = vib.bifurcations()[end[0]]
+    end_text = (f"{record['kind']} at {xkey} = {record['parameter']:.9g}: "
+                f"{record['note']}")
     if threshold:
         from fivdisc.continuation.from_hopf import hopf_cycles
 
@@ -233,7 +236,7 @@ def bistable_region(
     growth = smap["max_growth_rate"].transpose(ykey, xkey).values
     region = _classify(growth, xs, ys, rows[0][3], side)
     return _dataset(case, curves_h, rows, xs, ys, growth, region, (xkey, xr_), (ykey, yr_),
-                    y_start, hopf, orbit_text, time.monotonic() - began)
+                    y_start, hopf, (orbit_text, end_text), time.monotonic() - began)
 
 
 def _vibration(base: Case, xkey: str, hopf_value: float, far: float, transient: float,
@@ -392,7 +395,7 @@ def _classify(growth: np.ndarray, xs: np.ndarray, ys: np.ndarray, table: np.ndar
 
 def _dataset(case: Case, curves_h: xr.Dataset, rows: list, xs: np.ndarray, ys: np.ndarray,
              growth: np.ndarray, region: np.ndarray, x: tuple, y: tuple, y_start: float,
-             hopf: Any, orbit_text: str, seconds: float) -> xr.Dataset:
+             hopf: Any, texts: tuple[str, str], seconds: float) -> xr.Dataset:
     import xarray as xr
 
     from fivdisc.engine.conventions import global_attrs, key_attrs
@@ -449,5 +452,6 @@ def _dataset(case: Case, curves_h: xr.Dataset, rows: list, xs: np.ndarray, ys: n
                "fivdisc_kind": "bistable_region", "x_key": xkey, "y_key": ykey,
                "x_range": np.asarray(xr_, dtype=float), "y_range": np.asarray(yr_, dtype=float),
                "y_start": y_start, "hopf_value": float(hopf.value), "hopf": str(hopf),
-               "vibration": orbit_text, "seconds": float(seconds), "case": case.to_toml()},
+               "vibration": texts[0], "vibration_end": texts[1], "seconds": float(seconds),
+               "case": case.to_toml()},
     )
