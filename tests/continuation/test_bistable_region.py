@@ -129,6 +129,28 @@ def test_no_subcritical_hopf_point_is_said():
         bistable_region(RIGID, (SPEED, (6.0, 14.0)), (DAMPING, (0.45, 0.55)), points=1)
 
 
+def test_paper_case_region_against_forward_runs():
+    """The packaged damped-disc case (the paper's first example, 0.2 % modal damping):
+    sliding stable above a subcritical Hopf point at 24.05 rad/s, and a stick-slip
+    vibration stable beside it up to about 41.6 rad/s, where it reaches the disc speed
+    tangentially; nearly independent of the disc's damping."""
+    from fivdisc import examples, load_case
+
+    case = load_case(examples.path("damped-disc"))
+    y = "disc.damping_ratio"
+    ds = bistable_region(case, (SPEED, (18.0, 60.0)), (y, (0.0015, 0.0025)), points=2,
+                         grid=(22, 3), seeds=3)
+    assert abs(ds.attrs["hopf_value"] - 24.054) < 1e-2
+    assert str(ds["curve_kind"].values[0]) == "grazing"
+    row = 1
+    at = float(ds[y].values[row])
+    inside, outside, unstable = (_middles(ds, c, row) for c in (1, 0, 2))
+    assert not _vibrates(case, SPEED, y, (inside, at), 0.01, 1.0)
+    assert _vibrates(case, SPEED, y, (inside, at), 1.0, 1.0)
+    assert not _vibrates(case, SPEED, y, (outside, at), 1.0, 1.0)
+    assert _vibrates(case, SPEED, y, (unstable, at), 0.01, 1.0)
+
+
 @pytest.mark.slow
 def test_three_pads_region_against_forward_runs():
     """Issue 36's three pads in (speed, disc damping): the subcritical Hopf point near

@@ -25,6 +25,11 @@ from fivdisc.cli._case import CASE
 @click.option("--threshold", is_flag=True,
               help="Also follow where the unstable orbits born at the Hopf point end (their "
               "grazing or fold).")
+@click.option("--vibration", "vibration_file",
+              type=click.Path(dir_okay=False, exists=True, path_type=Path),
+              help="A branch of the stable vibration in --x at the case's value of --y "
+              "(fivdisc continue -o), instead of the one found from a start stuck to the "
+              "disc: where several stable vibrations coexist, each has its own region.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               help="The region's netCDF file (.nc; default: beside CASE_FILE, "
               "CASE-bistable.nc), for fivdisc plot.")
@@ -33,8 +38,8 @@ from fivdisc.cli._case import CASE
 @click.option("--progress/--no-progress", default=True, show_default=True,
               help="Say what is being computed, on stderr.")
 def bistable(case_file: Path, x_spec: str, y_spec: str, points: int, grid_spec: str,
-             threshold: bool, output: Path | None, figure: Path | None,
-             progress: bool) -> None:
+             threshold: bool, vibration_file: Path | None, output: Path | None,
+             figure: Path | None, progress: bool) -> None:
     """Map where sliding is stable and yet a large kick starts a stable vibration.
 
     In the box --x by --y: the Hopf curves of the sliding equilibrium (with their first
@@ -73,8 +78,13 @@ def bistable(case_file: Path, x_spec: str, y_spec: str, points: int, grid_spec: 
         require("plot", "fivdisc bistable --figure")
         fig_out = check_output(figure, "--figure", figure_suffixes(), inputs=[case_file])
     case = load_case(case_file)
+    vibration = None
+    if vibration_file is not None:
+        from fivdisc.continuation.branch import open_branch
+
+        vibration = open_branch(vibration_file)
     ds = bistable_region(case, box[0], box[1], points=points, grid=(nx, ny),
-                         threshold=threshold, progress=progress)
+                         threshold=threshold, vibration=vibration, progress=progress)
     ds.attrs["case_name"] = case_file.stem
     write_netcdf(out, ds.to_netcdf)
     click.echo(f"wrote {out}")

@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from fivdisc.case import Case
+from fivdisc.continuation.branch import Branch
 from fivdisc.continuation.settings import ContinuationSettings
 from fivdisc.errors import CaseError, ConvergenceError, FivdiscError
 
@@ -70,6 +71,7 @@ def bistable_region(
     grid: tuple[int, int] = (41, 21),
     threshold: bool = False,
     seeds: int = 6,
+    vibration: Branch | None = None,
     settings: ContinuationSettings | None = None,
     progress: bool = False,
 ) -> xr.Dataset:
@@ -92,6 +94,11 @@ def bistable_region(
         grazing or fold; below it they are the threshold a kick must cross).
     seeds : int
         Seed lines per side of :func:`~fivdisc.analysis.codimension.hopf_curves`.
+    vibration : Branch, optional
+        The stable vibration's branch in ``x`` at the case's value of ``y``
+        (:func:`~fivdisc.continuation.walk.continue_orbit` of a stable stick-slip orbit,
+        followed to its end), instead of the one found from a stuck start: where several
+        stable vibrations coexist, each has its own region.
     settings : ContinuationSettings, optional
         Tolerances and budgets of the continuations.
     progress : bool
@@ -203,9 +210,18 @@ def bistable_region(
     # the equilibrium's stable side of the Hopf point along x
     side = -float(hopf.direction)
     far = float(max(xr_) if side > 0 else min(xr_))
-    say(f"the stable vibration beyond {xkey} = {hopf.value:.8g}")
-    vib, orbit_text = _vibration(base, xkey, hopf.value, float(far),
-                                 _TRANSIENT * 2.0 * np.pi / hopf.omega, settings)
+    if vibration is None:
+        say(f"the stable vibration beyond {xkey} = {hopf.value:.8g}")
+        vib, orbit_text = _vibration(base, xkey, hopf.value, float(far),
+                                     _TRANSIENT * 2.0 * np.pi / hopf.omega, settings)
+    else:
+        if vibration.key != xkey or not np.isclose(float(vibration.case.get(ykey)), y_start):
+            raise FivdiscError(f"vibration is a branch in {vibration.key} at {ykey} = "
+                               f"{vibration.case.get(ykey)!r}: it must be one in {xkey} at "
+                               f"{ykey} = {y_start:g}")
+        vib = vibration
+        orbit_text = (f"the given branch ({' / '.join(vib.signature(0))} at {xkey} = "
+                      f"{vib.parameter[0]:.6g}, T = {vib.period[0]:.6g} s)")
     ends = []
     end = _stable_end(vib)
     if end is None:
