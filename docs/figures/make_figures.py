@@ -78,7 +78,7 @@ def bistable_three_pads(work: Path) -> None:
     case = HERE.parents[1] / "tests" / "data" / "three_pads_issue36.toml"
     res = CliRunner().invoke(cli, [
         "bistable", str(case), "--x", "speed.value=15:50", "--y",
-        "disc.damping_ratio=0.002:0.004", "--points", "2", "--grid", "36:5",
+        "disc.damping_ratio=0.002:0.004", "--points", "2", "--grid", "71:41",
         "-o", str(work / "region.nc"), "--figure", str(HERE / "bistable-three-pads.png"),
         "--no-progress"])
     print(res.output)

@@ -335,7 +335,7 @@ def _both_ways(branch, which: int, condition: str | None, ykey: str, y_start: fl
                                               curve.condition]))
                 continue
         table, stop = _by_walks(branch, which, ykey, y_start, to, points, far, settings)
-        kind = f"{branch.bifurcations()[which]['kind']} (one-parameter walks)"
+        kind = "located by one-parameter walks"
         stops.append(f"towards {ykey} = {to:g}: {why}located by one-parameter walks: {stop}")
         parts.append(table)
     if not parts:

@@ -25,8 +25,6 @@ _SHADES = {-1: ("#dddddd", "undetermined (the vibration's end not followed there
            0: ("#c6e5c3", "sliding stable, no vibration"),
            1: ("#f7d08a", "bistable: sliding stable, a large kick starts a stable vibration"),
            2: ("#f4c7c3", "sliding unstable")}
-_SPECIALS = {"bautin": ("*", "GH", "Bautin point (l1 = 0)"),
-             "double_hopf": ("s", "HH", "double Hopf point")}
 
 
 @drawing
@@ -65,7 +63,7 @@ def plot_bistable_region(ds: xr.Dataset, ax: Axes | None = None) -> Figure:
     the Hopf curves where they bound the stable sliding (dashed where subcritical, solid
     where supercritical), the curve where the stable vibration ends (thick, named by its
     kind: fold of cycles or grazing) and, if followed, where the threshold orbits from
-    the Hopf point end (thin); the Bautin (GH) and double Hopf (HH) points.
+    the Hopf point end (thin); the Bautin points (GH).
 
     Parameters
     ----------
@@ -110,16 +108,17 @@ def plot_bistable_region(ds: xr.Dataset, ax: Axes | None = None) -> Figure:
                 color="k" if main else "C0", lw=2.4 if main else 1.5, marker=".",
                 label=(f"stable vibration ends ({kind})" if main
                        else f"threshold orbits end ({kind})"))
-    kinds = ds["special_kind"].values
-    for kind, (marker, short, name) in _SPECIALS.items():
-        sel = np.flatnonzero(kinds == kind)
-        if not sel.size:
-            continue
-        ax.plot(ds["special_x"].values[sel], ds["special_y"].values[sel], marker, ms=9,
-                color="k", mfc="gold" if kind == "bautin" else "w", label=f"{short}: {name}")
-        for i in sel:
-            ax.annotate(short, (ds["special_x"].values[i], ds["special_y"].values[i]),
-                        xytext=(5, 5), textcoords="offset points", fontsize="small")
+    # The Bautin points, where the Hopf curve turns from super- to subcritical (each once:
+    # hopf_curves finds one from every curve through it); double Hopf points are left to
+    # plot_hopf_curves (identical pads give one per seed line, which would hide the rest).
+    sel = np.flatnonzero(ds["special_kind"].values == "bautin")
+    points = {(round(float(ds["special_x"].values[i]), 6),
+               round(float(ds["special_y"].values[i]), 9)) for i in sel}
+    for k, (x, y) in enumerate(sorted(points)):
+        ax.plot(x, y, "*", ms=12, color="k", mfc="gold",
+                label="GH: Bautin point (l1 = 0)" if k == 0 else None)
+        ax.annotate("GH", (x, y), xytext=(5, 5), textcoords="offset points",
+                    fontsize="small")
     ax.set_xlim(*ds.attrs["x_range"])
     ax.set_ylim(*ds.attrs["y_range"])
     ax.set_xlabel(key_label(xkey))
