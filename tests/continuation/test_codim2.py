@@ -165,3 +165,41 @@ def test_bad_conditions_and_keys_are_refused():
         bifurcation_curve(RIGID, SPEED, "fold", DAMPING, 0.6, points=1, **branch_args)
     with pytest.raises(CaseError, match=r"to2 = -1\.0 is invalid|must be >= 0"):
         bifurcation_curve(RIGID, SPEED, "fold", DAMPING, -1.0, **branch_args)
+
+
+@pytest.mark.slow
+def test_period_doubling_and_torus_curves_cross_the_branches():
+    """The damped-disc orbit near 2.59 rad/s continued in the disc's damping ratio
+    towards zero meets tori and a period doubling near 3.59e-6
+    (test_continuation.py's doubled orbits start there). The period doubling and the
+    last torus before it followed in the speed; at three of the curves' speeds the branch
+    in the damping, computed afresh, locates each where its curve says (Brent on the
+    passing multiplier, 1e-7, against the curve's secant on Re mu + 1 or |mu| - 1, 1e-9:
+    1e-6 relative)."""
+    speed = 2.5911321532805127
+    case = load_case(examples.path("damped-disc"))
+    key = "disc.damping_ratio"
+
+    def primary(value: float) -> fivdisc.Branch:
+        at = case.replace({SPEED: value})
+        start = fivdisc.periodic_orbit(at, transient=6.0)
+        return fivdisc.continue_orbit(at, key, 2e-6, orbit=start, max_points=120)
+
+    branch = primary(speed)
+    kinds = [b["kind"] for b in branch.bifurcations()]
+    pd = kinds.index("period doubling")
+    torus = max(i for i, k in enumerate(kinds) if k == "torus" and i < pd)
+    curves = {kind: curve_from_branch(branch, i, SPEED, 2.6, points=4)
+              for kind, i in (("period doubling", pd), ("torus", torus))}
+    for curve in curves.values():
+        assert curve.stop_reason == f"reached {SPEED} = 2.6"
+        assert (np.abs(curve.condition) < 1e-8).all()
+    nodes = curves["period doubling"].second_parameter
+    for i in (1, 2, 3):
+        found = primary(float(nodes[i])).bifurcations()
+        for kind, curve in curves.items():
+            j = int(np.argmin(np.abs(curve.second_parameter - nodes[i])))
+            assert curve.second_parameter[j] == nodes[i]
+            near = [b["parameter"] for b in found if b["kind"] == kind]
+            value = min(near, key=lambda p: abs(p - curve.parameter[j]))
+            assert value == pytest.approx(curve.parameter[j], rel=1e-6)

@@ -101,7 +101,8 @@ class CurveProblem(OrbitProblem):
     """The continuation problem of a branch in ``key`` whose case moves with ``key2``.
 
     The scales of the unknowns are the first slice's, so that points of different
-    slices are in one set of coordinates (their tangents compare)."""
+    slices are in one set of coordinates (their tangents compare); the models at the
+    values of ``key`` are made from the slice's (:meth:`move`)."""
 
     def __init__(self, case: Case, key: str, key2: str, phases: np.ndarray, period: float,
                  settings: ContinuationSettings) -> None:
@@ -130,16 +131,6 @@ class CurveProblem(OrbitProblem):
         (self.q, self.case, self.base, self.shooting, self.free, self.m,
          self.template) = saved
         self._models.clear()
-
-    def model(self, p: float):
-        if p not in self._models:
-            if len(self._models) > 64:
-                self._models.clear()
-            try:
-                self._models[p] = model_at(self.base, self.case, {self.key: p})
-            except CaseError as exc:
-                raise ConvergenceError(str(exc), reason=str(exc)) from None
-        return self._models[p]
 
 
 @dataclass
@@ -294,8 +285,8 @@ def _on_slice(problem: CurveProblem, start: Point, condition: str, track: _Track
         dist = _to_zero(good[-2:], power, sign, track.slope)
         if one_sided:
             # short of the border by half the stopping distance (iterates nearer than
-            # about 1e-7 fall across it in the corrector), the first step on the previous
-            # slice's slope by a tenth of the way
+            # about 1e-7 fall across it in the corrector); the first step, on the
+            # previous slice's slope, only _SHORT of the way
             dist = (dist * _SHORT if len(good) == 1 else dist) - 0.5 * _NEAR * np.sign(dist)
         s = sb + dist
         if np.isfinite(bad) and (s - bad) * (sb - bad) <= 0:
