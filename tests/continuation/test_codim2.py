@@ -203,3 +203,33 @@ def test_period_doubling_and_torus_curves_cross_the_branches():
             near = [b["parameter"] for b in found if b["kind"] == kind]
             value = min(near, key=lambda p: abs(p - curve.parameter[j]))
             assert value == pytest.approx(curve.parameter[j], rel=1e-6)
+
+
+@pytest.mark.slow
+def test_symmetry_breaking_curve_crosses_the_branches_of_three_pads():
+    """Issue 36's three pads: the orbits born at the subcritical Hopf point (pads in
+    turn, T/3 apart) lose their symmetry near 19.7231 rad/s, where a pair of the T/3
+    map crosses the unit circle near the 1:3 resonance. Followed in the disc's damping
+    ratio (|mu| - 1 of the reduced map's eigenvalue); at three of its values the branch
+    from the Hopf point, computed afresh, locates it where the curve says (1e-6)."""
+    from pathlib import Path
+
+    case = load_case(Path(__file__).parents[1] / "data" / "three_pads_issue36.toml")
+    key = "disc.damping_ratio"
+
+    def cycles(damping: float) -> fivdisc.Branch:
+        at = case.replace({key: damping})
+        hopf = next(h for h in fivdisc.hopf_points(at, SPEED, np.linspace(19.4, 19.8, 5))
+                    if h.on_boundary)
+        return fivdisc.hopf_cycles(hopf, 20.0, confirm_periods=0)
+
+    branch = cycles(0.003)
+    (k,) = [i for i, b in enumerate(branch.bifurcations()) if b["kind"] == "symmetry breaking"]
+    curve = curve_from_branch(branch, k, key, 0.0033, points=4)
+    assert curve.stop_reason == f"reached {key} = 0.0033"
+    assert (np.abs(curve.condition) < 1e-9).all()
+    for i in (1, 2, 3):
+        found = [b["parameter"] for b in cycles(float(curve.second_parameter[i])).bifurcations()
+                 if b["kind"] == "symmetry breaking"]
+        assert len(found) == 1
+        assert found[0] == pytest.approx(curve.parameter[i], rel=1e-6)
