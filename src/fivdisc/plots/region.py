@@ -89,13 +89,22 @@ def plot_bistable_region(ds: xr.Dataset, ax: Axes | None = None) -> Figure:
     outer = ds["hopf_on_boundary"].values.astype(bool)
     sub = ds["hopf_l1"].values > 0.0
     curve = ds["hopf_curve"].values
-    drawn = set()
+    # Segments between consecutive points of one curve on the boundary, dashed where both
+    # ends are subcritical; consecutive segments of one style drawn as one line (a dash
+    # pattern restarts at every line: drawn one by one, short ones would look solid).
+    lines: list[tuple[str, list[int]]] = []
     for k in range(hx.size - 1):
         if curve[k] != curve[k + 1] or not (outer[k] and outer[k + 1]):
             continue
         style = "--" if sub[k] and sub[k + 1] else "-"
-        label = ("Hopf, subcritical" if style == "--" else "Hopf, supercritical")
-        ax.plot(hx[[k, k + 1]], hy[[k, k + 1]], style, color="C3", lw=2.0,
+        if lines and lines[-1][0] == style and lines[-1][1][-1] == k:
+            lines[-1][1].append(k + 1)
+        else:
+            lines.append((style, [k, k + 1]))
+    drawn = set()
+    for style, run in lines:
+        label = "Hopf, subcritical" if style == "--" else "Hopf, supercritical"
+        ax.plot(hx[run], hy[run], style, color="C3", lw=2.0,
                 label=None if label in drawn else label)
         drawn.add(label)
     names = {"fold": "fold of cycles", "grazing": "grazing"}
