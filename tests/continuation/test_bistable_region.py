@@ -52,7 +52,7 @@ def _middles(ds, code: int, row: int) -> float:
 @pytest.fixture(scope="module")
 def rigid():
     return bistable_region(RIGID, (SPEED, (6.0, 14.0)), (DAMPING, (0.45, 0.55)), points=3,
-                           grid=(17, 3), seeds=3)
+                           grid=(17, 3), seeds=3, threshold=True)
 
 
 def test_rigid_disc_region_against_forward_runs(rigid):
@@ -72,8 +72,14 @@ def test_rigid_disc_region_against_forward_runs(rigid):
 def test_region_layout_curves_and_the_hopf_boundary(rigid):
     ds = rigid
     assert ds.attrs["fivdisc_kind"] == "bistable_region"
-    assert list(ds["curve_role"].values) == ["vibration end"]
-    assert str(ds["curve_kind"].values[0]) == "grazing"
+    assert list(ds["curve_role"].values) == ["vibration end", "threshold end"]
+    assert list(ds["curve_kind"].values) == ["grazing", "grazing"]
+    # the unstable slipping orbits from the Hopf point graze the stick boundary (and
+    # turn into unstable stick-slip orbits) before the stable stick-slip orbit ends
+    for y in (0.45, 0.5, 0.55):
+        ends = [np.interp(y, ds["curve_y"].values[ds["curve"].values == c],
+                          ds["curve_x"].values[ds["curve"].values == c]) for c in (0, 1)]
+        assert ends[1] < ends[0]
     # every curve point an orbit (shooting residual) on its condition
     assert (ds["curve_residual"].values < 1e-8).all()
     assert (np.abs(ds["curve_condition"].values) < 1e-2).all()
