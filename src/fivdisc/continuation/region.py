@@ -174,6 +174,7 @@ def bistable_region(
         raise CaseError("a box needs KEY=START:STOP for each key (two values)")
     check_keys(case, [xkey, ykey], ["x", "y"])
     check_box(case, [(xkey, xr_), (ykey, yr_)], ["x", "y"])
+    # a constant speed, and an end of x the orbits can be continued to
     check_target(case, xkey, float(xr_[1]) if case.get(xkey) != xr_[1] else float(xr_[0]))
     if isinstance(points, bool) or not isinstance(points, int) or points < 2:
         raise CaseError(f"points = {points!r} is invalid: must be an integer >= 2")
@@ -192,9 +193,6 @@ def bistable_region(
     y_case = float(case.get(ykey))
     y_start = y_case if lo_y <= y_case <= hi_y else 0.5 * (lo_y + hi_y)
     base = case.replace({ykey: y_start})
-    say(f"Hopf curves in ({xkey}, {ykey})")
-    curves_h = hopf_curves(case, (xkey, tuple(xr_)), (ykey, tuple(yr_)), seeds=seeds,
-                           step=0.1)
     say(f"Hopf points along {xkey} at {ykey} = {y_start:g}")
     found = [h for h in hopf_points(base, xkey, np.linspace(xr_[0], xr_[1], 41))
              if h.on_boundary]
@@ -207,6 +205,9 @@ def bistable_region(
         raise FivdiscError(f"the {hopf}: not subcritical, so no bistable range begins at "
                            f"{ykey} = {y_start:g} (choose a box where the Hopf point is "
                            "subcritical)")
+    say(f"Hopf curves in ({xkey}, {ykey})")
+    curves_h = hopf_curves(case, (xkey, tuple(xr_)), (ykey, tuple(yr_)), seeds=seeds,
+                           step=0.1)
     # the equilibrium's stable side of the Hopf point along x
     side = -float(hopf.direction)
     far = float(max(xr_) if side > 0 else min(xr_))
