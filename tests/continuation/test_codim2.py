@@ -233,3 +233,17 @@ def test_symmetry_breaking_curve_crosses_the_branches_of_three_pads():
                  if b["kind"] == "symmetry breaking"]
         assert len(found) == 1
         assert found[0] == pytest.approx(curve.parameter[i], rel=1e-6)
+
+
+def test_a_curve_point_is_a_start_at_both_keys(grazing, tmp_path):
+    """An orbit started from a point of a curve (``--from curve.nc --point K``) is at the
+    point's values of both keys: Newton from the stored state converges at once to it."""
+    from fivdisc.analysis.orbits import saved_start
+
+    grazing.to_netcdf(tmp_path / "curve.nc")
+    saved = saved_start(tmp_path / "curve.nc", 3)
+    assert saved.case.get(DAMPING) == grazing.second_parameter[3]
+    assert saved.case.get(SPEED) == grazing.parameter[3]
+    orbit = fivdisc.periodic_orbit(saved.case, saved.state, period=saved.period,
+                                   phases=saved.phases)
+    assert orbit.period == pytest.approx(grazing.period[3], rel=1e-9)

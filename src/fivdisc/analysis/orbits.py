@@ -1212,7 +1212,8 @@ def saved_start(path: str | PathLike[str], point: int | None = None) -> SavedSta
     """A start from a file fivdisc wrote: an orbit (``fivdisc orbit -o``; its state,
     phases and period), a simulation result (its final state and phases) or a branch
     point (``fivdisc continue -o``; point ``point``, default its last: the point's state,
-    phases and period, and the case with the branch's key at the point's value).
+    phases and period, and the case with the branch's key at the point's value, and a
+    bifurcation curve's second key at its value there).
 
     Raises
     ------
@@ -1237,12 +1238,18 @@ def saved_start(path: str | PathLike[str], point: int | None = None) -> SavedSta
         value = float(ds["parameter"].values[k])
         phase = ds["phase"].values
         phases = (phase[k] if phase.ndim == 2 else phase).astype(np.int64)
+        where = f"{key} = {value:.10g}"
         if case is not None:
             case = case.replace({key: value})
+            if "second_parameter" in ds:
+                # a point of a bifurcation curve in two keys: the second key's value too
+                key2 = str(ds.attrs["key2"])
+                value2 = float(ds["second_parameter"].values[k])
+                case = case.replace({key2: value2})
+                where += f", {key2} = {value2:.10g}"
         return SavedStart(case, ds["state"].values[k].astype(float), phases,
                           float(ds["period"].values[k]),
-                          f"from point {k} of the branch in {path} ({key} = {value:.10g})",
-                          key, value)
+                          f"from point {k} of the branch in {path} ({where})", key, value)
     if point is not None:
         raise FivdiscError(f"--point {point} needs --from a branch (fivdisc continue -o); "
                            f"{path} holds no branch")
