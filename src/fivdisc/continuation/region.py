@@ -220,6 +220,10 @@ def bistable_region(
             raise FivdiscError(f"vibration is a branch in {vibration.key} at {ykey} = "
                                f"{vibration.case.get(ykey)!r}: it must be one in {xkey} at "
                                f"{ykey} = {y_start:g}")
+        if not vibration.stable[0]:
+            raise FivdiscError(f"vibration: the branch's first orbit (at {xkey} = "
+                               f"{vibration.parameter[0]:.6g}) is unstable: give a branch "
+                               "that starts from a stable vibration")
         vib = vibration
         orbit_text = (f"the given branch ({' / '.join(vib.signature(0))} at {xkey} = "
                       f"{vib.parameter[0]:.6g}, T = {vib.period[0]:.6g} s)")
