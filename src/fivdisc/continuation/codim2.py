@@ -8,7 +8,10 @@ the shooting equations, the phase condition, the corrector, the anchor away from
 switches); only its case moves with ``key2``. On each slice the unknowns are the orbit's
 point, its period and ``key``, and ``g`` is zeroed by a secant iteration along the
 slice's branch (arclength ``s`` from the slice's first point, each iterate a converged
-point of the branch): ``s_{k+1} = s_k - g_k (s_k - s_{k-1}) / (g_k - g_{k-1})``.
+point of the branch): ``s_{k+1} = s_k - g_k (s_k - s_{k-1}) / (g_k - g_{k-1})``, or on
+``g^2`` where ``g`` falls as the square root of the distance to its zero (a one-sided
+condition whose three last iterates fit that better, or whose straight-line step
+overshot).
 
 The defining conditions (each zero at the bifurcation, of one sign on either side):
 
@@ -40,11 +43,13 @@ reach zero (the in-phase orbit of three identical pads ends with its stick phase
 of the second key by the one-parameter walk instead.
 
 The curve steps ``key2`` evenly from the start to ``to2``; the first iterate of a slice
-is the previous point with ``key`` extrapolated linearly from the last two points (for a
-one-sided condition, backed off to its side by the last step's change of ``key``),
+is the previous point with ``key`` extrapolated through the last three points and the
+orbit through the last two (for a one-sided condition, first moved back along the
+previous branch by 1e-3 of the scaled arclength, or twice the extrapolation's error),
 corrected onto the slice's branch on the hyperplane normal to the previous tangent (so
 that it converges next to a fold, where ``key`` alone is no coordinate of the branch).
-A slice that fails halves the step of ``key2`` (down to 1/64 of it); the curve ends there.
+A slice that fails halves the step of ``key2`` (up to six times in a row; the curve ends
+there), and the step grows back once one goes through.
 """
 
 from __future__ import annotations
