@@ -29,7 +29,7 @@ _SEARCH_OPTIONS = ("--period", "--transient", "the search window", "--rtol")
               "sliders.1.preload, friction.decay, disc.damping_ratio, ...).")
 @click.option("--to", "target", type=float,
               help="The key's value where the continuation stops [the key's unit]; its side "
-              "of the case's value sets the direction. Required but with --key2.")
+              "of the case's value sets the direction. Required, except with --key2.")
 @click.option("--back-to", "back_to", type=float,
               help="The other end of the window [the key's unit]: a branch that turns at a "
               "fold stops where the key comes back past it (default: the start's value). "
