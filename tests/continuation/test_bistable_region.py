@@ -175,3 +175,32 @@ def test_three_pads_region_against_forward_runs():
     assert not _vibrates(case, SPEED, y, (inside, at), 0.01, 1.0)
     assert _vibrates(case, SPEED, y, (inside, at), 1.0, 1.0)
     assert not _vibrates(case, SPEED, y, (outside, at), 1.0, 1.0)
+
+
+@pytest.mark.slow
+def test_three_pads_with_the_pads_sticking_in_turn():
+    """The other stable vibration of issue 36's three pads, the pads sticking in turn
+    (T/3 apart; found after a 10 s transient from the case's own kick at 22 rad/s),
+    given as the vibration: its region reaches the issue's 45.954 rad/s at 0.3 % disc
+    damping (the issue's one-key continuation, another session's). Between the in-phase
+    vibration's end (42.46) and there, a run from that orbit keeps sticking while a small
+    kick from sliding dies out."""
+    from fivdisc.case import load_case
+
+    case = load_case(Path(__file__).parents[1] / "data" / "three_pads_issue36.toml")
+    y = "disc.damping_ratio"
+    orbit = fivdisc.periodic_orbit(case, transient=10.0)
+    assert orbit.symmetry.startswith("pads stick in turn") and orbit.verdict == "stable"
+    vibration = fivdisc.continue_orbit(case, SPEED, 50.0, orbit=orbit, confirm_periods=0)
+    ds = bistable_region(case, (SPEED, (15.0, 50.0)), (y, (0.0025, 0.0035)), points=2,
+                         grid=(36, 3), seeds=4, vibration=vibration)
+    at = float(np.interp(0.003, ds["curve_y"].values, ds["curve_x"].values))
+    assert at == pytest.approx(45.954, abs=1e-3)
+    speed = 44.5
+    i = int(np.argmin(np.abs(vibration.parameter - speed)))
+    on_orbit = case.replace({SPEED: float(vibration.parameter[i]),
+                             "simulation.duration": 1.0, "simulation.output_rate": 2000.0})
+    run = fivdisc.simulate(on_orbit, initial=vibration.dataset["state"].values[i])
+    assert np.any(run.events("stick") > 0.75)
+    assert not _vibrates(case, SPEED, y, (float(vibration.parameter[i]), 0.003), 0.01, 1.0)
+    assert ds["region"].values[1][np.argmin(np.abs(ds[SPEED].values - speed))] == 1
