@@ -2,14 +2,15 @@
 
     python docs/figures/make_figures.py bifurcation-speed   # about 2 min on 2 cores
     python docs/figures/make_figures.py fig10 fig27          # fivdisc reproduce's figures
+    python docs/figures/make_figures.py bistable-three-pads  # about 4 min on 2 cores
     python docs/figures/make_figures.py all
 
 Each figure is drawn by the command a user would run (``fivdisc bifurcation``,
-``fivdisc reproduce``), so a figure in the README is what that command gives today. The
-bifurcation diagram also prints the evidence its description in the README rests on:
-per stretch of speeds, the exponents with their uncertainties, the number of distinct
-section values, and the spectral verdict (:func:`fivdisc.classify`) of the slider's
-angle at one speed of each stretch.
+``fivdisc reproduce``, ``fivdisc bistable``), so a figure in the README is what that
+command gives today. The bifurcation diagram also prints the evidence its description in
+the README rests on: per stretch of speeds, the exponents with their uncertainties, the
+number of distinct section values, and the spectral verdict (:func:`fivdisc.classify`) of
+the slider's angle at one speed of each stretch.
 """
 
 from __future__ import annotations
@@ -67,8 +68,26 @@ def reproduced(figure: str, work: Path) -> None:
     shutil.copyfile(work / figure / f"{figure}.png", HERE / f"{figure}.png")
 
 
+def bistable_three_pads(work: Path) -> None:
+    """Issue 36's three pads (``tests/data/three_pads_issue36.toml``) as ``fivdisc
+    bistable`` maps them in (speed, disc damping), the box of the tutorial."""
+    from click.testing import CliRunner
+
+    from fivdisc.cli import cli
+
+    case = HERE.parents[1] / "tests" / "data" / "three_pads_issue36.toml"
+    res = CliRunner().invoke(cli, [
+        "bistable", str(case), "--x", "speed.value=15:50", "--y",
+        "disc.damping_ratio=0.002:0.004", "--points", "2", "--grid", "71:41",
+        "-o", str(work / "region.nc"), "--figure", str(HERE / "bistable-three-pads.png"),
+        "--no-progress"])
+    print(res.output)
+    if res.exit_code:
+        sys.exit(res.exit_code)
+
+
 def main(names: list[str]) -> None:
-    known = ["bifurcation-speed", "fig10", "fig27"]
+    known = ["bifurcation-speed", "fig10", "fig27", "bistable-three-pads"]
     names = known if names == ["all"] else names
     unknown = sorted(set(names) - set(known))
     if unknown or not names:
@@ -77,6 +96,8 @@ def main(names: list[str]) -> None:
         for name in names:
             if name == "bifurcation-speed":
                 bifurcation_speed(Path(directory))
+            elif name == "bistable-three-pads":
+                bistable_three_pads(Path(directory))
             else:
                 reproduced(name, Path(directory))
             print(f"wrote {HERE / (name + '.png')}")

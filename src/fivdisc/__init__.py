@@ -54,6 +54,9 @@ _API = {
     "fivdisc.continuation.walk": ("continue_orbit",),
     "fivdisc.continuation.from_hopf": ("hopf_cycles",),
     "fivdisc.continuation.branch": ("Branch", "open_branch"),
+    "fivdisc.continuation.codim2": ("BifurcationCurve", "bifurcation_curve",
+                                    "curve_from_branch", "open_curve"),
+    "fivdisc.continuation.region": ("bistable_region",),
 }
 
 

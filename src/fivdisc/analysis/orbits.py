@@ -726,7 +726,8 @@ def _probe(model: Model, x0: np.ndarray, phases: np.ndarray | None, window: floa
            rtol: float, atol: float) -> tuple[np.ndarray, float]:
     """Samples of the trajectory from ``x0`` over ``window`` (about 200 per period of the
     fastest mode kept; the output fills in the contact coordinates), and their spacing."""
-    rate = max(200.0 * float(np.max(model.omega)) / (2 * np.pi), 1e4)
+    # (a rigid disc has no modes: the sliders' own motion is slower than 1e4 samples/s)
+    rate = max(200.0 * float(np.max(model.omega, initial=0.0)) / (2 * np.pi), 1e4)
     probe = Integration(model, x0, duration=window, output_rate=rate, rtol=rtol, atol=atol,
                         phases=phases)
     probe.run_to(window)
@@ -1215,7 +1216,8 @@ def saved_start(path: str | PathLike[str], point: int | None = None) -> SavedSta
     """A start from a file fivdisc wrote: an orbit (``fivdisc orbit -o``; its state,
     phases and period), a simulation result (its final state and phases) or a branch
     point (``fivdisc continue -o``; point ``point``, default its last: the point's state,
-    phases and period, and the case with the branch's key at the point's value).
+    phases and period, and the case with the branch's key at the point's value, and a
+    bifurcation curve's second key at its value there).
 
     Raises
     ------
@@ -1240,12 +1242,18 @@ def saved_start(path: str | PathLike[str], point: int | None = None) -> SavedSta
         value = float(ds["parameter"].values[k])
         phase = ds["phase"].values
         phases = (phase[k] if phase.ndim == 2 else phase).astype(np.int64)
+        where = f"{key} = {value:.10g}"
         if case is not None:
             case = case.replace({key: value})
+            if "second_parameter" in ds:
+                # a point of a bifurcation curve in two keys: the second key's value too
+                key2 = str(ds.attrs["key2"])
+                value2 = float(ds["second_parameter"].values[k])
+                case = case.replace({key2: value2})
+                where += f", {key2} = {value2:.10g}"
         return SavedStart(case, ds["state"].values[k].astype(float), phases,
                           float(ds["period"].values[k]),
-                          f"from point {k} of the branch in {path} ({key} = {value:.10g})",
-                          key, value)
+                          f"from point {k} of the branch in {path} ({where})", key, value)
     if point is not None:
         raise FivdiscError(f"--point {point} needs --from a branch (fivdisc continue -o); "
                            f"{path} holds no branch")

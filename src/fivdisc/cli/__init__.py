@@ -88,6 +88,7 @@ def cli() -> None:
 
 def _register() -> None:
     from fivdisc.cli import (
+        bistable,
         continuation,
         dynamics,
         examples,
@@ -107,6 +108,7 @@ def _register() -> None:
     cli.add_command(dynamics.orbit)
     cli.add_command(dynamics.lyapunov)
     cli.add_command(continuation.continuation)
+    cli.add_command(bistable.bistable)
     cli.add_command(sweep.sweep)
     cli.add_command(sweep.separation_map)
     cli.add_command(sweep.bifurcation)

@@ -12,8 +12,12 @@ import click
 
 from fivdisc.cli._case import CASE
 from fivdisc.continuation.settings import ContinuationSettings
+from fivdisc.errors import FivdiscError
 
 _DEFAULT = ContinuationSettings()
+# The defining conditions of fivdisc.continuation.codim2.CONDITIONS (light to list here).
+_CONDITIONS = ("fold", "period doubling", "torus", "symmetry breaking", "grazing",
+               "stick split")
 # How the first orbit's search options are named in messages.
 _SEARCH_OPTIONS = ("--period", "--transient", "the search window", "--rtol")
 
@@ -23,9 +27,9 @@ _SEARCH_OPTIONS = ("--period", "--transient", "the search window", "--rtol")
 @click.option("--key", required=True,
               help="The numeric case key to continue in (speed.value, slider.normal_damping, "
               "sliders.1.preload, friction.decay, disc.damping_ratio, ...).")
-@click.option("--to", "target", type=float, required=True,
+@click.option("--to", "target", type=float,
               help="The key's value where the continuation stops [the key's unit]; its side "
-              "of the case's value sets the direction.")
+              "of the case's value sets the direction. Required, except with --key2.")
 @click.option("--back-to", "back_to", type=float,
               help="The other end of the window [the key's unit]: a branch that turns at a "
               "fold stops where the key comes back past it (default: the start's value). "
@@ -49,6 +53,17 @@ _SEARCH_OPTIONS = ("--period", "--transient", "the search window", "--rtol")
               "equilibrium changes stability, else the first found, with a warning (its "
               "orbits are unstable). Says which it takes, whether it is sub- or "
               "supercritical and the bistable range.")
+@click.option("--key2", help="With --from BRANCH --bifurcation K: follow the bifurcation in "
+              "two keys, --key solved for as this second key goes --to2 a value (a curve of "
+              "--curve-points points, each with its shooting residual and the defining "
+              "condition's value).")
+@click.option("--to2", type=float, help="Where the curve in --key2 ends [its unit].")
+@click.option("--condition", type=click.Choice(list(_CONDITIONS)),
+              help="The defining condition the curve follows (default: the bifurcation's "
+              "kind); needed where a branch ends at a border, e.g. 'grazing' where the "
+              "stick phase of a stick-slip orbit vanishes.")
+@click.option("--curve-points", type=int, default=50, show_default=True,
+              help="Points on the --key2 curve, evenly spaced in --key2.")
 @click.option("--points", type=int, default=_DEFAULT.max_points, show_default=True,
               help="Most points on the branch.")
 @click.option("--step", type=float, default=_DEFAULT.step, show_default=True,
@@ -70,9 +85,11 @@ _SEARCH_OPTIONS = ("--period", "--transient", "the search window", "--rtol")
               help="Write the branch to a netCDF file (.nc), for fivdisc plot.")
 @click.option("--progress/--no-progress", default=True, show_default=True,
               help="Show the Newton iterations and the points on a terminal.")
-def continuation(case_file: Path | None, key: str, target: float, back_to: float | None,
+def continuation(case_file: Path | None, key: str, target: float | None, back_to: float | None,
                  from_file: Path | None, which: int | None, point: int | None,
-                 hopf_spec: str | None, points: int, step: float, max_step: float,
+                 hopf_spec: str | None, key2: str | None, to2: float | None,
+                 condition: str | None, curve_points: int, points: int, step: float,
+                 max_step: float,
                  transient: float | None, period: float | None, rtol: float, tol: float,
                  as_json: bool,
                  output: Path | None, progress: bool) -> None:
@@ -85,9 +102,71 @@ def continuation(case_file: Path | None, key: str, target: float, back_to: float
     CASE_FILE is a TOML file or a packaged example. Ctrl-C stops the continuation and
     writes the branch so far.
     """
+    if key2 is not None or to2 is not None or condition is not None:
+        _curve(case_file, key, from_file, which, key2, to2, condition, curve_points, rtol, tol,
+               as_json, output, progress)
+        return
+    if target is None:
+        raise FivdiscError("--to VALUE is needed: the key's value where the continuation "
+                           "stops")
     with _interrupts_wait_for_the_branch():
         _continue(case_file, key, target, back_to, from_file, which, point, hopf_spec, points,
                   step, max_step, transient, period, rtol, tol, as_json, output, progress)
+
+
+def _curve(case_file: Path | None, key: str, from_file: Path | None, which: int | None,
+           key2: str | None, to2: float | None, condition: str | None, curve_points: int,
+           rtol: float, tol: float, as_json: bool, output: Path | None,
+           progress: bool) -> None:
+    """``--key2``: a bifurcation of a branch followed in two keys; the curve printed
+    (every point with its residuals) and written."""
+    import json
+
+    from fivdisc.case import load_case
+    from fivdisc.continuation.branch import open_branch
+    from fivdisc.continuation.checks import full_key
+    from fivdisc.continuation.codim2 import curve_from_branch
+    from fivdisc.errors import FivdiscError
+    from fivdisc.files import check_output
+
+    if key2 is None or to2 is None:
+        raise FivdiscError("a curve in two keys needs --key2 KEY and --to2 VALUE (with --from "
+                           "BRANCH --bifurcation K)")
+    if from_file is None or which is None:
+        raise FivdiscError("--key2 follows a bifurcation of a branch: give --from BRANCH "
+                           "(a file of fivdisc continue -o) and --bifurcation K")
+    key, key2 = full_key(key, "--key"), full_key(key2, "--key2")
+    inputs = [p for p in (case_file, from_file) if p is not None]
+    out = check_output(output, "-o", (".nc",), inputs=inputs) if output else None
+    if isinstance(curve_points, bool) or curve_points < 2:
+        raise FivdiscError(f"--curve-points = {curve_points!r} is invalid: must be an "
+                           "integer >= 2")
+    branch = open_branch(from_file)
+    if branch.key != key:
+        raise FivdiscError(f"--key {key} differs from the branch's key {branch.key}: the curve "
+                           "solves for the branch's own key")
+    if case_file is not None:
+        # the case given replaces the stored one (the same system, other settings)
+        branch.dataset.attrs["case"] = load_case(case_file).to_toml()
+    settings = _DEFAULT.replace(rtol=rtol, tol=tol)
+    curve = curve_from_branch(branch, which, key2, to2, condition=condition,
+                              points=curve_points, settings=settings, progress=progress)
+    if out is not None:
+        curve.to_netcdf(out)
+    if as_json:
+        click.echo(json.dumps({"kind": curve.kind, "key": curve.key, "key2": curve.key2,
+                               "stop_reason": curve.stop_reason,
+                               "points": [{"value": float(p), "value2": float(q),
+                                           "period": float(t), "residual": float(r),
+                                           "condition": float(g)}
+                                          for p, q, t, r, g in zip(
+                                              curve.parameter, curve.second_parameter,
+                                              curve.period, curve.dataset["residual"].values,
+                                              curve.condition, strict=True)]}, indent=2))
+    else:
+        click.echo(str(curve))
+    if len(curve) < 2:
+        sys.exit(1)
 
 
 @contextmanager

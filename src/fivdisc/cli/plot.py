@@ -150,7 +150,15 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
     default = click.core.ParameterSource.DEFAULT
     kind_given = None if given("kind") == default else kind
     slider_given = None if given("slider") == default else slider
-    if read_dataset(result, "plot").attrs.get("content") == CONTENT:
+    stored_attrs = read_dataset(result, "plot").attrs
+    if stored_attrs.get("content") == CONTENT and "curve_kind" in stored_attrs:
+        from fivdisc.continuation.codim2 import open_curve
+
+        out = check_output(output or result.with_name(f"{result.stem}.png"), "-o",
+                           figure_suffixes(), inputs=[result])
+        _save(plots.plot_bifurcation_curve(open_curve(result)), out, dpi)
+        return
+    if stored_attrs.get("content") == CONTENT:
         out = check_output(output or result.with_name(f"{result.stem}-{var or 'period'}.png"),
                            "-o", figure_suffixes(), inputs=[result])
         fig = _branch(result, var, slider, (("--run", run), ("--probe", probe),
@@ -177,6 +185,14 @@ def plot(result: Path, run: str | None, kind: str, var: str | None, probe: int |
     run = run if run is not None else (groups[0] if groups else None)
     with xr.open_dataset(result, group=run) as stored:
         what = stored.attrs.get("fivdisc_kind", "simulation")
+    if what == "bistable_region":
+        out = check_output(output or result.with_name(f"{result.stem}.png"), "-o",
+                           figure_suffixes(), inputs=[result])
+        check_netcdf(result)
+        with xr.open_dataset(result, group=run) as stored:
+            fig = plots.plot_bistable_region(stored.load())
+        _save(fig, out, dpi)
+        return
     if what in ("stability_map", "sweep", "eigen_branches", "stability_boundary"):
         unused = [name for name, value in (("--kind", kind_given), ("--var", var),
                                            ("--probe", probe), ("--slider", slider_given),

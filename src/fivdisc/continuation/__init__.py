@@ -7,7 +7,9 @@ the key as one more unknown, and their corrector), its *settings*
 *detection* and location of bifurcations between points
 (:mod:`~fivdisc.continuation.detection`), the *walk* along the branch
 (:mod:`~fivdisc.continuation.walk`) and its result, the *branch*
-(:mod:`~fivdisc.continuation.branch`). The names below are imported on first use.
+(:mod:`~fivdisc.continuation.branch`); a bifurcation followed in two keys
+(:mod:`~fivdisc.continuation.codim2`) and the bistable region in two keys
+(:mod:`~fivdisc.continuation.region`). The names below are imported on first use.
 """
 
 from fivdisc._lazy import public
@@ -20,6 +22,9 @@ _API = {
     "fivdisc.continuation.detection": ("Bifurcation",),
     "fivdisc.analysis.kinds": ("BifurcationKind",),
     "fivdisc.continuation.branch": ("Branch", "open_branch"),
+    "fivdisc.continuation.codim2": ("BifurcationCurve", "CONDITIONS", "bifurcation_curve",
+                                    "curve_from_branch", "open_curve"),
+    "fivdisc.continuation.region": ("REGIONS", "bistable_region"),
 }
 
 __all__, __getattr__, __dir__ = public(globals(), _API)

@@ -18,6 +18,7 @@ _API = {
                                 "plot_stability_boundary", "plot_stability_map"),
     "fivdisc.plots.branch": ("plot_branch",),
     "fivdisc.plots.sweep": ("plot_bifurcation", "plot_separation_map"),
+    "fivdisc.plots.region": ("plot_bifurcation_curve", "plot_bistable_region"),
 }
 
 __all__, __getattr__, __dir__ = public(globals(), _API)
