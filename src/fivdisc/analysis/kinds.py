@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from enum import StrEnum
 
-__all__ = ["BifurcationKind"]
+__all__ = ["CURVE_CONDITIONS", "BifurcationKind"]
 
 
 class BifurcationKind(StrEnum):
@@ -48,3 +48,10 @@ class BifurcationKind(StrEnum):
     CASCADE_END = "cascade end"
     END = "end"
     GAP = "gap"
+
+
+#: The bifurcations a curve in two keys follows by their defining conditions
+#: (:func:`fivdisc.continuation.codim2.bifurcation_curve`).
+CURVE_CONDITIONS = (BifurcationKind.FOLD, BifurcationKind.PERIOD_DOUBLING,
+                    BifurcationKind.TORUS, BifurcationKind.SYMMETRY_BREAKING,
+                    BifurcationKind.GRAZING, BifurcationKind.STICK_SPLIT)

@@ -10,14 +10,12 @@ from pathlib import Path
 
 import click
 
+from fivdisc.analysis.kinds import CURVE_CONDITIONS
 from fivdisc.cli._case import CASE
 from fivdisc.continuation.settings import ContinuationSettings
 from fivdisc.errors import FivdiscError
 
 _DEFAULT = ContinuationSettings()
-# The defining conditions of fivdisc.continuation.codim2.CONDITIONS (light to list here).
-_CONDITIONS = ("fold", "period doubling", "torus", "symmetry breaking", "grazing",
-               "stick split")
 # How the first orbit's search options are named in messages.
 _SEARCH_OPTIONS = ("--period", "--transient", "the search window", "--rtol")
 
@@ -58,7 +56,7 @@ _SEARCH_OPTIONS = ("--period", "--transient", "the search window", "--rtol")
               "--curve-points points, each with its shooting residual and the defining "
               "condition's value).")
 @click.option("--to2", type=float, help="Where the curve in --key2 ends [its unit].")
-@click.option("--condition", type=click.Choice(list(_CONDITIONS)),
+@click.option("--condition", type=click.Choice([str(k) for k in CURVE_CONDITIONS]),
               help="The defining condition the curve follows (default: the bifurcation's "
               "kind); needed where a branch ends at a border, e.g. 'grazing' where the "
               "stick phase of a stick-slip orbit vanishes.")

@@ -61,6 +61,8 @@ from typing import Any
 
 import numpy as np
 
+from fivdisc.analysis.kinds import CURVE_CONDITIONS
+from fivdisc.analysis.kinds import BifurcationKind as Kind
 from fivdisc.case import Case
 from fivdisc.continuation.branch import Branch
 from fivdisc.continuation.checks import check_key, full_key
@@ -74,14 +76,10 @@ __all__ = ["CONDITIONS", "BifurcationCurve", "bifurcation_curve", "curve_from_br
            "open_curve"]
 
 #: The defining conditions a curve can follow.
-CONDITIONS = ("fold", "period doubling", "torus", "symmetry breaking", "grazing",
-              "stick split")
+CONDITIONS = CURVE_CONDITIONS
 # Conditions that hold on one side only: past their zero the orbit has another sequence
 # of phases.
-_ONE_SIDED = ("grazing", "stick split")
-# The branch kinds of fivdisc continue and the condition each is followed by.
-_FROM_KIND = {"fold": "fold", "period doubling": "period doubling", "torus": "torus",
-              "symmetry breaking": "symmetry breaking", "grazing": "grazing"}
+_ONE_SIDED = (Kind.GRAZING, Kind.STICK_SPLIT)
 # A slice's secant stops once its step moves the scaled unknowns by less than this (the
 # key by less than this relative to its first value): ten times finer than the
 # one-parameter location's 1e-7, so that a curve point is on the bifurcation to 1e-8.
@@ -214,12 +212,12 @@ def condition_value(problem: OrbitProblem, pt: Point, condition: str,
         grazing, no stick phase for a stick split, no multiplier of the class).
     """
     track = track or _Track()
-    if condition == "fold":
+    if condition == Kind.FOLD:
         return float(pt.tangent[-1]), 0j
-    if condition in ("period doubling", "torus"):
+    if condition in (Kind.PERIOD_DOUBLING, Kind.TORUS):
         mu = _followed(multipliers_of_kind(pt, condition), track)
-        return (mu.real + 1.0 if condition == "period doubling" else abs(mu) - 1.0), mu
-    if condition == "symmetry breaking":
+        return (mu.real + 1.0 if condition == Kind.PERIOD_DOUBLING else abs(mu) - 1.0), mu
+    if condition == Kind.SYMMETRY_BREAKING:
         if pt.reduced is not None:
             red = np.delete(pt.reduced, np.argmin(np.abs(pt.reduced - 1.0)))
             mu = _followed(red, track)
@@ -228,7 +226,7 @@ def condition_value(problem: OrbitProblem, pt: Point, condition: str,
             mu = _followed(others, track)
         return abs(mu) - 1.0, mu
     sig = " ".join(pt.cycle.signature)
-    if condition == "grazing":
+    if condition == Kind.GRAZING:
         if "stick" in sig:
             # a stick phase that shrinks to nothing, or one reached tangentially
             near = _stick_phases(pt) + _approaches(problem, pt)
@@ -621,10 +619,11 @@ def curve_from_branch(branch: Branch, which: int, key2: str, to2: float, *,
                            "bifurcation(s), numbered from 0")
     b = bifs[which]
     if condition is None:
-        if b["kind"] not in _FROM_KIND:
+        # A kind with a defining condition of its own is followed by it.
+        if b["kind"] not in CONDITIONS:
             raise FivdiscError(f"bifurcation {which} is a {b['kind']}: say which condition to "
                                f"follow there (one of {', '.join(CONDITIONS)})")
-        condition = _FROM_KIND[b["kind"]]
+        condition = Kind(b["kind"])
     value, state, period, phases = (float(b["parameter"]), b["state"], float(b["period"]),
                                     b["phases"])
     if condition in _ONE_SIDED and 0 <= b["point"] < len(branch):

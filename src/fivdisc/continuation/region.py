@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from fivdisc.analysis.kinds import BifurcationKind as Kind
 from fivdisc.case import Case
 from fivdisc.continuation.branch import Branch
 from fivdisc.continuation.settings import ContinuationSettings
@@ -57,9 +58,10 @@ _TRIES = (0.3, 0.5, 0.15, 0.7)
 _TRANSIENT = 675
 # The branch kinds that end the stable vibration, and the condition each is followed by.
 # None: a border where the flow map jumps, located by one-parameter walks (_by_walks).
-_ENDS = {"fold": "fold", "grazing": "grazing", "signature change": "grazing",
-         "end": "grazing", "discontinuity": None, "discontinuity end": None,
-         "cascade end": None}
+_ENDS = {Kind.FOLD: Kind.FOLD, Kind.GRAZING: Kind.GRAZING,
+         Kind.SIGNATURE_CHANGE: Kind.GRAZING, Kind.STICK_SPLIT: Kind.STICK_SPLIT,
+         Kind.END: Kind.GRAZING, Kind.DISCONTINUITY: None, Kind.DISCONTINUITY_END: None,
+         Kind.CASCADE_END: None}
 
 
 def bistable_region(
@@ -242,7 +244,7 @@ def bistable_region(
         say("the threshold orbits from the Hopf point")
         cycles = hopf_cycles(hopf, float(far), settings=settings)
         last = [(i, b["kind"]) for i, b in enumerate(cycles.bifurcations())
-                if b["kind"] in ("grazing", "fold")]
+                if b["kind"] in (Kind.GRAZING, Kind.FOLD)]
         if last:
             ends.append(("threshold end", cycles, last[0]))
     rows = []

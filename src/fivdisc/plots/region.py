@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from fivdisc.analysis.kinds import BifurcationKind as Kind
 from fivdisc.plots.branch import key_label
 from fivdisc.plots.text import drawing, new_axes, set_title
 
@@ -107,7 +108,8 @@ def plot_bistable_region(ds: xr.Dataset, ax: Axes | None = None) -> Figure:
         ax.plot(hx[run], hy[run], style, color="C3", lw=2.0,
                 label=None if label in drawn else label)
         drawn.add(label)
-    names = {"fold": "fold of cycles", "grazing": "grazing"}
+    names = {Kind.FOLD: "fold of cycles", Kind.GRAZING: "grazing",
+             Kind.STICK_SPLIT: "stick split"}
     for c in range(ds.sizes["curve"]):
         sel = ds["curve"].values == c
         role = str(ds["curve_role"].values[c])
