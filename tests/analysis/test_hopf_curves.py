@@ -276,3 +276,30 @@ def test_the_figure_draws_each_style_as_one_line(stribeck):
     sub = int((stribeck["l1"].values > 0).sum())
     assert dashed and solid
     assert max(len(ln.get_xdata()) for ln in dashed) >= sub - 1
+
+
+def test_every_hopf_curve_is_traced_once():
+    """Three pads over (speed, disc damping) in the box of the bistable-region tutorial:
+    each eigenvalue's Hopf curve once. The disc mode C02's curve bends sharply where it
+    meets the pads' (the Bautin point), and a seed on it lay farther from the traced
+    chords than their tolerance: it was traced a second time. Second route: at each
+    curve's middle point, solved afresh, a pair lies on the imaginary axis at the curve's
+    frequency."""
+    from pathlib import Path
+
+    from fivdisc.case import load_case
+
+    case = load_case(Path(__file__).parents[1] / "data" / "three_pads_issue36.toml")
+    key = "disc.damping_ratio"
+    ds = hopf_curves(case, (SPEED, (15.0, 50.0)), (key, (0.002, 0.004)))
+    modes = [str(m) for m in ds["curve_mode"].values]
+    assert sorted(modes) == ["C02", "phi~0", "phi~1", "phi~2"]
+    for c in range(ds.sizes["curve_index"]):
+        sel = np.flatnonzero(ds["hopf_curve"].values == c)
+        mid = sel[sel.size // 2]
+        point = case.replace({SPEED: float(ds[SPEED].values[mid]),
+                              key: float(ds[key].values[mid])})
+        lam = linear_stability(point).eigenvalues
+        # a pair on the imaginary axis at the curve's frequency
+        i = int(np.argmin(np.abs(lam.imag / (2 * np.pi) - ds["frequency"].values[mid])))
+        assert abs(lam[i].real) < 1e-6 * abs(lam[i])

@@ -483,6 +483,29 @@ def _covers(curve: _Curve, seed: _Seed, tol: float = 1e-3) -> bool:
     return False
 
 
+def _follows_to(box: _Box, curve: _Curve, seed: _Seed, step: float) -> bool:
+    """Whether the seed lies on the traced curve where the chords miss it: a seed lies on
+    the exact curve, the chords off it by up to their sagitta, which near a sharp bend
+    exceeds :func:`_covers`' tolerance (a Hopf curve of C02 was traced twice). Within a
+    step of the curve's nearest point, the curve's eigenvalue is followed along the line
+    to the seed in steps of 1e-3 of the box (each time the eigenvalue nearest the last:
+    the pad modes' eigenvalues, 0.1 Hz apart, move far less per step) and must arrive at
+    the seed's own."""
+    u = np.array([p.u for p in curve.points])
+    dist = np.linalg.norm(u - seed.u, axis=1)
+    k = int(np.argmin(dist))
+    if dist[k] >= step:
+        return False
+    lam = curve.points[k].lam
+    n = max(2, math.ceil(dist[k] / 1e-3))
+    for t in np.linspace(0.0, 1.0, n + 1)[1:]:
+        s = box.solve(u[k] + t * (seed.u - u[k]))
+        if s is None:
+            return False
+        lam = complex(s.lam[int(np.argmin(np.abs(s.lam - lam)))])
+    return abs(lam - seed.lam) <= 1e-9 * abs(seed.lam)
+
+
 @dataclass
 class _Special:
     kind: str
@@ -681,7 +704,7 @@ def hopf_curves(
     found, grid = _seeds(box, seeds)
     curves: list[_Curve] = []
     for seed in found:
-        if any(_covers(c, seed) for c in curves):
+        if any(_covers(c, seed) or _follows_to(box, c, seed, step) for c in curves):
             continue
         curve = _trace_seed(box, seed, step)
         if curve is not None and len(curve.points) > 1:
