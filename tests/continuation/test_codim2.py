@@ -247,3 +247,34 @@ def test_a_curve_point_is_a_start_at_both_keys(grazing, tmp_path):
     orbit = fivdisc.periodic_orbit(saved.case, saved.state, period=saved.period,
                                    phases=saved.phases)
     assert orbit.period == pytest.approx(grazing.period[3], rel=1e-9)
+
+
+def _fig13_branch(static: float) -> fivdisc.Branch:
+    """The paper's Fig. 13 stick-slip orbit, continued up in the disc speed to where its
+    stick phase splits (near 6.5758 rad/s at mu_s = 0.8)."""
+    from fivdisc.paper.cases import FIGURES
+
+    case = FIGURES[13].case.replace({"friction.static": static})
+    orbit = fivdisc.periodic_orbit(case, transient=5.0, window=0.05)
+    return fivdisc.continue_orbit(case, SPEED, 8.0, orbit=orbit, max_points=40,
+                                  confirm_periods=0)
+
+
+def test_stick_split_curve_crosses_the_branches_of_the_paper_case():
+    """The Fig. 13 branch ends at a stick split; followed in the static friction
+    coefficient, the split moves up in speed. Each fresh branch locates its end by
+    bisection on converged orbits to 1e-7, and where it meets a shallow dip the last
+    orbit found depends on how shallow an excursion the event search still sees: 2e-6
+    across starts and steps (docs/continuation.md). So the curve (condition zeroed to
+    1e-7) agrees with the branches to 3e-6."""
+    branch = _fig13_branch(0.8)
+    (k,) = [i for i, b in enumerate(branch.bifurcations()) if b["kind"] == "stick split"]
+    curve = curve_from_branch(branch, k, "friction.static", 0.808, points=4)
+    assert curve.stop_reason == "reached friction.static = 0.808"
+    assert np.all(np.abs(curve.condition) < 1e-6)
+    assert np.all(np.diff(curve.parameter) > 0)
+    for i in _three(curve):
+        again = _fig13_branch(float(curve.second_parameter[i]))
+        (found,) = [b["parameter"] for b in again.bifurcations()
+                    if b["kind"] == "stick split"]
+        assert found == pytest.approx(curve.parameter[i], rel=1e-6)
