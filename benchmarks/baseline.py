@@ -22,7 +22,7 @@ _TESTS = str(Path(__file__).resolve().parents[1] / "tests")
 if _TESTS not in sys.path:
     sys.path.insert(0, _TESTS)
 
-from reference_model import (  # noqa: E402
+from reference.model import (  # noqa: E402
     ModeData,
     ReferenceResult,
     jacobi_integral,
