@@ -87,8 +87,9 @@ def _seconds(python: str, args: tuple[str, ...], env: dict[str, str], workdir: P
     seconds = time.perf_counter() - start
     CPU.append(_cpu() - cpu)
     # Exit status 1 is a result (an orbit not converged, an inconclusive exponent), not
-    # a failure of the benchmark.
-    if out.returncode not in (0, 1):
+    # a failure of the benchmark; a traceback is (numba missing from the interpreter that
+    # runs the numba commit's tree made its "first use" 0.3 s).
+    if out.returncode not in (0, 1) or "Traceback (most recent call last)" in out.stderr:
         raise SystemExit(f"fivdisc {' '.join(args)} failed ({out.returncode}):\n"
                          f"{out.stderr}")
     return seconds
