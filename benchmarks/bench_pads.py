@@ -25,54 +25,17 @@ import argparse
 import os
 import platform
 import time
+from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from fivdisc.analysis.orbits import periodic_orbit
-from fivdisc.case import Case
+from fivdisc.case import load_case
 from fivdisc.continuation.walk import continue_orbit
 
-#: The issue's three-pad case at 22 rad/s (``bist-22-large.toml``).
-CASE = """
-[disc]
-modes = [[0, 0], [0, 1], [0, 2], [0, 3]]
-damping_ratio = 0.003
-damping_frame = "material"
-[slider]
-face = "top"
-track_radius = 0.1
-mass = 0.1
-normal_stiffness = 3e4
-normal_damping = 0.1
-rotational_stiffness = 2e3
-rotational_damping = 0.1
-preload = 500.0
-[[sliders]]
-angle = 0.0
-[[sliders]]
-angle = 2.0943951023931953
-[[sliders]]
-angle = 4.1887902047863905
-[friction]
-law = "stribeck"
-static = 0.8
-kinetic_max = 0.6
-kinetic_min = 0.35
-stribeck_velocity = 1.0
-stribeck_exponent = 2.0
-viscous = 0.0
-[speed]
-profile = "constant"
-value = 22.0
-[simulation]
-duration = 3.0
-initial_state = "equilibrium"
-output_rate = 10000.0
-[simulation.perturbation]
-phi = 0.0
-phi_dot = 14.0
-"""
+#: The issue's three-pad case at 22 rad/s (``bist-22-large.toml``), as the tests keep it.
+CASE = Path(__file__).resolve().parents[1] / "tests" / "data" / "three_pads_issue36.toml"
 
 
 def main() -> None:
@@ -84,7 +47,7 @@ def main() -> None:
     parser.add_argument("--confirm", type=int, default=400,
                         help="periods of the forward run that confirms an end")
     args = parser.parse_args()
-    case = Case.from_toml(CASE)
+    case = load_case(CASE)
     print(f"python {platform.python_version()}, {platform.processor() or platform.machine()}, "
           f"{os.cpu_count()} cores")
     start = time.perf_counter()

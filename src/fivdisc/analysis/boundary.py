@@ -23,10 +23,9 @@ import math
 import numpy as np
 import xarray as xr
 
-from fivdisc.analysis.points import ParameterPoints, check_box, check_keys, check_values
+from fivdisc.analysis.points import ParameterPoints, box_of
 from fivdisc.analysis.stability import mode_labels
 from fivdisc.case import Case
-from fivdisc.errors import CaseError
 
 # Root-finder tolerance in the box scaled to the unit square: the growth rate is known to
 # ~1e-13 of the eigenvalues, so a tighter tolerance only chases round-off.
@@ -239,21 +238,9 @@ def stability_boundary(
     >>> print(f"{curve['frequency'].values[0]:.2f} Hz")  # sqrt(k_phi / I) / 2 pi
     225.08 Hz
     """
-    xkey, ykey = x[0], y[0]
-    xr_, yr_ = check_values("x", xkey, x[1]), check_values("y", ykey, y[1])
-    if len(xr_) != 2 or len(yr_) != 2:
-        raise CaseError("a boundary box needs KEY=START:STOP for each key (two values)")
-    if seeds < 2 or step <= 0.0:
-        raise CaseError(f"seeds = {seeds}, step = {step} are invalid: need seeds >= 2 and "
-                        "step > 0")
-    check_keys(case, [xkey, ykey], ["x", "y"])
-    check_box(case, [(xkey, xr_), (ykey, yr_)], ["x", "y"])
-    points = ParameterPoints(case, [xkey, ykey])
-    points.require_equilibrium((xr_[0], yr_[0]), "--boundary")
-    lo = np.array([xr_[0], yr_[0]])
-    span = np.array([xr_[1] - xr_[0], yr_[1] - yr_[0]])
-    g = _Growth(points, lo, span)
-    return _dataset(case, g, zero_curves(g, seeds, step), (xkey, xr_), (ykey, yr_))
+    box = box_of(case, x, y, seeds, step, "--boundary", "a boundary box")
+    g = _Growth(box.points, box.lo, box.span)
+    return _dataset(case, g, zero_curves(g, seeds, step), box.x, box.y)
 
 
 def zero_curves(g, seeds: int = 12, step: float = 0.02

@@ -38,10 +38,9 @@ import xarray as xr
 
 from fivdisc.analysis.boundary import zero_curves
 from fivdisc.analysis.normalform import first_lyapunov
-from fivdisc.analysis.points import ParameterPoints, check_box, check_keys, check_values
+from fivdisc.analysis.points import ParameterPoints, box_of
 from fivdisc.analysis.stability import mode_labels
 from fivdisc.case import Case
-from fivdisc.errors import CaseError
 
 __all__ = ["hopf_curve_lines", "hopf_curves"]
 
@@ -687,20 +686,8 @@ def hopf_curves(
     >>> print(curves["l1"].values[0] < 0 < curves["l1"].values[-1])
     True
     """
-    xkey, ykey = x[0], y[0]
-    xr_, yr_ = check_values("x", xkey, x[1]), check_values("y", ykey, y[1])
-    if len(xr_) != 2 or len(yr_) != 2:
-        raise CaseError("a box needs KEY=START:STOP for each key (two values)")
-    if seeds < 2 or not step > 0.0:
-        raise CaseError(f"seeds = {seeds}, step = {step} are invalid: need seeds >= 2 and "
-                        "step > 0")
-    check_keys(case, [xkey, ykey], ["x", "y"])
-    check_box(case, [(xkey, xr_), (ykey, yr_)], ["x", "y"])
-    points = ParameterPoints(case, [xkey, ykey])
-    points.require_equilibrium((xr_[0], yr_[0]), "--hopf-curves")
-    lo = np.array([xr_[0], yr_[0]])
-    span = np.array([xr_[1] - xr_[0], yr_[1] - yr_[0]])
-    box = _Box(points, lo, span)
+    checked = box_of(case, x, y, seeds, step, "--hopf-curves")
+    box = _Box(checked.points, checked.lo, checked.span)
     found, grid = _seeds(box, seeds)
     curves: list[_Curve] = []
     for seed in found:
@@ -713,7 +700,7 @@ def hopf_curves(
     specials = [sp for i, c in enumerate(curves) for sp in _specials(box, c, i, l1s[i])]
     specials = _merge(specials, curves)
     existence = _existence_curves(box, grid, seeds, step)
-    return _dataset(case, box, curves, l1s, specials, existence, (xkey, xr_), (ykey, yr_))
+    return _dataset(case, box, curves, l1s, specials, existence, checked.x, checked.y)
 
 
 def _merge(specials: list[_Special], curves: list[_Curve]) -> list[_Special]:

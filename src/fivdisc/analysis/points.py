@@ -11,6 +11,7 @@ cannot change it (the sliders' dampers).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import NamedTuple
 
 import numpy as np
 
@@ -335,3 +336,37 @@ class ParameterPoints:
         """Eigenvalues [1/s] of the slip Jacobian at one point (None: no equilibrium)."""
         point = self.linearise(values, guess)
         return None if point is None else np.linalg.eigvals(point[2])
+
+
+class Box(NamedTuple):
+    """A checked box of two keys (:func:`box_of`): each axis as (key, (start, stop)), the
+    equilibria and Jacobians over it, its lower corner and its sides."""
+
+    x: tuple[str, np.ndarray]
+    y: tuple[str, np.ndarray]
+    points: ParameterPoints
+    lo: np.ndarray
+    span: np.ndarray
+
+
+def box_of(case: Case, x: tuple[str, Sequence[float]], y: tuple[str, Sequence[float]],
+           seeds: int, step: float, option: str, what: str = "a box") -> Box:
+    """The box ``x`` by ``y`` (each ``(key, (start, stop))``) of a case, checked before any
+    work: two values per key, ``seeds >= 2`` and ``step > 0`` (the tracing's), keys that
+    change the linearisation and a box the model accepts, a sliding equilibrium at its
+    lower corner (``option`` names the scan in the messages, ``what`` the box)."""
+    from fivdisc.errors import CaseError
+
+    xkey, ykey = x[0], y[0]
+    xr_, yr_ = check_values("x", xkey, x[1]), check_values("y", ykey, y[1])
+    if len(xr_) != 2 or len(yr_) != 2:
+        raise CaseError(f"{what} needs KEY=START:STOP for each key (two values)")
+    if seeds < 2 or not step > 0.0:
+        raise CaseError(f"seeds = {seeds}, step = {step} are invalid: need seeds >= 2 and "
+                        "step > 0")
+    check_keys(case, [xkey, ykey], ["x", "y"])
+    check_box(case, [(xkey, xr_), (ykey, yr_)], ["x", "y"])
+    points = ParameterPoints(case, [xkey, ykey])
+    points.require_equilibrium((xr_[0], yr_[0]), option)
+    return Box((xkey, xr_), (ykey, yr_), points, np.array([xr_[0], yr_[0]]),
+               np.array([xr_[1] - xr_[0], yr_[1] - yr_[0]]))

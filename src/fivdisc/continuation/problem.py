@@ -307,47 +307,37 @@ class OrbitProblem:
             raise ConvergenceError(reason, reason=reason)
         z, residual, it = best
         point = self._linearised(z, phase, residual, it)
+        # One Newton step on the point's own Jacobian (the chord iterations used the
+        # previous point's).
+        lhs = np.vstack([point.jac, row])
+        rhs = -np.r_[self.gap_of(point.shot, point.x), phase @ (z[:m] - x_ref),
+                     row @ z - target]
+        z_new = z + np.linalg.solve(lhs, rhs)
+        x, period, p = self.unpack(z_new)
+        shooting = self.shooter(p)
+        try:
+            shot = shooting.shoot(x, period, tangents=False)
+            polished = (shooting.residual(shot, x, period)
+                        if np.array_equal(shot.free, self.free) else np.inf)
+        except FivdiscError:
+            polished = np.inf
         if residual > POLISH * self.tol:
             # The chord iterations stalled above the polish level (the previous point's
-            # Jacobian no longer contracts well enough): one Newton step on this point's
-            # own Jacobian, kept if it lowers the residual.
-            lhs = np.vstack([point.jac, row])
-            rhs = -np.r_[self.gap_of(point.shot, point.x), phase @ (z[:m] - x_ref),
-                         row @ z - target]
-            z_new = z + np.linalg.solve(lhs, rhs)
-            x, period, p = self.unpack(z_new)
-            try:
-                shot = self.shooter(p).shoot(x, period, tangents=False)
-                polished = (self.shooter(p).residual(shot, x, period)
-                            if np.array_equal(shot.free, self.free) else np.inf)
-            except FivdiscError:
-                polished = np.inf
+            # Jacobian no longer contracts well enough): the step is kept, with its own
+            # linearisation, if it lowers the residual.
             if polished < residual:
                 point = self._linearised(z_new, phase, polished, it + 1)
-        else:
-            # Polished: one Newton step on the point's own Jacobian all the same. The
-            # chord iterations' Jacobian (the previous point's) leaves the period off by
-            # up to the residual times the conditioning, large where a multiplier is near
-            # 1 (1.4e-9 of the period at a residual of 7e-11 on the rigid-disc orbit); the
-            # point's own step takes it to the integration's accuracy. Its Jacobian and
-            # multipliers are kept: the step moves the point by about that much.
-            lhs = np.vstack([point.jac, row])
-            rhs = -np.r_[self.gap_of(point.shot, point.x), phase @ (z[:m] - x_ref),
-                         row @ z - target]
-            z_new = z + np.linalg.solve(lhs, rhs)
-            x, period, p = self.unpack(z_new)
-            try:
-                shooting = self.shooter(p)
-                shot = shooting.shoot(x, period, tangents=False)
-                polished = (shooting.residual(shot, x, period)
-                            if np.array_equal(shot.free, self.free) else np.inf)
-            except FivdiscError:
-                polished = np.inf
-            if polished < POLISH * self.tol:
-                x = shooting.held(x)
-                held = ~shot.free
-                x[held] = shot.end[held]
-                point.z, point.x, point.residual = z_new, x, polished
+        elif polished < POLISH * self.tol:
+            # Polished, the step is taken all the same. The chord iterations' Jacobian
+            # leaves the period off by up to the residual times the conditioning, large
+            # where a multiplier is near 1 (1.4e-9 of the period at a residual of 7e-11
+            # on the rigid-disc orbit); the point's own step takes it to the
+            # integration's accuracy. Its Jacobian and multipliers are kept: the step
+            # moves the point by about that much.
+            x = shooting.held(x)
+            held = ~shot.free
+            x[held] = shot.end[held]
+            point.z, point.x, point.residual = z_new, x, polished
         return point
 
     def _linearised(self, z: np.ndarray, phase: np.ndarray, residual: float,
