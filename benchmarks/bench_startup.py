@@ -6,16 +6,27 @@ Run ``python benchmarks/bench_startup.py`` (``--repeat N`` processes per command
 with the garbage collector's default thresholds, which the command line raises;
 ``--reference`` also times the slow scipy reference on it, once, as a whole process;
 ``--baseline COMMIT`` also times each fivdisc command with the fivdisc of an earlier
-commit, ``previous.source_tree``, on the same interpreter and libraries). The fivdisc on
-``sys.path`` is timed: set ``PYTHONPATH=src`` to time a clone. It prints, per command, the
-median wall time of its fresh processes [s], its ratio to the interpreter's start
-(``python -c pass``), to ``python -c "import numpy"`` and to the baseline's, the median
-processor time (user and system, all threads) and its ratio to the baseline's, and its
-target (issue 11, item 3; issue 29, item 2 for the Fig. 10 command). The commands take
-turns, so that a change in the machine's load during the run falls on all of them alike;
-each runs once before the timing (compiled bytecode, the file cache). The Fig. 10
-command is compared, last, with the sum of ``python -c "import numpy"`` and the
-integration it prints (its median): issue 37, item 5 asks for at most 1.3 x that, and
+commit). The fivdisc on ``sys.path`` is timed: set ``PYTHONPATH=src`` to time a clone.
+
+The baseline's commands run with the Python of the commit's own virtual environment,
+``previous.environment`` (built once and cached; a minute or two the first time), without
+``PYTHONPATH``: the numba commits need numba, which the working tree no longer depends on
+and its environment need not have, so their sources on this interpreter would end in an
+ImportError. That environment is a virtual environment of the same interpreter with the
+same libraries plus numba (their versions, both sides', are printed; for
+``previous.LAST_NUMBA`` numpy, scipy and pydantic are the same), so that mostly fivdisc's
+own code, and its kernel, differ. The run before the timing fills the numba cache of the
+baseline's installed copy, if it is empty: its commands are timed with their kernels
+cached, as a user's second run would be (``bench_first_use.py`` times the first).
+
+It prints, per command, the median wall time of its fresh processes [s], its ratio to the
+interpreter's start (``python -c pass``), to ``python -c "import numpy"`` and to the
+baseline's, the median processor time (user and system, all threads) and its ratio to the
+baseline's, and its target (issue 11, item 3; issue 29, item 2 for the Fig. 10 command).
+The commands take turns, so that a change in the machine's load during the run falls on
+all of them alike; each runs once before the timing (compiled bytecode, the file cache).
+The Fig. 10 command is compared, last, with the sum of ``python -c "import numpy"`` and
+the integration it prints (its median): issue 37, item 5 asks for at most 1.3 x that, and
 at most 0.45 x the numba kernel's command (``--baseline`` a numba commit such as
 ``previous.LAST_NUMBA``).
 """
@@ -33,7 +44,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from previous import source_tree
+from previous import environment, versions, without_pythonpath
 
 # The console script `fivdisc` runs exactly this; through the interpreter being timed, so
 # that no installed copy of fivdisc stands in for the one on sys.path.
@@ -105,16 +116,18 @@ def main() -> None:
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     load = os.getloadavg()[0]
     # Each run: (label, argv, target, environment or None for this one's).
-    baseline_env = None
+    baseline_env = baseline_python = None
     if args.baseline:
-        baseline_env = {**os.environ, "PYTHONPATH": str(source_tree(args.baseline))}
+        baseline_python = str(environment(args.baseline))
+        baseline_env = without_pythonpath()
     with tempfile.TemporaryDirectory() as tmp:
         workdir = Path(tmp)
         commands = _commands(workdir, args.fig10)
         runs = [(label, argv, target, None) for label, argv, target in commands]
         if baseline_env is not None:
-            runs += [(f"{label} @{args.baseline}", argv, None, baseline_env)
-                     for label, argv, _ in commands[2:]]
+            # The same commands, the interpreter replaced by the baseline environment's.
+            runs += [(f"{label} @{args.baseline}", [baseline_python, *argv[1:]], None,
+                      baseline_env) for label, argv, _ in commands[2:]]
         for _, argv, _, env in runs:
             _seconds(argv, workdir, env)
         times: list[list[tuple[float, float]]] = [[] for _ in runs]
@@ -132,6 +145,9 @@ def main() -> None:
     cpu_before = dict(zip(range(2, n), cpus[n:], strict=len(runs) > n))
     print(f"fresh processes, median of {args.repeat} each ({sys.executable}); "
           f"load average {load:.2f} before the run, {os.getloadavg()[0]:.2f} after")
+    if baseline_python is not None:
+        print(f"libraries: {versions(sys.executable)}; @{args.baseline} "
+              f"({baseline_python}): {versions(baseline_python)}")
     # On a loaded machine the processor time (all threads) says more than the wall time.
     print(f"{'command':<44} {'median [s]':>10} {'/ pass':>8} {'/ numpy':>8} "
           f"{'/ before':>9} {'cpu [s]':>8} {'/ before':>9} {'target [s]':>11}")

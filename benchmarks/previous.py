@@ -7,10 +7,20 @@ then runs ``code`` with that environment's Python and returns its standard outpu
 first call takes a minute or two (the install; for a commit whose kernel was numba, also
 numba's compilation on first use).
 
+``environment(commit)`` is that environment's Python, for the benchmarks of whole
+processes (start-up, first use) whose baseline needs a library the working tree no
+longer has: the kernel in numba (``LAST_NUMBA`` and before). They run the earlier
+commit's commands with it, without ``PYTHONPATH`` (``without_pythonpath``): the same
+interpreter (a virtual environment of the same Python) with, from the same package
+indexes, the same libraries plus numba (``versions`` says which: for ``LAST_NUMBA`` numpy,
+scipy and pydantic are the working tree's versions). ``environment(commit,
+extras=("distributed",))`` also installs an extra's requirements into it (once), pinned
+to the versions this interpreter has.
+
 ``source_tree(commit)`` only unpacks the commit's ``src`` (cached in the same place), for
-the benchmarks of whole processes (start-up, first use), which run it with the same
-interpreter and libraries as the working tree, on ``PYTHONPATH``: then only fivdisc's
-own code differs between the two.
+a baseline that needs nothing the working tree's libraries lack (``bench_sweep_pool``):
+it runs with this interpreter and its libraries, on ``PYTHONPATH``, so that only
+fivdisc's own code differs between the two.
 """
 
 from __future__ import annotations
@@ -20,6 +30,8 @@ import subprocess
 import sys
 import tarfile
 import tempfile
+import tomllib
+from collections.abc import Iterable
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
@@ -38,20 +50,63 @@ def _resolve(commit: str) -> str:
                           capture_output=True, text=True).stdout.strip()
 
 
-def environment(commit: str) -> Path:
-    """Python executable of a virtual environment with fivdisc at ``commit``."""
+def environment(commit: str, extras: Iterable[str] = ()) -> Path:
+    """Python executable of a virtual environment with fivdisc at ``commit``, and the
+    requirements of its optional ``extras`` (e.g. ``"distributed"``, which ``fivdisc
+    sweep`` needs)."""
     full = _resolve(commit)
     home = CACHE / full
     python = home / "venv" / "bin" / "python"
-    if (home / "ready").exists():
-        return python
-    home.mkdir(parents=True, exist_ok=True)
-    src = home / "src"
-    _unpack(full, src)
-    subprocess.run([sys.executable, "-m", "venv", str(home / "venv")], check=True)
-    subprocess.run([str(python), "-m", "pip", "install", "-q", str(src)], check=True)
-    (home / "ready").touch()
+    if not (home / "ready").exists():
+        home.mkdir(parents=True, exist_ok=True)
+        src = home / "src"
+        _unpack(full, src)
+        subprocess.run([sys.executable, "-m", "venv", str(home / "venv")], check=True)
+        subprocess.run([str(python), "-m", "pip", "install", "-q", str(src)], check=True)
+        (home / "ready").touch()
+    for extra in extras:
+        if not (home / f"ready-{extra}").exists():
+            _install_extra(home, python, extra)
+            (home / f"ready-{extra}").touch()
     return python
+
+
+def _extra_requirements(pyproject: Path, extra: str) -> list[str]:
+    """The requirements of fivdisc's optional ``extra`` in ``pyproject``, the package's own
+    extras it names (``fivdisc[plot,distributed]``) expanded."""
+    project = tomllib.loads(pyproject.read_text())["project"]
+    found: list[str] = []
+    for requirement in project.get("optional-dependencies", {})[extra]:
+        if requirement.replace(" ", "").startswith(project["name"] + "["):
+            names = requirement.split("[", 1)[1].split("]", 1)[0].split(",")
+            for name in names:
+                found += _extra_requirements(pyproject, name.strip())
+        else:
+            found.append(requirement)
+    return found
+
+
+def _install_extra(home: Path, python: Path, extra: str) -> None:
+    """Install the requirements of ``extra`` (not fivdisc again: that would replace the
+    installed copy and its numba cache), at the versions this interpreter has where it
+    has them (``pip freeze`` as constraints)."""
+    requirements = _extra_requirements(home / "src" / "pyproject.toml", extra)
+    frozen = subprocess.run([sys.executable, "-m", "pip", "freeze"], check=True,
+                            capture_output=True, text=True).stdout.splitlines()
+    pins = [line for line in frozen if "==" in line and not line.startswith(("-", "#"))
+            and not line.lower().startswith("fivdisc")]
+    with tempfile.NamedTemporaryFile("w", suffix=".txt") as constraints:
+        constraints.write("\n".join(pins) + "\n")
+        constraints.flush()
+        subprocess.run([str(python), "-m", "pip", "install", "-q", "-c", constraints.name,
+                        *requirements], check=True)
+
+
+def without_pythonpath() -> dict[str, str]:
+    """This process's environment variables without ``PYTHONPATH``: set to a clone's
+    ``src`` (to time it), it would put today's fivdisc before an earlier commit's
+    installed one."""
+    return {key: value for key, value in os.environ.items() if key != "PYTHONPATH"}
 
 
 def _unpack(full: str, dest: Path, *paths: str) -> None:
@@ -75,12 +130,25 @@ def source_tree(commit: str) -> Path:
     return home / "src"
 
 
+_VERSIONS = ("import importlib.metadata as m, sys\n"
+             "for name in sys.argv[1:]:\n"
+             "    try: print(name, m.version(name))\n"
+             "    except m.PackageNotFoundError: print(name, '-')")
+
+
+def versions(python: str | Path, names: Iterable[str] = ("numpy", "scipy", "pydantic",
+                                                         "numba")) -> str:
+    """``name version`` of each library installed for ``python``, on one line ('-' where
+    it has none)."""
+    out = subprocess.run([str(python), "-c", _VERSIONS, *names], check=True,
+                         capture_output=True, text=True, env=without_pythonpath()).stdout
+    return ", ".join(out.split("\n")[:-1])
+
+
 def run_previous(commit: str, code: str) -> str:
     """Standard output of ``code`` run by fivdisc at ``commit``."""
     python = environment(commit)
-    # Without PYTHONPATH: set to a clone's src (to time it), it would put today's fivdisc
-    # before the one installed at `commit`.
-    env = {key: value for key, value in os.environ.items() if key != "PYTHONPATH"}
+    env = without_pythonpath()
     env.update(OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
     return subprocess.run([str(python), "-c", code], check=True, capture_output=True,
                           text=True, env=env, cwd=tempfile.gettempdir()).stdout
