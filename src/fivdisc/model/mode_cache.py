@@ -10,6 +10,13 @@ short command. The modes of a geometry, and their values at the radii a model as
 is stamped with a hash of :mod:`fivdisc.model.plate`'s source and the numpy and scipy
 versions: when one changes, the stored modes are ignored and found again. A file that
 cannot be read, or a directory that cannot be written, only costs the root searches.
+
+The modes of every packaged example (their geometries, sliders' tracks and probes) ship
+with the package, in ``plate-modes.json`` beside this module, so that even the first
+command after an install imports no root finder: they are read before the user's file
+and win over it (the same bits on every machine, whatever its scipy). That file is
+stamped with the hash of ``plate.py``'s source alone and written by
+``tools/seed_modes.py``; a test checks it against modes solved afresh.
 """
 
 from __future__ import annotations
@@ -21,9 +28,10 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-__all__ = ["lookup", "lookup_values", "remember", "remember_values"]
+__all__ = ["lookup", "lookup_values", "remember", "remember_values", "source_stamp"]
 
 _FILE = "fivdisc-plate-modes.json"
+_SEED = Path(__file__).with_name("plate-modes.json")
 _modes: dict[str, Any] | None = None
 
 
@@ -35,6 +43,15 @@ def _path() -> Path:
     return Path(home) / "fivdisc" / _FILE
 
 
+def _source() -> bytes:
+    return Path(__file__).with_name("plate.py").read_bytes()
+
+
+def source_stamp() -> str:
+    """The stamp of the packaged modes: a hash of ``plate.py``'s source."""
+    return hashlib.sha256(_source()).hexdigest()[:16]
+
+
 @lru_cache(maxsize=1)
 def _stamp() -> str:
     # The modes are what plate.py computes with these numpy and scipy (their Bessel
@@ -42,9 +59,32 @@ def _stamp() -> str:
     import numpy
     import scipy
 
-    source = Path(__file__).with_name("plate.py").read_bytes()
     versions = f"{numpy.__version__} {scipy.__version__}".encode()
-    return hashlib.sha256(source + versions).hexdigest()[:16]
+    return hashlib.sha256(_source() + versions).hexdigest()[:16]
+
+
+def _seeded() -> dict[str, Any]:
+    """The packaged examples' modes, if stamped by today's ``plate.py``."""
+    try:
+        stored = json.loads(_SEED.read_text())
+    except (OSError, ValueError):
+        return {}
+    if not (isinstance(stored, dict) and stored.get("stamp") == source_stamp()
+            and isinstance(stored.get("modes"), dict)):
+        return {}
+    return stored["modes"]
+
+
+def _with_seed(modes: dict[str, Any]) -> dict[str, Any]:
+    """The user's ``modes`` with the packaged ones over them (the values at radii merged
+    request by request)."""
+    merged = dict(modes)
+    for key, value in _seeded().items():
+        mine = merged.get(key)
+        if key.startswith("values ") and isinstance(mine, dict) and isinstance(value, dict):
+            value = {**mine, **value}
+        merged[key] = value
+    return merged
 
 
 def _read() -> dict[str, Any]:
@@ -62,7 +102,7 @@ def lookup(key: str) -> Any:
     """The value stored under ``key`` (a mode's ``repr`` of its arguments), or None."""
     global _modes
     if _modes is None:
-        _modes = _read()
+        _modes = _with_seed(_read())
     return _modes.get(key)
 
 
@@ -93,7 +133,7 @@ def remember(key: str, value: Any) -> None:
 
     modes = _read()
     modes[key] = value
-    _modes = modes
+    _modes = _with_seed(modes)
     path = _path()
     text = json.dumps({"stamp": _stamp(), "modes": modes})
     try:
