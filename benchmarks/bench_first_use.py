@@ -7,15 +7,28 @@ commands; ``--installed`` to time the fivdisc of this interpreter instead of a f
 install). The working tree is installed with ``pip install`` into a new virtual
 environment (about a minute: the compiled core is built then), and each command runs as
 a whole process the way a new user starts it: its first use in that installation, then
-its later use (the same command again, ``--rounds`` times). The earlier commit runs from
-its unpacked sources (``previous.source_tree``) on this interpreter and its libraries,
-with ``NUMBA_CACHE_DIR`` set to a new empty directory, so that every kernel it needs
-compiles. It prints each process's wall time [s], first use / later use (target of
-issue 37, item 5: within 10 %) and first use now / first use then, with the load average
-before and after and each process's processor time: on a machine shared with other work
-the absolute times say little, the ratios more.
-"""
+its later use (the same command again, ``--rounds`` times).
 
+The earlier commit runs with the Python of its own virtual environment,
+``previous.environment`` (built once and cached under ``~/.cache/fivdisc-bench``; with
+the ``distributed`` extra when ``sweep`` is timed), without ``PYTHONPATH``: its kernel is
+numba, which the working tree no longer depends on and its environment need not have
+(its sources on this interpreter end in an ImportError). That environment is a virtual
+environment of the same interpreter with the same libraries plus numba (both sides'
+versions are printed; for ``previous.LAST_NUMBA`` numpy, scipy and pydantic are the
+same), so that the difference is fivdisc's own code and its kernel. Each of its
+processes gets ``NUMBA_CACHE_DIR`` set to a new empty directory, which that commit's
+kernels look in first (``fivdisc._kernels.cache``), before the ``__pycache__`` of the
+installed copy that other runs may have filled: every kernel the command needs compiles,
+the way it did after a fresh install then (the number of kernels compiled into the
+directory is printed as a check). Its other cache, the plate's modes, goes to the same
+directory unless ``FIVDISC_CACHE_DIR`` is set.
+
+It prints each process's wall time [s], first use / later use (target of issue 37, item
+5: within 10 %) and first use now / first use then, with the load average before and
+after and each process's processor time: on a machine shared with other work the
+absolute times say little, the ratios more.
+"""
 from __future__ import annotations
 
 import argparse
@@ -29,7 +42,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from previous import LAST_NUMBA, source_tree
+from previous import LAST_NUMBA, environment, versions, without_pythonpath
 
 REPO = Path(__file__).resolve().parents[1]
 # The console script `fivdisc` runs exactly this; through the interpreter being timed.
@@ -116,12 +129,14 @@ def main() -> None:
                         help="time the fivdisc of this interpreter, not a fresh install")
     args = parser.parse_args()
     names = args.only or list(COMMANDS)
-    before = str(source_tree(args.baseline))
+    # `fivdisc sweep` needs the distributed extra, at that commit as now.
+    before = str(environment(args.baseline,
+                             extras=("distributed",) if "sweep" in names else ()))
     load = os.getloadavg()[0]
     first: dict[str, float] = {}
     later: dict[str, list[float]] = {n: [] for n in names}
     then: dict[str, float] = {}
-    env_now = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env_now = without_pythonpath()
     with tempfile.TemporaryDirectory() as tmp:
         python = sys.executable if args.installed else _fresh_install(Path(tmp) / "venv")
         if args.installed:
@@ -134,15 +149,22 @@ def main() -> None:
                 for _ in range(args.rounds):
                     later[name].append(_seconds(python, cmd, env_now, Path(work)))
             with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as work:
-                then[name] = _seconds(sys.executable, cmd,
-                                      {**os.environ, "PYTHONPATH": before,
-                                       "NUMBA_CACHE_DIR": cache}, Path(work))
+                then[name] = _seconds(before, cmd,
+                                      {**without_pythonpath(), "NUMBA_CACHE_DIR": cache},
+                                      Path(work))
+                compiled = len(list(Path(cache).rglob("*.nbi")))
             print(f"{name:<10} first {first[name]:6.2f} s (cpu {cpu:.1f} s), later "
                   f"{statistics.median(later[name]):6.2f} s; at {args.baseline} from an empty "
-                  f"numba cache {then[name]:6.1f} s (cpu {CPU[-1]:.1f} s); load "
-                  f"{os.getloadavg()[0]:.1f}", flush=True)
+                  f"numba cache {then[name]:6.1f} s (cpu {CPU[-1]:.1f} s, {compiled} kernels "
+                  f"compiled); load {os.getloadavg()[0]:.1f}", flush=True)
+            if not compiled:
+                print(f"  (at {args.baseline}, {name} compiled nothing into its empty numba "
+                      "cache: not a first use of a numba kernel)", flush=True)
+        # Read after the timing, so that it cannot warm anything a first use reads.
+        libraries = f"now {versions(python)}; at {args.baseline} {versions(before)}"
     print(f"\nload average {load:.2f} before, {os.getloadavg()[0]:.2f} after "
           f"({os.cpu_count()} cores)")
+    print(f"libraries: {libraries}")
     print(f"{'command':<10} {'first [s]':>10} {'later [s]':>10} {'first/later':>12} "
           f"{args.baseline + ' [s]':>13} {'now/then':>9}")
     for name in names:
