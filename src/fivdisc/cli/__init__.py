@@ -51,7 +51,39 @@ class _Warnings:
         self.held = []
 
 
+# Each sub-command: its module in this package and the function defining it. A command is
+# imported when it is named, so that a short command loads only its own module (all of
+# them for the group's help).
+_COMMANDS = {
+    "bifurcation": ("sweep", "bifurcation"),
+    "bistable": ("bistable", "bistable"),
+    "continue": ("continuation", "continuation"),
+    "examples": ("examples", "examples"),
+    "lyapunov": ("dynamics", "lyapunov"),
+    "modes": ("modes", "modes"),
+    "orbit": ("dynamics", "orbit"),
+    "plot": ("plot", "plot"),
+    "reproduce": ("reproduce", "reproduce"),
+    "separation-map": ("sweep", "separation_map"),
+    "simulate": ("simulate", "simulate"),
+    "stability": ("stability", "stability"),
+    "sweep": ("sweep", "sweep"),
+    "warmup": ("warmup", "warmup"),
+}
+
+
 class _Group(click.Group):
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted({*self.commands, *_COMMANDS})
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        if cmd_name not in self.commands and cmd_name in _COMMANDS:
+            from importlib import import_module
+
+            module, name = _COMMANDS[cmd_name]
+            self.add_command(getattr(import_module(f"fivdisc.cli.{module}"), name), cmd_name)
+        return super().get_command(ctx, cmd_name)
+
     def invoke(self, ctx: click.Context):
         shown = _Warnings()
         with warnings.catch_warnings():
@@ -84,40 +116,6 @@ class _Group(click.Group):
 @click.version_option(package_name="fivdisc")
 def cli() -> None:
     """fivdisc: friction-induced vibration of a slider on a spinning elastic disc."""
-
-
-def _register() -> None:
-    from fivdisc.cli import (
-        bistable,
-        continuation,
-        dynamics,
-        examples,
-        modes,
-        plot,
-        reproduce,
-        simulate,
-        stability,
-        sweep,
-        warmup,
-    )
-
-    cli.add_command(modes.modes)
-    cli.add_command(simulate.simulate)
-    cli.add_command(plot.plot)
-    cli.add_command(stability.stability)
-    cli.add_command(dynamics.orbit)
-    cli.add_command(dynamics.lyapunov)
-    cli.add_command(continuation.continuation)
-    cli.add_command(bistable.bistable)
-    cli.add_command(sweep.sweep)
-    cli.add_command(sweep.separation_map)
-    cli.add_command(sweep.bifurcation)
-    cli.add_command(reproduce.reproduce)
-    cli.add_command(examples.examples)
-    cli.add_command(warmup.warmup)
-
-
-_register()
 
 
 def main() -> None:
