@@ -7,15 +7,17 @@ then runs ``code`` with that environment's Python and returns its standard outpu
 first call takes a minute or two (the install; for a commit whose kernel was numba, also
 numba's compilation on first use).
 
-``environment(commit)`` is that environment's Python, for the benchmarks of whole
-processes (start-up, first use) whose baseline needs a library the working tree no
-longer has: the kernel in numba (``LAST_NUMBA`` and before). They run the earlier
-commit's commands with it, without ``PYTHONPATH`` (``without_pythonpath``): the same
-interpreter (a virtual environment of the same Python) with, from the same package
-indexes, the same libraries plus numba (``versions`` says which: for ``LAST_NUMBA`` numpy,
-scipy and pydantic are the working tree's versions). ``environment(commit,
+``environment(commit)`` is that environment's Python, for the benchmarks that run an
+earlier commit in processes of its own (start-up, first use, the earlier store checks of
+``bench_store``) because it needs a library the working tree no longer has: its kernel
+in numba (``LAST_NUMBA`` and before), which its package imports. They run it without
+``PYTHONPATH`` (``without_pythonpath``): the same interpreter (a virtual environment of
+the same Python) with the same libraries, pinned to the versions this interpreter has
+where the commit allows them, plus numba (``versions`` prints them; environments built
+before the pinning have the versions the package indexes offered then: for
+``LAST_NUMBA`` numpy, scipy and pydantic are the working tree's). ``environment(commit,
 extras=("distributed",))`` also installs an extra's requirements into it (once), pinned
-to the versions this interpreter has.
+likewise.
 
 ``source_tree(commit)`` only unpacks the commit's ``src`` (cached in the same place), for
 a baseline that needs nothing the working tree's libraries lack (``bench_sweep_pool``):
@@ -31,7 +33,8 @@ import sys
 import tarfile
 import tempfile
 import tomllib
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
@@ -62,7 +65,13 @@ def environment(commit: str, extras: Iterable[str] = ()) -> Path:
         src = home / "src"
         _unpack(full, src)
         subprocess.run([sys.executable, "-m", "venv", str(home / "venv")], check=True)
-        subprocess.run([str(python), "-m", "pip", "install", "-q", str(src)], check=True)
+        with _constraints() as pins:
+            pinned = subprocess.run([str(python), "-m", "pip", "install", "-q", "-c", pins,
+                                     str(src)])
+        if pinned.returncode:
+            print(f"fivdisc at {commit} cannot have this interpreter's library versions; "
+                  "installing it with the newest it allows", file=sys.stderr)
+            subprocess.run([str(python), "-m", "pip", "install", "-q", str(src)], check=True)
         (home / "ready").touch()
     for extra in extras:
         if not (home / f"ready-{extra}").exists():
@@ -86,11 +95,10 @@ def _extra_requirements(pyproject: Path, extra: str) -> list[str]:
     return found
 
 
-def _install_extra(home: Path, python: Path, extra: str) -> None:
-    """Install the requirements of ``extra`` (not fivdisc again: that would replace the
-    installed copy and its numba cache), at the versions this interpreter has where it
-    has them (``pip freeze`` as constraints)."""
-    requirements = _extra_requirements(home / "src" / "pyproject.toml", extra)
+@contextmanager
+def _constraints() -> Iterator[str]:
+    """A pip constraints file: the version of every library this interpreter has
+    (``pip freeze``, fivdisc left out)."""
     frozen = subprocess.run([sys.executable, "-m", "pip", "freeze"], check=True,
                             capture_output=True, text=True).stdout.splitlines()
     pins = [line for line in frozen if "==" in line and not line.startswith(("-", "#"))
@@ -98,7 +106,15 @@ def _install_extra(home: Path, python: Path, extra: str) -> None:
     with tempfile.NamedTemporaryFile("w", suffix=".txt") as constraints:
         constraints.write("\n".join(pins) + "\n")
         constraints.flush()
-        subprocess.run([str(python), "-m", "pip", "install", "-q", "-c", constraints.name,
+        yield constraints.name
+
+
+def _install_extra(home: Path, python: Path, extra: str) -> None:
+    """Install the requirements of ``extra`` (not fivdisc again: that would replace the
+    installed copy and its numba cache), at the versions this interpreter has."""
+    requirements = _extra_requirements(home / "src" / "pyproject.toml", extra)
+    with _constraints() as pins:
+        subprocess.run([str(python), "-m", "pip", "install", "-q", "-c", pins,
                         *requirements], check=True)
 
 
