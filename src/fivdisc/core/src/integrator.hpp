@@ -29,13 +29,12 @@ namespace fivdisc {
 
 // Scratch of the integrator, allocated once.
 struct Scratch {
-    std::vector<double> ynew, ytmp, yout, dy, kst, rc, evn, evt, probes, ev_old, err_vec;
+    std::vector<double> ynew, ytmp, yout, dy, rc, evn, evt, probes, ev_old, err_vec;
     void init(int size, int n_ev) {
         ynew.assign(size, 0.0);
         ytmp.assign(size, 0.0);
         yout.assign(size, 0.0);
         dy.assign(size, 0.0);
-        kst.assign(size, 0.0);
         rc.assign(static_cast<size_t>(5) * size, 0.0);
         evn.assign(n_ev, 0.0);
         evt.assign(n_ev, 0.0);
@@ -163,7 +162,6 @@ class Integrator {
         const int size = L.size;
         double* ys = sc.ytmp.data();
         Work<double>* ws = &wk;
-        double* kst = sc.kst.data();
         for (int st = 1; st < 7; ++st) {
             if (tan) {
                 ys = tan->ys(st);
@@ -177,9 +175,7 @@ class Integrator {
                     for (int i = 0; i < size; ++i) ys[i] += a * kj[i];
                 }
             }
-            evaluate<double, double>(M, t + dp5::C[st] * hs, ys, size, ph.data(), sg.data(), false, *ws, kst);
-            double* kk = K(st);
-            for (int i = 0; i < size; ++i) kk[i] = kst[i];
+            evaluate<double, double>(M, t + dp5::C[st] * hs, ys, size, ph.data(), sg.data(), false, *ws, K(st));
         }
         if (tan)
             for (int i = 0; i < size; ++i) sc.ytmp[i] = ys[i];

@@ -83,6 +83,7 @@ struct Work {
 // Index of the piece holding x: the last start below x (at or below it when right);
 // 0 before the first. A bisection on the starts.
 inline int piece(const Pieces& p, double x, bool right) {
+    if (p.count <= 1) return 0;  // a constant speed, at every evaluation
     int lo = 0, hi = p.count;
     while (lo < hi) {
         const int mid = (lo + hi) / 2;
@@ -216,9 +217,19 @@ void evaluate(const Model& M, TT t, const T* y, int ylen, const int* ph, const i
             rc[1] = c1;
             rs[1] = s1;
         }
+        // The last two terms kept in registers: the chain waits on arithmetic, not on
+        // reloading what it just stored.
+        const T two_c1 = 2.0 * c1;
+        T c_prev = rc[0], c_cur = c1, s_prev = rs[0], s_cur = s1;
         for (int k = 1; k < lmax; ++k) {
-            rc[k + 1] = 2.0 * c1 * rc[k] - rc[k - 1];
-            rs[k + 1] = 2.0 * c1 * rs[k] - rs[k - 1];
+            const T c_next = two_c1 * c_cur - c_prev;
+            const T s_next = two_c1 * s_cur - s_prev;
+            rc[k + 1] = c_next;
+            rs[k + 1] = s_next;
+            c_prev = c_cur;
+            c_cur = c_next;
+            s_prev = s_cur;
+            s_cur = s_next;
         }
         T wc = zero, wcd = zero, l2gq = zero, gpqd = zero;
         gpq = zero;
