@@ -25,11 +25,14 @@ An earlier commit's store runs as it was, with that commit's own package: in a p
 its own (one per commit, started once, asked for each check in its turn, timing it
 itself), with the Python of the commit's virtual environment, ``previous.environment``
 (built once and cached, with the ``distributed`` extra; a minute or two the first time).
-Its store module cannot be imported beside this fivdisc: it imports names of the package
-as it was (``fivdisc.conventions`` and others, gone since the package moved into layer
-folders), and its package imports the numba kernel, which this interpreter need not
-have. That environment is the same interpreter with the same libraries (zarr, numcodecs,
-xarray, numpy, at this interpreter's versions) plus numba, which the store does not use.
+Its store module alone, imported beside this fivdisc (as this benchmark did before), no
+longer runs: its imports from the package resolve to today's modules, and one of them,
+``fivdisc.conventions`` (the attributes of a new store), is gone since the package moved
+into layer folders; the others (the sweep's spec, its reductions) would be today's, not
+the commit's. Its whole package on this interpreter does not import either: it needs the
+numba kernel, which this interpreter need not have. That environment is the same
+interpreter with the same libraries (zarr, numcodecs, xarray, numpy, at this
+interpreter's versions) plus numba, which the store does not use.
 """
 
 from __future__ import annotations
