@@ -7,7 +7,10 @@ commands; ``--installed`` to time the fivdisc of this interpreter instead of a f
 install). The working tree is installed with ``pip install`` into a new virtual
 environment (about a minute: the compiled core is built then), and each command runs as
 a whole process the way a new user starts it: its first use in that installation, then
-its later use (the same command again, ``--rounds`` times).
+its later use (the same command again, ``--rounds`` times). The installation's commands
+start from an empty cache of disc modes (``FIVDISC_CACHE_DIR`` set to a new directory: a
+new user's machine), and with Python's bytecode writing on whatever the calling shell
+says.
 
 The earlier commit runs with the Python of its own virtual environment,
 ``previous.environment`` (built once and cached under ``~/.cache/fivdisc-bench``; with
@@ -141,6 +144,11 @@ def main() -> None:
         python = sys.executable if args.installed else _fresh_install(Path(tmp) / "venv")
         if args.installed:
             env_now = dict(os.environ)
+        else:
+            # A new user's machine: no disc modes stored yet (only those that ship with
+            # the package), and Python writing its bytecode as it does by default.
+            env_now["FIVDISC_CACHE_DIR"] = str(Path(tmp) / "cache")
+            env_now.pop("PYTHONDONTWRITEBYTECODE", None)
         for name in names:
             cmd = COMMANDS[name]
             with tempfile.TemporaryDirectory() as work:
