@@ -166,5 +166,8 @@ def run_previous(commit: str, code: str) -> str:
     python = environment(commit)
     env = without_pythonpath()
     env.update(OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
-    return subprocess.run([str(python), "-c", code], check=True, capture_output=True,
-                          text=True, env=env, cwd=tempfile.gettempdir()).stdout
+    out = subprocess.run([str(python), "-c", code], capture_output=True, text=True, env=env,
+                         cwd=tempfile.gettempdir())
+    if out.returncode != 0:
+        raise SystemExit(f"fivdisc at {commit} failed ({out.returncode}):\n{out.stderr}")
+    return out.stdout

@@ -1,7 +1,7 @@
 """Every benchmark behind the README's speed table, in one sitting, into one log.
 
 Run ``python benchmarks/speed_table.py -o speed-table.log`` on a quiet machine (about
-40 minutes on 2 cores, more the first time, when the earlier commits' environments are
+25 minutes on 2 cores, more the first time, when the earlier commits' environments are
 built). It runs each script of :data:`RUNS` in turn, with the arguments the README's row
 names, from the ``benchmarks`` directory and with the fivdisc on ``PYTHONPATH`` (set
 ``PYTHONPATH=src`` for a clone), and writes to the log, for each: the command, the
@@ -32,9 +32,11 @@ RUNS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("floor.py", ()),
     ("floor.py", ("--only", "sliders", "--cpu-time")),
     ("bench_core.py", ()),
+    ("compare_core.py", ()),
     ("bench_family.py", ()),
     ("bench_tangent.py", ("--cpu-time", "--span", "2", "--rounds", "21")),
     ("bench_sweep.py", ()),
+    ("bench_sweep_pool.py", ("--repeat", "5", "--baseline", "c312c11")),
     ("bench_store.py", ()),
     ("bench_continuation.py", ("--rounds", "2")),
     ("bench_stability_boundary.py", ()),
