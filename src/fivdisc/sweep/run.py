@@ -101,9 +101,15 @@ def _exit_with_parent(parent: int) -> None:
 
 
 def _init_local_worker(parent: int) -> None:
+    from tqdm import tqdm
+
     # Ctrl-C reaches the whole process group; only the coordinator should act on it.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     threading.Thread(target=_exit_with_parent, args=(parent,), daemon=True).start()
+    # A worker shows no bars. tqdm's default lock is a named semaphore shared between
+    # processes, which a worker terminated by an interrupted sweep would leave behind
+    # (Python's resource tracker then reports it as leaked at the command's exit).
+    tqdm.set_lock(threading.RLock())
 
 
 class _WorkerDied(Exception):
