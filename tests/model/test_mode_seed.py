@@ -43,7 +43,7 @@ def test_the_packaged_modes_are_the_solved_ones(monkeypatch, tmp_path) -> None:
     last bits, and only scipy's Bessel functions may differ from the version that wrote
     the file in the last bits."""
     monkeypatch.setenv("FIVDISC_CACHE_DIR", str(tmp_path))
-    monkeypatch.setattr(mode_cache, "_SEED", tmp_path / "absent.json")
+    monkeypatch.setattr(mode_cache, "_seeded", dict)
     monkeypatch.setattr(mode_cache, "_modes", None)
     plate_module.clear_cache()
     modes = _seed()["modes"]

@@ -501,7 +501,7 @@ def test_stored_modes_are_the_solved_ones_to_the_last_bit(monkeypatch, tmp_path)
 
     monkeypatch.setenv("FIVDISC_CACHE_DIR", str(tmp_path))
     # Without the packaged modes (tests/model/test_mode_seed.py), so that all are stored.
-    monkeypatch.setattr(plate_cache, "_SEED", tmp_path / "absent.json")
+    monkeypatch.setattr(plate_cache, "_seeded", dict)
 
     def modes():
         plate_module.clear_cache()

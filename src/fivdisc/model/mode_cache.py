@@ -63,16 +63,22 @@ def _stamp() -> str:
     return hashlib.sha256(_source() + versions).hexdigest()[:16]
 
 
-def _seeded() -> dict[str, Any]:
-    """The packaged examples' modes, if stamped by today's ``plate.py``."""
+def _stored(path: Path, stamp: str) -> dict[str, Any]:
+    """The modes in the file at `path` if it is stamped `stamp`, else none."""
     try:
-        stored = json.loads(_SEED.read_text())
+        stored = json.loads(path.read_text())
     except (OSError, ValueError):
         return {}
-    if not (isinstance(stored, dict) and stored.get("stamp") == source_stamp()
+    if not (isinstance(stored, dict) and stored.get("stamp") == stamp
             and isinstance(stored.get("modes"), dict)):
         return {}
     return stored["modes"]
+
+
+@lru_cache(maxsize=1)
+def _seeded() -> dict[str, Any]:
+    """The packaged examples' modes, if stamped by today's ``plate.py``."""
+    return _stored(_SEED, source_stamp())
 
 
 def _with_seed(modes: dict[str, Any]) -> dict[str, Any]:
@@ -88,14 +94,7 @@ def _with_seed(modes: dict[str, Any]) -> dict[str, Any]:
 
 
 def _read() -> dict[str, Any]:
-    try:
-        stored = json.loads(_path().read_text())
-    except (OSError, ValueError):
-        return {}
-    if not (isinstance(stored, dict) and stored.get("stamp") == _stamp()
-            and isinstance(stored.get("modes"), dict)):
-        return {}
-    return stored["modes"]
+    return _stored(_path(), _stamp())
 
 
 def lookup(key: str) -> Any:
