@@ -7,10 +7,13 @@ commands; ``--installed`` to time the fivdisc of this interpreter instead of a f
 install). The working tree is installed with ``pip install`` into a new virtual
 environment (about a minute: the compiled core is built then), and each command runs as
 a whole process the way a new user starts it: its first use in that installation, then
-its later use (the same command again, ``--rounds`` times). The installation's commands
+its later use (the same command again, ``--rounds`` times, default 3). A single process
+varies by about 10 %, so there are ``--installs`` installations (default 3: the fresh
+install and copies of it, file for file), each giving one first use per command; the
+median first use is compared with the median later use. Every installation's commands
 start from an empty cache of disc modes (``FIVDISC_CACHE_DIR`` set to a new directory: a
-new user's machine), and with Python's bytecode writing on whatever the calling shell
-says.
+new user's machine), with Python writing its bytecode (its default, whatever the calling
+shell says).
 
 The earlier commit runs with the Python of its own virtual environment,
 ``previous.environment`` (built once and cached under ``~/.cache/fivdisc-bench``; with
@@ -122,10 +125,27 @@ def _fresh_install(home: Path) -> str:
     return python
 
 
+def _installations(tmp: Path, count: int) -> list[tuple[str, dict[str, str]]]:
+    """Python and environment of `count` installations of the working tree, each as a new
+    user's machine has it: no disc modes stored yet (only those that ship with the
+    package) and Python writing its bytecode as it does by default. One fresh install and
+    `count` - 1 copies of it, file for file with their times (so that the bytecode pip
+    compiled stays valid): each gives a first use."""
+    env = without_pythonpath()
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    _fresh_install(tmp / "venv0")
+    for k in range(1, count):
+        shutil.copytree(tmp / "venv0", tmp / f"venv{k}", symlinks=True)
+    return [(str(tmp / f"venv{k}" / "bin" / "python"),
+             {**env, "FIVDISC_CACHE_DIR": str(tmp / f"cache{k}")}) for k in range(count)]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--baseline", default=LAST_NUMBA, help="earlier (numba) commit")
-    parser.add_argument("--rounds", type=int, default=1, help="later uses per command")
+    parser.add_argument("--rounds", type=int, default=3, help="later uses per command")
+    parser.add_argument("--installs", type=int, default=3,
+                        help="installations, each giving one first use per command")
     parser.add_argument("--only", action="append", choices=sorted(COMMANDS),
                         help="time this command (repeatable; default: all)")
     parser.add_argument("--installed", action="store_true",
@@ -136,32 +156,30 @@ def main() -> None:
     before = str(environment(args.baseline,
                              extras=("distributed",) if "sweep" in names else ()))
     load = os.getloadavg()[0]
-    first: dict[str, float] = {}
+    first: dict[str, list[float]] = {n: [] for n in names}
     later: dict[str, list[float]] = {n: [] for n in names}
     then: dict[str, float] = {}
-    env_now = without_pythonpath()
     with tempfile.TemporaryDirectory() as tmp:
-        python = sys.executable if args.installed else _fresh_install(Path(tmp) / "venv")
         if args.installed:
-            env_now = dict(os.environ)
+            installs = [(sys.executable, dict(os.environ))]
         else:
-            # A new user's machine: no disc modes stored yet (only those that ship with
-            # the package), and Python writing its bytecode as it does by default.
-            env_now["FIVDISC_CACHE_DIR"] = str(Path(tmp) / "cache")
-            env_now.pop("PYTHONDONTWRITEBYTECODE", None)
+            installs = _installations(Path(tmp), args.installs)
+        python = installs[0][0]
         for name in names:
             cmd = COMMANDS[name]
-            with tempfile.TemporaryDirectory() as work:
-                first[name] = _seconds(python, cmd, env_now, Path(work))
-                cpu = CPU[-1]
-                for _ in range(args.rounds):
-                    later[name].append(_seconds(python, cmd, env_now, Path(work)))
+            for k, (python_k, env_k) in enumerate(installs):
+                with tempfile.TemporaryDirectory() as work:
+                    first[name].append(_seconds(python_k, cmd, env_k, Path(work)))
+                    if k == 0:
+                        cpu = CPU[-1]
+                        for _ in range(args.rounds):
+                            later[name].append(_seconds(python_k, cmd, env_k, Path(work)))
             with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as work:
                 then[name] = _seconds(before, cmd,
                                       {**without_pythonpath(), "NUMBA_CACHE_DIR": cache},
                                       Path(work))
                 compiled = len(list(Path(cache).rglob("*.nbi")))
-            print(f"{name:<10} first {first[name]:6.2f} s (cpu {cpu:.1f} s), later "
+            print(f"{name:<10} first {_spread(first[name])} s (cpu {cpu:.1f} s), later "
                   f"{statistics.median(later[name]):6.2f} s; at {args.baseline} from an empty "
                   f"numba cache {then[name]:6.1f} s (cpu {CPU[-1]:.1f} s, {compiled} kernels "
                   f"compiled); load {os.getloadavg()[0]:.1f}", flush=True)
@@ -177,8 +195,15 @@ def main() -> None:
           f"{args.baseline + ' [s]':>13} {'now/then':>9}")
     for name in names:
         mine = statistics.median(later[name])
-        print(f"{name:<10} {first[name]:>10.2f} {mine:>10.2f} {first[name] / mine:>12.2f} "
-              f"{then[name]:>13.1f} {first[name] / then[name]:>9.2f}")
+        new = statistics.median(first[name])
+        print(f"{name:<10} {new:>10.2f} {mine:>10.2f} {new / mine:>12.2f} "
+              f"{then[name]:>13.1f} {new / then[name]:>9.2f}")
+
+
+def _spread(values: list[float]) -> str:
+    """The median of `values` and, for several, all of them."""
+    median = f"{statistics.median(values):6.2f}"
+    return median if len(values) == 1 else f"{median} ({', '.join(f'{v:.2f}' for v in values)})"
 
 
 if __name__ == "__main__":
