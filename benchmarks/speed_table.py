@@ -1,7 +1,7 @@
 """Every benchmark behind the README's speed table, in one sitting, into one log.
 
 Run ``python benchmarks/speed_table.py -o speed-table.log`` on a quiet machine (about
-25 minutes on 2 cores, more the first time, when the earlier commits' environments are
+20 minutes on 2 cores, more the first time, when the earlier commits' environments are
 built). It runs each script of :data:`RUNS` in turn, with the arguments the README's row
 names, from the ``benchmarks`` directory and with the fivdisc on ``PYTHONPATH`` (set
 ``PYTHONPATH=src`` for a clone), and writes to the log, for each: the command, the
