@@ -28,7 +28,6 @@ from __future__ import annotations
 import argparse
 import os
 import platform
-import time
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -38,15 +37,7 @@ from fivdisc.analysis.orbits import periodic_orbit
 from fivdisc.continuation.codim2 import curve_from_branch
 from fivdisc.continuation.region import bistable_region
 from fivdisc.continuation.walk import continue_orbit
-
-
-def _fastest(rounds: int, work):
-    times, out = [], None
-    for _ in range(rounds):
-        start = time.perf_counter()
-        out = work()
-        times.append(time.perf_counter() - start)
-    return min(times), out
+from timing import fastest
 
 
 def main() -> None:
@@ -60,14 +51,14 @@ def main() -> None:
     base = load_case(examples.path("damped-disc"))
     case = base.replace({"speed.value": 12.3})
     periodic_orbit(case, transient=5.0)  # warm-up: the mode cache, the core
-    one, orbit = _fastest(args.rounds, lambda: periodic_orbit(case, transient=5.0))
-    t_branch, branch = _fastest(args.rounds, lambda: continue_orbit(
+    one, orbit = fastest(args.rounds, lambda: periodic_orbit(case, transient=5.0))
+    t_branch, branch = fastest(args.rounds, lambda: continue_orbit(
         case, "speed.value", 12.8, orbit=orbit, max_points=16))
     per_point = t_branch / len(branch)
     (k,) = [i for i, b in enumerate(branch.bifurcations()) if b["kind"] == "fold"]
     print(f"baseline: one orbit solve {one:.2f} s; one-parameter branch {len(branch)} points "
           f"in {t_branch:.2f} s ({per_point:.3f} s a point, the fold located on the way)")
-    t_curve, curve = _fastest(args.rounds, lambda: curve_from_branch(
+    t_curve, curve = fastest(args.rounds, lambda: curve_from_branch(
         branch, k, "disc.damping_ratio", 0.0025, points=args.points))
     print(f"fold curve in the damping ratio: {len(curve)} points in {t_curve:.2f} s "
           f"({t_curve / len(curve):.3f} s a point) = {t_curve / one:.1f} orbit solves = "
@@ -78,7 +69,7 @@ def main() -> None:
     print(f"  {verdict} the target of 100 points in under 60 s")
     if args.no_region:
         return
-    t_region, ds = _fastest(args.rounds, lambda: bistable_region(
+    t_region, ds = fastest(args.rounds, lambda: bistable_region(
         base, ("speed.value", (18.0, 100.0)), ("disc.damping_ratio", (0.001, 0.003))))
     print(f"bistable region, 2 keys, defaults: {t_region:.1f} s = {t_region / one:.0f} orbit "
           f"solves = {t_region / per_point:.0f} branch points "

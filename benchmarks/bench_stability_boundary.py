@@ -11,7 +11,6 @@ runs each, and prints the times, the eigen-solves each made and the ratio.
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
 
@@ -19,17 +18,9 @@ from fivdisc import load_case
 from fivdisc.analysis.boundary import stability_boundary
 from fivdisc.analysis.stability import stability_map
 from fivdisc.examples import path
+from timing import fastest
 
 X, Y = "slider.normal_damping", "slider.rotational_damping"
-
-
-def _best(repeat: int, work):
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        out = work()
-        times.append(time.perf_counter() - start)
-    return min(times), out
 
 
 def main() -> None:
@@ -39,9 +30,9 @@ def main() -> None:
     for name in ("fig03a", "fig03b"):
         case = load_case(path(name))
         stability_boundary(case, (X, (0.0, 12.0)), (Y, (0.0, 3.0)), seeds=3)  # load kernels
-        exact, ds = _best(args.repeat, lambda c=case: stability_boundary(
+        exact, ds = fastest(args.repeat, lambda c=case: stability_boundary(
             c, (X, (0.0, 12.0)), (Y, (0.0, 3.0))))
-        grid, _ = _best(args.repeat, lambda c=case: stability_map(
+        grid, _ = fastest(args.repeat, lambda c=case: stability_map(
             c, (X, np.linspace(0.0, 12.0, 40)), (Y, np.linspace(0.0, 3.0, 40))))
         print(f"{name}: exact boundary {exact:.2f} s ({ds.attrs['evaluations']} eigen-solves, "
               f"{ds.sizes['point']} points on {ds.sizes['curve']} curve(s)); "

@@ -24,16 +24,25 @@ RIGID = Case(disc={"modes": []}, slider={"rotational_damping": 0.5},
              friction={"decay": 1.0}, speed={"value": 1.0})
 
 
-def test_a_branch_continued_from_a_hopf_branch_restates_its_kind_and_range(tmp_path):
-    """Three points from the Hopf point leave the range undetermined; the branch
-    continued from that file reaches the grazing and states the range from the Hopf
-    point to it, as one continuation from the point does (second route)."""
-    case = tmp_path / "rigid.toml"
+@pytest.fixture(scope="module")
+def three_from_hopf(tmp_path_factory):
+    """A branch of three orbits from RIGID's Hopf point: too short to reach the grazing
+    that ends the bistable range."""
+    home = tmp_path_factory.mktemp("from-hopf")
+    case, first = home / "rigid.toml", home / "hopf.nc"
     case.write_text(RIGID.to_toml())
-    first, second = tmp_path / "hopf.nc", tmp_path / "on.nc"
     res = run_cli(["continue", case, "--key", "speed.value", "--to", "30", "--from-hopf",
                    "0.5:30:25", "--points", "3", "--no-progress", "-o", first])
     assert res.exit_code == 0, res.output
+    return first
+
+
+def test_a_branch_continued_from_a_hopf_branch_restates_its_kind_and_range(
+        three_from_hopf, tmp_path):
+    """Three points from the Hopf point leave the range undetermined; the branch
+    continued from that file reaches the grazing and states the range from the Hopf
+    point to it, as one continuation from the point does (second route)."""
+    first, second = three_from_hopf, tmp_path / "on.nc"
     assert open_branch(first).hopf()["bistable_undetermined"]
     res = run_cli(["continue", "--from", first, "--key", "speed.value", "--to", "30",
                    "--points", "200", "--no-progress", "-o", second, "--json"])
@@ -55,18 +64,13 @@ def test_a_branch_continued_from_a_hopf_branch_restates_its_kind_and_range(tmp_p
     assert whole["bistable"][1] == pytest.approx(info["bistable"][1], rel=1e-5)
 
 
-def test_an_undetermined_range_names_the_farthest_orbit_reached(tmp_path):
+def test_an_undetermined_range_names_the_farthest_orbit_reached(three_from_hopf, tmp_path):
     """A branch continued from a Hopf branch back towards the Hopf point has not decided
     the range beyond its farthest orbit, which is its start, not its end (the new user's
     branch walked down and said "not determined up to" its last value)."""
     import re
 
-    case = tmp_path / "rigid.toml"
-    case.write_text(RIGID.to_toml())
-    first, back = tmp_path / "hopf.nc", tmp_path / "back.nc"
-    res = run_cli(["continue", case, "--key", "speed.value", "--to", "30", "--from-hopf",
-                   "0.5:30:25", "--points", "3", "--no-progress", "-o", first])
-    assert res.exit_code == 0, res.output
+    first, back = three_from_hopf, tmp_path / "back.nc"
     hopf = open_branch(first).hopf()["value"]
     res = run_cli(["continue", "--from", first, "--key", "speed.value", "--to",
                    hopf + 1e-4, "--points", "5", "--no-progress", "-o", back])
