@@ -227,18 +227,21 @@ def _groups(group: Any) -> Iterator[Any]:
         yield from _groups(group.groups[name])
 
 
-def _token(value: Any) -> bytes:
-    """The bytes of an attribute or variable value, with its type and shape."""
+def _token(value: Any) -> tuple[bytes, Any]:
+    """An attribute or variable value as (a header with its type and shape, its bytes):
+    the header and a buffer over the values, so that a large variable is hashed without
+    a copy."""
     import numpy as np
 
     if isinstance(value, str):
-        return b"s" + value.encode()
+        return b"s", value.encode()
     array = np.asarray(value)
     if array.dtype.kind in "OUS":  # text: one item at a time, each with its length
         items = [str(v).encode() for v in array.ravel()]
         body = b"".join(len(i).to_bytes(8, "little") + i for i in items)
-        return f"t{array.shape}".encode() + body
-    return f"{array.dtype.str}{array.shape}".encode() + np.ascontiguousarray(array).tobytes()
+        return f"t{array.shape}".encode(), body
+    return (f"{array.dtype.str}{array.shape}".encode(),
+            np.ascontiguousarray(array).reshape(-1).view(np.uint8))
 
 
 def netcdf_checksum(path: str | PathLike[str]) -> str:
@@ -259,9 +262,11 @@ def netcdf_checksum(path: str | PathLike[str]) -> str:
     digest = hashlib.sha256()
 
     def update(name: str, value: Any) -> None:
-        token = _token(value)
+        # The token is framed by its length: header and body are one token.
+        header, body = _token(value)
         digest.update(len(name).to_bytes(8, "little") + name.encode())
-        digest.update(len(token).to_bytes(8, "little") + token)
+        digest.update((len(header) + len(body)).to_bytes(8, "little") + header)
+        digest.update(body)
 
     with netCDF4.Dataset(path) as root:
         for group in _groups(root):

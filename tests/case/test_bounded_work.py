@@ -15,7 +15,9 @@ from fivdisc.limits import (
     MAX_MODES,
     MAX_NODAL_CIRCLES,
     MAX_NODAL_DIAMETERS,
+    available_memory,
     check_memory,
+    physical_memory,
     simulation_bytes,
 )
 from fivdisc.model.plate import clear_cache
@@ -120,16 +122,36 @@ def test_the_memory_estimate_bounds_a_run_and_is_not_far_above_it() -> None:
 
 
 def test_check_memory_compares_with_the_available_memory(monkeypatch) -> None:
+    # A machine of 64 kB with 1000 bytes available.
+    monkeypatch.setattr("fivdisc.limits.physical_memory", lambda: 64_000)
     monkeypatch.setattr("fivdisc.limits.available_memory", lambda: 1000)
     check_memory(800, "x", "y")
-    with pytest.raises(FivdiscError, match=r"^a grid needs about 7.\d+e-07 GiB of memory, but "
-                                           r"9.\d+e-07 GiB is available: use less$"):
-        check_memory(801, "a grid", "use less")
+    with pytest.raises(FivdiscError, match=r"^a grid needs about 9.3\d+e-07 GiB of memory, but "
+                                           r"9.3\d+e-07 GiB is available: use less$"):
+        check_memory(1001, "a grid", "use less")
     # a case fitting the real machine is refused on a machine with less memory
     monkeypatch.setattr("fivdisc.limits.available_memory", lambda: 1_000_000)
     with pytest.raises(FivdiscError, match=r"simulation.duration = 1\.0 s at "
                                            r"simulation.output_rate = 10000\.0 Hz"):
         simulate(Case())
+
+
+def test_a_need_below_a_64th_of_the_machine_is_not_checked(monkeypatch) -> None:
+    # The available memory is asked only above 1/64 of the machine's (psutil's import
+    # costs more than a small run); nothing is available here, so asking refuses.
+    monkeypatch.setattr("fivdisc.limits.physical_memory", lambda: 64_000)
+    monkeypatch.setattr("fivdisc.limits.available_memory", lambda: 0)
+    check_memory(1000, "x", "y")
+    with pytest.raises(FivdiscError, match="0 GiB is available"):
+        check_memory(1001, "x", "y")
+    # where the system does not say its memory, every need is checked
+    monkeypatch.setattr("fivdisc.limits.physical_memory", lambda: 0)
+    with pytest.raises(FivdiscError, match="0 GiB is available"):
+        check_memory(1, "x", "y")
+
+
+def test_physical_memory_is_at_least_what_is_available() -> None:
+    assert physical_memory() >= available_memory() > 0
 
 
 # --- grids, sweeps, figures ------------------------------------------------------------------

@@ -142,6 +142,37 @@ def test_a_result_rewritten_through_xarray_keeps_its_checksum(result_file: Path,
         assert ds["event_kind"].size == 0 and ds["event_kind"].dtype is str
 
 
+def test_the_checksum_is_the_documented_digest(tmp_path: Path) -> None:
+    """netcdf_checksum is SHA-256 over, in order of name, each attribute and variable as a
+    length-framed name and a length-framed token (type, shape, stored bytes), computed here
+    by hand for a small file: files written before keep their checksums however the hash
+    is fed (a large variable is hashed without copies)."""
+    import hashlib
+
+    from fivdisc.files import netcdf_checksum
+
+    path = tmp_path / "small.nc"
+    x = np.arange(6.0).reshape(3, 2)
+    with netCDF4.Dataset(path, "w") as root:
+        root.createDimension("a", 3)
+        root.createDimension("b", 2)
+        var = root.createVariable("x", np.float64, ("a", "b"))
+        var[...] = x
+        var.setncattr("units", "m")
+        root.setncattr("title", "t")
+        root.setncattr(CHECKSUM, "ignored")
+
+    def framed(data: bytes) -> bytes:
+        return len(data).to_bytes(8, "little") + data
+
+    digest = hashlib.sha256()
+    for name, token in (("group", b"s/"), ("attribute title", b"st"),
+                        ("variable x", b"<f8(3, 2)" + x.tobytes()),
+                        ("attribute x.units", b"sm")):
+        digest.update(framed(name.encode()) + framed(token))
+    assert netcdf_checksum(path) == digest.hexdigest()
+
+
 def test_files_without_a_checksum_are_read_as_before(result_file: Path) -> None:
     # Files of a fivdisc before checksums (or of another program) are not refused.
     with netCDF4.Dataset(result_file, "a") as ds:

@@ -30,7 +30,7 @@ class Table(BaseModel):
     (:mod:`fivdisc.case.tree`) and the error messages (:mod:`fivdisc.case.messages`).
     """
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", defer_build=True)
 
     # Dotted location of this table in a case file, to name keys in error messages.
     _key: ClassVar[tuple[str, ...]] = ()

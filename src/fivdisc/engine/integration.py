@@ -285,7 +285,8 @@ class Integration:
         if phases is not None:
             ph[:] = phases
         bp = model.speed.breakpoints
-        self.breaks = np.unique(bp[bp < duration])
+        # Not np.unique: numpy 2.4's imports numpy.ma (15 ms), before the kernel starts.
+        self.breaks = np.array(sorted(set(bp[bp < duration].tolist())), dtype=float)
         self.core = core.Integrator(
             core.core_model(model), y, ph, t_final=float(duration),
             rtol=float(sim.rtol if rtol is None else rtol),

@@ -100,6 +100,11 @@ def _read() -> dict[str, Any]:
 def lookup(key: str) -> Any:
     """The value stored under ``key`` (a mode's ``repr`` of its arguments), or None."""
     global _modes
+    seeded = _seeded().get(key)
+    if seeded is not None and not key.startswith("values "):
+        # A packaged value wins over the user's: the user's cache (its stamp imports
+        # scipy) need not be read.
+        return seeded
     if _modes is None:
         _modes = _with_seed(_read())
     return _modes.get(key)
@@ -110,9 +115,12 @@ def lookup_values(key: str, radii: list[float]) -> list[float] | None:
     derivative), or None. The radii are looked up as one request: numpy's vectorised
     Bessel functions may round a radius differently in another array, and a model must
     read back exactly what it computed."""
-    stored = lookup(f"values {key}")
-    found = stored.get(repr(radii)) if isinstance(stored, dict) else None
-    return found if isinstance(found, list) and len(found) == len(radii) else None
+    def found_in(stored: Any) -> list[float] | None:
+        found = stored.get(repr(radii)) if isinstance(stored, dict) else None
+        return found if isinstance(found, list) and len(found) == len(radii) else None
+
+    # The packaged values win (see lookup): the user's are read only for other radii.
+    return found_in(_seeded().get(f"values {key}")) or found_in(lookup(f"values {key}"))
 
 
 def remember_values(key: str, radii: list[float], values: list[float]) -> None:
