@@ -1,9 +1,12 @@
 """Imports a run will need next, done in a background thread while the kernel integrates.
 
-The integration kernel releases the GIL (``nogil``), so while it runs a second thread can
-import what the result needs afterwards: for a command that writes netCDF, the netCDF
-library (a fifth of a second of processor time). On a machine with two cores the import
-then costs little wall time. In a process that already has it it does nothing.
+The integration kernel releases the GIL, so while it runs a second thread can import what
+the result needs afterwards: for a command that writes netCDF, the netCDF library (a
+fifth of a second of processor time). On a machine with two cores the import then costs
+little wall time. While the thread imports, the interpreter's switch interval is
+shortened (0.2 ms, restored after), so that the main thread, back from each kernel call,
+takes the GIL at once instead of waiting for the import to let go. In a process that
+already has the library it does nothing.
 """
 
 from __future__ import annotations
@@ -25,13 +28,22 @@ _threads: dict[str, threading.Thread] = {}
 
 
 def _quietly(tasks: list[Callable[[], None]]) -> None:
-    for task in tasks:
-        try:
-            task()
-        except Exception:
-            # A failure here (a missing optional library, say) is the main thread's to
-            # report, when it imports the same module and needs it.
-            return
+    # The kernel releases the GIL for a few milliseconds per call; back from each, the
+    # main thread would wait up to the switch interval (5 ms) for this thread to let go,
+    # so that the import would delay the run about as long as it takes. A short
+    # interval while it imports keeps those waits short.
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(min(interval, 2e-4))
+    try:
+        for task in tasks:
+            try:
+                task()
+            except Exception:
+                # A failure here (a missing optional library, say) is the main thread's
+                # to report, when it imports the same module and needs it.
+                return
+    finally:
+        sys.setswitchinterval(interval)
 
 
 def warm_up(*names: str) -> Callable[[], None]:
