@@ -7,13 +7,15 @@ commands; ``--installed`` to time the fivdisc of this interpreter instead of a f
 install). The working tree is installed with ``pip install`` into a new virtual
 environment (about a minute: the compiled core is built then), and each command runs as
 a whole process the way a new user starts it: its first use in that installation, then
-its later use (the same command again, ``--rounds`` times, default 3). A single process
-varies by about 10 %, so there are ``--installs`` installations (default 3: the fresh
-install and copies of it, file for file), each giving one first use per command; the
-median first use is compared with the median later use. Every installation's commands
-start from an empty cache of disc modes (``FIVDISC_CACHE_DIR`` set to a new directory: a
-new user's machine), with Python writing its bytecode (its default, whatever the calling
-shell says).
+its later use (the same command again, ``--rounds`` times). A single process varies by
+about 10 %, so there are ``--installs`` installations (default 3: the fresh install and
+copies of it, file for file), each giving one first use per command and its later uses
+right after it, so that first and later uses alternate in time and a drift of the
+machine's speed during the run falls on both alike; the median first use is compared
+with the median later use, and each installation's first use with its own later use.
+Every installation's commands start from an empty cache of disc modes
+(``FIVDISC_CACHE_DIR`` set to a new directory: a new user's machine), with Python writing
+its bytecode (its default, whatever the calling shell says).
 
 The earlier commit runs with the Python of its own virtual environment,
 ``previous.environment`` (built once and cached under ``~/.cache/fivdisc-bench``; with
@@ -143,7 +145,8 @@ def _installations(tmp: Path, count: int) -> list[tuple[str, dict[str, str]]]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--baseline", default=LAST_NUMBA, help="earlier (numba) commit")
-    parser.add_argument("--rounds", type=int, default=3, help="later uses per command")
+    parser.add_argument("--rounds", type=int, default=1,
+                        help="later uses per command and installation")
     parser.add_argument("--installs", type=int, default=3,
                         help="installations, each giving one first use per command")
     parser.add_argument("--only", action="append", choices=sorted(COMMANDS),
@@ -167,20 +170,24 @@ def main() -> None:
         python = installs[0][0]
         for name in names:
             cmd = COMMANDS[name]
+            pairs = []
             for k, (python_k, env_k) in enumerate(installs):
                 with tempfile.TemporaryDirectory() as work:
                     first[name].append(_seconds(python_k, cmd, env_k, Path(work)))
                     if k == 0:
                         cpu = CPU[-1]
-                        for _ in range(args.rounds):
-                            later[name].append(_seconds(python_k, cmd, env_k, Path(work)))
+                    mine = [_seconds(python_k, cmd, env_k, Path(work))
+                            for _ in range(args.rounds)]
+                    later[name] += mine
+                    pairs.append(first[name][-1] / statistics.median(mine))
             with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as work:
                 then[name] = _seconds(before, cmd,
                                       {**without_pythonpath(), "NUMBA_CACHE_DIR": cache},
                                       Path(work))
                 compiled = len(list(Path(cache).rglob("*.nbi")))
             print(f"{name:<10} first {_spread(first[name])} s (cpu {cpu:.1f} s), later "
-                  f"{statistics.median(later[name]):6.2f} s; at {args.baseline} from an empty "
+                  f"{_spread(later[name])} s, first/later per installation "
+                  f"{', '.join(f'{r:.2f}' for r in pairs)}; at {args.baseline} from an empty "
                   f"numba cache {then[name]:6.1f} s (cpu {CPU[-1]:.1f} s, {compiled} kernels "
                   f"compiled); load {os.getloadavg()[0]:.1f}", flush=True)
             if not compiled:
