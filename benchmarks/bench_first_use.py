@@ -8,7 +8,7 @@ install). The working tree is installed with ``pip install`` into a new virtual
 environment (about a minute: the compiled core is built then), and each command runs as
 a whole process the way a new user starts it: its first use in that installation, then
 its later use (the same command again, ``--rounds`` times). A single process varies by
-about 10 %, so there are ``--installs`` installations (default 3: the fresh install and
+about 10 %, so there are ``--installs`` installations (default 5: the fresh install and
 copies of it, file for file), each giving one first use per command and its later uses
 right after it, so that first and later uses alternate in time and a drift of the
 machine's speed during the run falls on both alike; the median first use is compared
@@ -147,7 +147,7 @@ def main() -> None:
     parser.add_argument("--baseline", default=LAST_NUMBA, help="earlier (numba) commit")
     parser.add_argument("--rounds", type=int, default=1,
                         help="later uses per command and installation")
-    parser.add_argument("--installs", type=int, default=3,
+    parser.add_argument("--installs", type=int, default=5,
                         help="installations, each giving one first use per command")
     parser.add_argument("--only", action="append", choices=sorted(COMMANDS),
                         help="time this command (repeatable; default: all)")

@@ -104,6 +104,7 @@ Pieces pieces(const Array& a, const char* name) {
     p.rows.assign(a.data(), a.data() + a.size());
     for (int k = 1; k < p.count; ++k)
         if (!(p.start(k) > p.start(k - 1))) fail(std::string(name) + "'s piece starts must increase");
+    p.flat = p.count == 1 && p.c(0, 1) == 0.0 && p.c(0, 2) == 0.0 && p.c(0, 3) == 0.0;
     return p;
 }
 
@@ -152,6 +153,9 @@ Model make_model(const Array& disc, const Array& slider, const Array& shape, con
         fail("opts: the largest l must be a whole number from 0 to " + std::to_string(MAX_L));
     m.lmax = static_cast<int>(lmax);
     d.li.resize(n);
+    d.l2.resize(n);
+    d.cs.resize(n);
+    d.sn.resize(n);
     d.partner.resize(n);
     for (long i = 0; i < n; ++i) {
         const double l = d.l[i];
@@ -160,6 +164,9 @@ Model make_model(const Array& disc, const Array& slider, const Array& shape, con
         if (!(d.sgn[i] == 1.0 || d.sgn[i] == -1.0))
             fail("disc: the cosine/sine flag of coordinate " + std::to_string(i) + " must be +1 or -1");
         d.li[i] = static_cast<int>(l);
+        d.l2[i] = l * l;
+        d.cs[i] = 0.5 + 0.5 * d.sgn[i];
+        d.sn[i] = 0.5 - 0.5 * d.sgn[i];
         const double p = partner[i];
         if (!(p == -1 || (p >= 0 && p < n && p == std::floor(p) && p != i)))
             fail("disc: the partner of coordinate " + std::to_string(i) + " must be -1 or another coordinate");

@@ -20,6 +20,8 @@ struct Disc {
     std::vector<double> sgn;       // +1 cosine (C) coordinate, -1 sine (D) coordinate
     std::vector<double> l;         // nodal diameters, as a number
     std::vector<int> li;           // the same, as an index
+    std::vector<double> l2;        // l^2
+    std::vector<double> cs, sn;    // 1, 0 for a cosine coordinate; 0, 1 for a sine one
     std::vector<int> partner;      // the other member of a doublet, -1 for l = 0
     std::vector<double> minv;      // 1 / M
     std::vector<double> kd;        // M omega^2
@@ -41,6 +43,7 @@ struct Sliders {
 struct Pieces {
     std::vector<double> rows;  // row-major (count, 5)
     int count = 0;
+    bool flat = false;  // one piece, constant: 0 = c1 = c2 = c3
     double start(int k) const { return rows[5 * k]; }
     double c(int k, int p) const { return rows[5 * k + 1 + p]; }
 };

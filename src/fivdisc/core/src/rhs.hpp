@@ -101,6 +101,13 @@ inline int piece(const Pieces& p, double x, bool right) {
 // complex t gives the time derivatives in the imaginary part.
 template <class TT>
 inline void speed_at(const Pieces& sp, TT t, bool right, TT& om, TT& omd) {
+    if (sp.flat) {
+        // A constant speed, at every evaluation: what the cubic below gives at a finite
+        // t, c0 and +0 exactly, without its arithmetic.
+        om = TT(sp.c(0, 0));
+        omd = TT(0.0);
+        return;
+    }
     const int k = piece(sp, re(t), right);
     const TT tau = t - sp.start(k);
     const double c0 = sp.c(k, 0), c1 = sp.c(k, 1), c2 = sp.c(k, 2), c3 = sp.c(k, 3);
@@ -241,13 +248,12 @@ void evaluate(const Model& M, TT t, const T* y, int ylen, const int* ph, const i
         const double* shj = &M.shape[static_cast<size_t>(j) * n];
         for (int i = 0; i < n; ++i) {
             const int li = disc.li[i];
-            const double sgn = disc.sgn[i];
             const double minv = disc.minv[i];
-            // Branch-free g = R cos(l psi) (C, sgn = 1) or R sin(l psi) (D, sgn = -1).
-            const double cs = 0.5 + 0.5 * sgn;
-            const double sn = 0.5 - 0.5 * sgn;
+            // Branch-free g = R cos(l psi) (C: cs = 1, sn = 0) or R sin(l psi) (D).
+            const double cs = disc.cs[i];
+            const double sn = disc.sn[i];
             const T gi = shj[i] * (cs * rc[li] + sn * rs[li]);
-            const T gpi = static_cast<double>(li) * shj[i] * (sn * rc[li] - cs * rs[li]);
+            const T gpi = disc.l[i] * shj[i] * (sn * rc[li] - cs * rs[li]);
             gj[i] = gi;
             gpj[i] = gpi;
             const T qi = y[i];
@@ -256,7 +262,7 @@ void evaluate(const Model& M, TT t, const T* y, int ylen, const int* ph, const i
             wcd += gi * qdi;
             gpq += gpi * qi;
             gpqd += gpi * qdi;
-            l2gq += static_cast<double>(li * li) * gi * qi;
+            l2gq += disc.l2[i] * gi * qi;
             if (ns == 1) {
                 s_gf += gi * wk.fq[i] * minv;
                 s_gg += gi * gi * minv;
