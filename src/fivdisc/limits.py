@@ -69,7 +69,7 @@ MAX_RASTER_SIDE = 2**16 - 1
 # Share of the available memory one request may plan to use.
 _MEMORY_SHARE = 0.8
 # Share of the machine's memory below which a request is not checked against what is
-# available now (1/64: 375 MiB of 24 GiB, 32 MiB of 2 GiB).
+# available now (1/64: 384 MiB of 24 GiB, 32 MiB of 2 GiB).
 _SMALL_SHARE = 1 / 64
 # float64 values held per output sample of a run with n modal coordinates and p probes:
 # the kernel's state and auxiliary buffers (2 n + 9), the dataset's copies of them
