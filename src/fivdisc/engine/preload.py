@@ -28,10 +28,8 @@ _threads: dict[str, threading.Thread] = {}
 
 
 def _quietly(tasks: list[Callable[[], None]]) -> None:
-    # The kernel releases the GIL for a few milliseconds per call; back from each, the
-    # main thread would wait up to the switch interval (5 ms) for this thread to let go,
-    # so that the import would delay the run about as long as it takes. A short
-    # interval while it imports keeps those waits short.
+    # With the default switch interval (5 ms) the main thread, back from each 2 ms
+    # kernel call, would wait for this import about as long as the import takes.
     interval = sys.getswitchinterval()
     sys.setswitchinterval(min(interval, 2e-4))
     try:

@@ -83,7 +83,7 @@ struct Work {
 // Index of the piece holding x: the last start below x (at or below it when right);
 // 0 before the first. A bisection on the starts.
 inline int piece(const Pieces& p, double x, bool right) {
-    if (p.count <= 1) return 0;  // a constant speed, at every evaluation
+    if (p.count <= 1) return 0;  // one piece (a ramp, a one-piece table): no search
     int lo = 0, hi = p.count;
     while (lo < hi) {
         const int mid = (lo + hi) / 2;
